@@ -1,1 +1,47 @@
-//! placeholder
+//! Meshing for C2Warp: from an image to the triangle mesh that gets warped.
+//!
+//! The pipeline is image → [`Domain`] (polygons traced from the alpha channel, or the
+//! full rectangle) → [`triangulate`] (a constrained Delaunay triangulation with
+//! [spade], with handle points and bars as vertices and constraint edges) → [`Mesh`].
+//! Meshes can be saved and loaded as Wavefront OBJ ([`Mesh::write_obj`],
+//! [`Mesh::read_obj`]).
+//!
+//! Coordinates are image pixel coordinates throughout: origin at the top-left corner,
+//! x to the right, y down; pixel `(x, y)` covers `[x, x+1] × [y, y+1]`. The crate knows
+//! nothing of UIs, GPUs or warping weights.
+//!
+//! # Example
+//! ```
+//! use glam::DVec2;
+//! use mesh::{Constraints, DomainOptions, MeshOptions, mesh_image};
+//!
+//! // A 100×80 image whose left half is transparent.
+//! let img = image::RgbaImage::from_fn(100, 80, |x, _| {
+//!     image::Rgba([200, 100, 50, if x < 50 { 0 } else { 255 }])
+//! });
+//! let bar = vec![DVec2::new(60.0, 10.0), DVec2::new(90.0, 70.0)];
+//! let constraints = Constraints { points: &[], polylines: std::slice::from_ref(&bar) };
+//! let opts = MeshOptions { target_vertices: 2_000, ..MeshOptions::default() };
+//! let t = mesh_image(&img, &DomainOptions::default(), &opts, &constraints)?;
+//! t.mesh.sanity_check()?;
+//! assert!(!t.is_convex);
+//! // The bar's ends are vertices at exactly the given coordinates.
+//! assert_eq!(t.mesh.vertices[t.polyline_vertices[0][1] as usize], bar[1]);
+//! # Ok::<(), mesh::MeshError>(())
+//! ```
+
+mod domain;
+mod error;
+mod geometry;
+mod mesh;
+mod obj;
+mod simplify;
+mod trace;
+mod triangulate;
+
+pub use domain::{Domain, DomainOptions, Polygon, domain_from_image};
+pub use error::MeshError;
+pub use mesh::Mesh;
+pub use triangulate::{
+    Constraints, MAX_VERTICES_PER_PIXEL, MeshOptions, TriangulatedImage, mesh_image, triangulate,
+};

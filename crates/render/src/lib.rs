@@ -1,1 +1,33 @@
-//! placeholder
+//! Draws a deformed textured triangle mesh into an RGBA image, and reads and
+//! writes image files safely.
+//!
+//! This crate knows nothing of how the deformed positions were computed: it
+//! takes a [`WarpMesh`] (rest positions = texture coordinates in source
+//! pixels, deformed positions in output pixels, triangles) and draws it.
+//!
+//! * [`warp_cpu`] rasterises at full resolution on the CPU (in parallel with
+//!   rayon), for export on machines without a GPU.
+//! * [`load_image`] / [`decode_image`] decode PNG and JPEG under
+//!   [`ImageLimits`], failing fast on hostile headers.
+//! * [`save_png_atomic`] / [`write_atomic`] replace files atomically, so a
+//!   crash or a full disk never leaves a half-written file over a good one.
+//!
+//! Coordinates follow one convention throughout: origin at the top-left
+//! corner, y down, pixel `(x, y)` covering `[x, x+1] × [y, y+1]` with its
+//! centre at `(x + 0.5, y + 0.5)`.
+
+#![warn(missing_docs)]
+
+mod atomic;
+mod error;
+mod image_io;
+mod mesh;
+mod raster;
+mod sample;
+mod warp;
+
+pub use atomic::{save_png_atomic, write_atomic};
+pub use error::RenderError;
+pub use image_io::{ImageLimits, decode_image, load_image};
+pub use mesh::WarpMesh;
+pub use warp::{RasterOptions, coverage_counts, warp_cpu};

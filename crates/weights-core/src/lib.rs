@@ -1,1 +1,35 @@
-//! placeholder
+//! Closed-form C² weights for handle-driven image warping, after Xian, Jin and Wang,
+//! "Efficient C²-Weighting for Image Warping", with their virtual-handle insertion.
+//!
+//! The crate knows samples, triangles and handles; it knows nothing of images, pixels
+//! or screens. Build a [`Domain`] from sample positions and triangles, put
+//! [`Handle`]s on it, and a [`Rig`] gives every sample sparse weights over the handle
+//! nodes that
+//! - sum to one and are non-negative,
+//! - are one at a node's own sample and zero at every other node,
+//! - are zero beyond each node's support radius (1 − α)·r_d + α·r_h,
+//! - are C² in the distance (basis [`Basis`]).
+//!
+//! Distances are Euclidean on convex domains and shortest paths on the sample graph
+//! otherwise ([`Metric`]). Virtual handles are inserted until every node's cell fits in
+//! its support (Algorithm 1); their transforms blend the real handles' by harmonic
+//! coordinates on the dual graph. Inserting or removing a handle updates only what it
+//! changes and gives the same weights as a rebuild with the same nodes.
+
+mod basis;
+mod domain;
+mod error;
+mod harmonic;
+mod rig;
+mod transform;
+mod virtual_handles;
+mod voronoi;
+mod weights;
+
+pub use basis::{Basis, MAX_DEGREE, MIN_DEGREE, MiddleControls};
+pub use domain::{Domain, Metric};
+pub use error::{DomainError, RigError};
+pub use rig::{
+    BuildTimings, Handle, Node, NodeKind, NodeRadii, Rig, RigOptions, RigStats,
+};
+pub use transform::Similarity;

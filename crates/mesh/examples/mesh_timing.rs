@@ -1,0 +1,79 @@
+//! Times `domain_from_image` + `triangulate` on a 1024×1024 opaque image and on a
+//! cut-out, for several target vertex counts, and reports mesh quality.
+//!
+//! Run with `cargo run --release -p mesh --example mesh_timing`.
+
+use std::time::Instant;
+
+use glam::DVec2;
+use mesh::{Constraints, DomainOptions, MeshOptions, domain_from_image, triangulate};
+
+fn cutout(size: u32) -> image::RgbaImage {
+    let c = size as f64 / 2.0;
+    image::RgbaImage::from_fn(size, size, |x, y| {
+        let p = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
+        // A wobbly blob with a square hole, and a separate small disc.
+        let d = p - DVec2::splat(c * 0.9);
+        let r = c * 0.7 * (1.0 + 0.15 * (5.0 * d.y.atan2(d.x)).sin());
+        let in_blob = d.length() < r;
+        let in_hole = (d.x - 40.0).abs() < 60.0 && (d.y + 30.0).abs() < 60.0;
+        let in_disc = (p - DVec2::new(c * 1.75, c * 1.75)).length() < c * 0.2;
+        let a = if (in_blob && !in_hole) || in_disc { 255 } else { 0 };
+        image::Rgba([128, 64, 32, a])
+    })
+}
+
+fn min_angle_deg(m: &mesh::Mesh) -> (f64, f64) {
+    let mut worst = 180.0f64;
+    let mut below = 0usize;
+    for t in 0..m.triangles.len() {
+        let [a, b, c] = m.triangle_positions(t);
+        for (p, q, r) in [(a, b, c), (b, c, a), (c, a, b)] {
+            let ang = (q - p).angle_to(r - p).abs().to_degrees();
+            worst = worst.min(ang);
+            if ang < 20.0 {
+                below += 1;
+            }
+        }
+    }
+    (worst, below as f64 / m.triangles.len() as f64)
+}
+
+fn main() {
+    let images = [
+        ("opaque", image::RgbaImage::from_pixel(1024, 1024, image::Rgba([1, 2, 3, 255]))),
+        ("cut-out", cutout(1024)),
+    ];
+    for (name, img) in &images {
+        let t0 = Instant::now();
+        let domain = domain_from_image(img, &DomainOptions::default()).expect("domain");
+        let t_domain = t0.elapsed();
+        let rings: usize = domain.rings().map(|r| r.len()).sum();
+        println!(
+            "{name}: domain {:.1} ms, {} polygons, {} ring vertices, area {:.0}",
+            t_domain.as_secs_f64() * 1e3,
+            domain.polygons.len(),
+            rings,
+            domain.area()
+        );
+        for target in [20_000usize, 100_000, 600_000] {
+            let opts = MeshOptions {
+                target_vertices: target,
+                ..MeshOptions::default()
+            };
+            let t1 = Instant::now();
+            let t = triangulate(&domain, &Constraints::default(), &opts).expect("mesh");
+            let el = t1.elapsed();
+            let (worst, frac) = min_angle_deg(&t.mesh);
+            println!(
+                "  target {target:>7}: {:>7} vertices ({:+.1}%), {:>8} triangles, {:>7.1} ms; min angle {:.1}°, {:.3}% angles < 20°",
+                t.mesh.vertices.len(),
+                (t.mesh.vertices.len() as f64 / target as f64 - 1.0) * 100.0,
+                t.mesh.triangles.len(),
+                el.as_secs_f64() * 1e3,
+                worst,
+                frac * 100.0 / 3.0
+            );
+        }
+    }
+}

@@ -1,0 +1,250 @@
+//! Douglas–Peucker simplification of traced outlines that keeps them simple and disjoint.
+
+use glam::DVec2;
+
+use crate::geometry::{SegmentGrid, dist2_point_segment};
+
+type P = [i64; 2];
+
+fn to_f(p: P) -> DVec2 {
+    DVec2::new(p[0] as f64, p[1] as f64)
+}
+
+/// Simplifies closed rings with Douglas–Peucker at tolerance `tol` (pixels).
+///
+/// The input rings must be simple and pairwise disjoint (as traced outlines are). Where a
+/// simplified ring would cross or touch itself or another ring, the offending segments
+/// get back some of their original vertices until no conflict is left, so the output
+/// rings are simple and disjoint too. Orientation and the sign of the area are kept.
+pub(crate) fn simplify_rings(rings: &[Vec<P>], tol: f64) -> Vec<Vec<P>> {
+    let mut keep: Vec<Vec<bool>> = rings.iter().map(|r| douglas_peucker(r, tol)).collect();
+    // Resolve conflicts; each round keeps at least one more original vertex, so this ends.
+    loop {
+        let conflicts = find_conflicts(rings, &keep);
+        if conflicts.is_empty() {
+            break;
+        }
+        let mut progress = false;
+        for (r, i, j) in conflicts {
+            if let Some(k) = farthest_between(&rings[r], i, j) {
+                if !keep[r][k] {
+                    keep[r][k] = true;
+                    progress = true;
+                }
+            }
+        }
+        if !progress {
+            break; // Only original segments conflict: the input was not simple.
+        }
+    }
+    rings
+        .iter()
+        .zip(&keep)
+        .map(|(ring, k)| {
+            ring.iter()
+                .zip(k)
+                .filter(|(_, k)| **k)
+                .map(|(p, _)| *p)
+                .collect()
+        })
+        .collect()
+}
+
+/// Index of the vertex strictly between `i` and `j` (cyclically) farthest from the segment
+/// `ring[i] ring[j]`, or `None` when they are neighbours.
+fn farthest_between(ring: &[P], i: usize, j: usize) -> Option<usize> {
+    let n = ring.len();
+    let (a, b) = (to_f(ring[i]), to_f(ring[j]));
+    let mut best = None;
+    let mut best_d = -1.0;
+    let mut k = (i + 1) % n;
+    while k != j {
+        let d = dist2_point_segment(to_f(ring[k]), a, b);
+        if d > best_d {
+            best_d = d;
+            best = Some(k);
+        }
+        k = (k + 1) % n;
+    }
+    best
+}
+
+/// Douglas–Peucker on a closed ring; returns which vertices to keep (at least 3, with the
+/// sign of the area preserved, or all of them).
+fn douglas_peucker(ring: &[P], tol: f64) -> Vec<bool> {
+    let n = ring.len();
+    let mut keep = vec![false; n];
+    if n <= 4 || tol <= 0.0 {
+        return vec![true; n];
+    }
+    let p0 = to_f(ring[0]);
+    let far = (1..n)
+        .max_by(|&a, &b| {
+            to_f(ring[a])
+                .distance_squared(p0)
+                .total_cmp(&to_f(ring[b]).distance_squared(p0))
+        })
+        .unwrap_or(n / 2);
+    keep[0] = true;
+    keep[far] = true;
+    let tol2 = tol * tol;
+    // Spans (i, j) with j possibly == n meaning index 0.
+    let mut stack = vec![(0usize, far), (far, n)];
+    while let Some((i, j)) = stack.pop() {
+        if j <= i + 1 {
+            continue;
+        }
+        let (a, b) = (to_f(ring[i]), to_f(ring[j % n]));
+        let mut best = 0;
+        let mut best_d = -1.0;
+        for k in i + 1..j {
+            let d = dist2_point_segment(to_f(ring[k]), a, b);
+            if d > best_d {
+                best_d = d;
+                best = k;
+            }
+        }
+        if best_d > tol2 {
+            keep[best] = true;
+            stack.push((i, best));
+            stack.push((best, j));
+        }
+    }
+    let kept: Vec<DVec2> = ring
+        .iter()
+        .zip(&keep)
+        .filter(|(_, k)| **k)
+        .map(|(p, _)| to_f(*p))
+        .collect();
+    let before = crate::geometry::ring_signed_area(&ring.iter().map(|&p| to_f(p)).collect::<Vec<_>>());
+    let after = crate::geometry::ring_signed_area(&kept);
+    if kept.len() < 3 || after == 0.0 || after.signum() != before.signum() {
+        return vec![true; n];
+    }
+    keep
+}
+
+fn orient_i(a: P, b: P, c: P) -> i128 {
+    let (abx, aby) = (i128::from(b[0] - a[0]), i128::from(b[1] - a[1]));
+    let (acx, acy) = (i128::from(c[0] - a[0]), i128::from(c[1] - a[1]));
+    abx * acy - aby * acx
+}
+
+fn on_segment(a: P, b: P, p: P) -> bool {
+    p[0] >= a[0].min(b[0]) && p[0] <= a[0].max(b[0]) && p[1] >= a[1].min(b[1]) && p[1] <= a[1].max(b[1])
+}
+
+/// Whether closed segments `a b` and `c d` share any point (exact integer arithmetic).
+fn segments_touch(a: P, b: P, c: P, d: P) -> bool {
+    let d1 = orient_i(c, d, a).signum();
+    let d2 = orient_i(c, d, b).signum();
+    let d3 = orient_i(a, b, c).signum();
+    let d4 = orient_i(a, b, d).signum();
+    if d1 * d2 < 0 && d3 * d4 < 0 {
+        return true;
+    }
+    (d1 == 0 && on_segment(c, d, a))
+        || (d2 == 0 && on_segment(c, d, b))
+        || (d3 == 0 && on_segment(a, b, c))
+        || (d4 == 0 && on_segment(a, b, d))
+}
+
+/// Simplified segments `(ring, from, to)` (original indices) that touch a segment they
+/// should not.
+fn find_conflicts(rings: &[Vec<P>], keep: &[Vec<bool>]) -> Vec<(usize, usize, usize)> {
+    // Segment list: ring, position in the kept list, original from/to indices.
+    struct Seg {
+        ring: usize,
+        pos: usize,
+        count: usize,
+        i: usize,
+        j: usize,
+    }
+    let mut segs = Vec::new();
+    let mut geo = Vec::new();
+    for (r, (ring, k)) in rings.iter().zip(keep).enumerate() {
+        let idx: Vec<usize> = (0..ring.len()).filter(|&i| k[i]).collect();
+        let m = idx.len();
+        for p in 0..m {
+            let (i, j) = (idx[p], idx[(p + 1) % m]);
+            segs.push(Seg {
+                ring: r,
+                pos: p,
+                count: m,
+                i,
+                j,
+            });
+            geo.push([to_f(ring[i]), to_f(ring[j])]);
+        }
+    }
+    let grid = SegmentGrid::new(geo, 8.0);
+    let mut bad = vec![false; segs.len()];
+    grid.for_each_cell(|items| {
+        for (x, &s) in items.iter().enumerate() {
+            for &t in &items[x + 1..] {
+                let (si, ti) = (s as usize, t as usize);
+                let (s, t) = (&segs[si], &segs[ti]);
+                let (a, b) = (rings[s.ring][s.i], rings[s.ring][s.j]);
+                let (c, d) = (rings[t.ring][t.i], rings[t.ring][t.j]);
+                let conflict = if s.ring == t.ring && (s.pos + 1) % s.count == t.pos {
+                    // t follows s: they share b == c; conflict if t folds back onto s.
+                    orient_i(a, b, d) == 0 && dot(a, b, c, d) < 0
+                } else if s.ring == t.ring && (t.pos + 1) % t.count == s.pos {
+                    orient_i(c, d, b) == 0 && dot(c, d, a, b) < 0
+                } else {
+                    segments_touch(a, b, c, d)
+                };
+                if conflict {
+                    bad[si] = true;
+                    bad[ti] = true;
+                }
+            }
+        }
+    });
+    segs.iter()
+        .zip(&bad)
+        .filter(|(_, b)| **b)
+        .map(|(s, _)| (s.ring, s.i, s.j))
+        .collect()
+}
+
+fn dot(a: P, b: P, c: P, d: P) -> i128 {
+    i128::from(b[0] - a[0]) * i128::from(d[0] - c[0]) + i128::from(b[1] - a[1]) * i128::from(d[1] - c[1])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn staircase_simplifies_and_stays_simple() {
+        // A staircase ring: a right triangle traced along pixel edges.
+        let mut ring = vec![[0, 0]];
+        for k in 0..20 {
+            ring.push([k, k + 1]);
+            ring.push([k + 1, k + 1]);
+        }
+        ring.push([20, 0]);
+        // Orientation for positive area in the crate's convention.
+        let out = simplify_rings(&[ring.clone()], 0.75);
+        assert!(out[0].len() >= 3 && out[0].len() < ring.len());
+    }
+
+    #[test]
+    fn touching_detection() {
+        assert!(segments_touch([0, 0], [4, 4], [0, 4], [4, 0]));
+        assert!(segments_touch([0, 0], [4, 0], [2, 0], [2, 3]));
+        assert!(!segments_touch([0, 0], [4, 0], [0, 1], [4, 1]));
+        assert!(segments_touch([0, 0], [4, 0], [3, 0], [6, 0]));
+    }
+
+    #[test]
+    fn close_rings_do_not_cross_after_simplification() {
+        // Two thin combs interleaved closely would cross if simplified independently.
+        let outer: Vec<P> = vec![[0, 0], [0, 10], [1, 10], [1, 1], [30, 1], [30, 0]];
+        let inner: Vec<P> = vec![[2, 2], [2, 3], [15, 3], [15, 2]];
+        let out = simplify_rings(&[outer, inner], 3.0);
+        let ids: Vec<Vec<bool>> = out.iter().map(|r| vec![true; r.len()]).collect();
+        assert!(find_conflicts(&out, &ids).is_empty());
+    }
+}

@@ -1,0 +1,652 @@
+//! Constrained Delaunay triangulation of a domain with spade, seeded on a hexagonal
+//! lattice and lightly refined.
+
+use std::collections::HashMap;
+use std::panic::{AssertUnwindSafe, catch_unwind};
+
+use glam::DVec2;
+use spade::handles::{FixedVertexHandle, VertexHandle};
+use spade::{
+    AngleLimit, CdtEdge, ConstrainedDelaunayTriangulation, Point2, RefinementParameters,
+    Triangulation,
+};
+
+use crate::geometry::{RingBands, SegmentGrid, dist2_point_segment, ring_signed_area, segment_hits};
+use crate::{Domain, DomainOptions, Mesh, MeshError, domain_from_image};
+
+type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
+
+/// Most vertices per px² of domain that [`triangulate`] will aim for.
+pub const MAX_VERTICES_PER_PIXEL: f64 = 4.0;
+
+/// Lattice points closer than this many lattice spacings to the boundary, a constraint
+/// point or a polyline are left out, so no sliver triangles form there.
+const CLEARANCE: f64 = 0.5;
+
+/// Mesh density and quality.
+#[derive(Debug, Clone)]
+pub struct MeshOptions {
+    /// About how many vertices the mesh should have (the result lands within about
+    /// ±30%, usually much closer). Default 20 000. Capped at
+    /// [`MAX_VERTICES_PER_PIXEL`] per px² of domain; at least the boundary's and the
+    /// constraints' vertices are always used.
+    pub target_vertices: usize,
+    /// Smallest triangle angle (degrees) the refinement aims for, except next to small
+    /// angles of the input (sharp outline corners, constraints close to each other).
+    /// Clamped to `[0, 33]`; NaN means the default. Default 25.
+    pub min_angle_deg: f64,
+}
+
+impl Default for MeshOptions {
+    fn default() -> Self {
+        MeshOptions {
+            target_vertices: 20_000,
+            min_angle_deg: 25.0,
+        }
+    }
+}
+
+/// Points and polylines that must appear in the mesh, in pixel coordinates.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Constraints<'a> {
+    /// Each becomes a mesh vertex at exactly these coordinates (e.g. point handles).
+    pub points: &'a [DVec2],
+    /// Each point becomes a vertex at exactly its coordinates, and each pair of
+    /// consecutive points is joined by a chain of collinear mesh edges (e.g. bar
+    /// handles). Polylines may cross each other (a vertex is added at the crossing) but
+    /// not leave the domain.
+    pub polylines: &'a [Vec<DVec2>],
+}
+
+/// A triangulated domain and where the constraints ended up.
+#[derive(Debug, Clone)]
+pub struct TriangulatedImage {
+    /// The mesh; see [`Mesh`] for its orientation.
+    pub mesh: Mesh,
+    /// Vertex index of each [`Constraints::points`] entry (equal points share a vertex).
+    pub point_vertices: Vec<u32>,
+    /// Vertex index of each point of each [`Constraints::polylines`] entry.
+    pub polyline_vertices: Vec<Vec<u32>>,
+    /// For each polyline, every vertex along it in order, from its first point to its
+    /// last: its own points and the extra vertices that split its segments. Consecutive
+    /// entries are joined by mesh edges.
+    pub polyline_paths: Vec<Vec<u32>>,
+    /// `true` when the domain is the full image rectangle (convex).
+    pub is_convex: bool,
+}
+
+/// Meshes an image in one call: [`domain_from_image`] then [`triangulate`].
+///
+/// # Errors
+/// As [`domain_from_image`] and [`triangulate`].
+///
+/// # Example
+/// ```
+/// use glam::DVec2;
+/// use mesh::{Constraints, DomainOptions, MeshOptions, mesh_image};
+///
+/// let img = image::RgbaImage::from_pixel(64, 48, image::Rgba([9, 9, 9, 255]));
+/// let handles = [DVec2::new(10.5, 20.25), DVec2::new(40.0, 30.0)];
+/// let opts = MeshOptions { target_vertices: 500, ..MeshOptions::default() };
+/// let constraints = Constraints { points: &handles, polylines: &[] };
+/// let t = mesh_image(&img, &DomainOptions::default(), &opts, &constraints)?;
+/// assert!(t.is_convex);
+/// assert_eq!(t.mesh.vertices[t.point_vertices[0] as usize], handles[0]);
+/// assert!((t.mesh.area() - 64.0 * 48.0).abs() < 1e-6);
+/// t.mesh.sanity_check()?;
+/// # Ok::<(), mesh::MeshError>(())
+/// ```
+pub fn mesh_image(
+    image: &image::RgbaImage,
+    domain_opts: &DomainOptions,
+    opts: &MeshOptions,
+    constraints: &Constraints,
+) -> Result<TriangulatedImage, MeshError> {
+    let domain = domain_from_image(image, domain_opts)?;
+    triangulate(&domain, constraints, opts)
+}
+
+/// Triangulates a domain: a constrained Delaunay triangulation (spade) whose constraint
+/// edges are the domain's rings and the constraint polylines, keeping only triangles
+/// inside the domain.
+///
+/// Method: interior vertices are seeded on a hexagonal lattice whose spacing gives about
+/// [`MeshOptions::target_vertices`] vertices, leaving a gap of half a spacing around
+/// the boundary and the constraints; boundary and polyline segments are split to the
+/// same spacing; then spade's Delaunay refinement fixes triangles below the angle limit
+/// or above twice the lattice triangle area. Vertices at constraint coordinates are
+/// never moved or removed. Inside and outside are told apart by parity of crossed
+/// boundary edges, so closed constraint polylines do not carve holes.
+///
+/// Every returned vertex is used by a triangle, triangles are non-degenerate and follow
+/// [`Mesh`]'s orientation. Points on the boundary are allowed.
+///
+/// # Errors
+/// * [`MeshError::EmptyDomain`]: no polygon, or zero total area.
+/// * [`MeshError::InvalidDomain`]: a ring with fewer than 3 vertices or zero area, or
+///   rings that cross.
+/// * [`MeshError::NonFinite`]: a NaN or infinite coordinate.
+/// * [`MeshError::PointOutsideDomain`], [`MeshError::PolylinePointOutsideDomain`],
+///   [`MeshError::PolylineOutsideDomain`]: a constraint off the shape.
+/// * [`MeshError::Triangulation`]: an internal failure of the triangulator.
+pub fn triangulate(
+    domain: &Domain,
+    constraints: &Constraints,
+    opts: &MeshOptions,
+) -> Result<TriangulatedImage, MeshError> {
+    // --- Validate the domain -------------------------------------------------------
+    if domain.polygons.is_empty() {
+        return Err(MeshError::EmptyDomain);
+    }
+    let mut extent = 0.0f64;
+    for (pi, poly) in domain.polygons.iter().enumerate() {
+        for (ri, ring) in poly.rings().enumerate() {
+            let name = || {
+                if ri == 0 {
+                    format!("outer ring of polygon {pi}")
+                } else {
+                    format!("hole {} of polygon {pi}", ri - 1)
+                }
+            };
+            if ring.iter().any(|p| !p.is_finite()) {
+                return Err(MeshError::NonFinite { what: name() });
+            }
+            if ring.len() < 3 {
+                return Err(MeshError::InvalidDomain(format!(
+                    "{} has {} vertices, needs at least 3",
+                    name(),
+                    ring.len()
+                )));
+            }
+            if ring_signed_area(ring) == 0.0 {
+                return Err(MeshError::InvalidDomain(format!("{} has zero area", name())));
+            }
+            for p in ring {
+                extent = extent.max(p.abs().max_element());
+            }
+        }
+    }
+    let area = domain.area();
+    if !(area > 0.0) {
+        return Err(MeshError::EmptyDomain);
+    }
+
+    // --- Lattice spacing ----------------------------------------------------------
+    let target = (opts.target_vertices as f64).min(MAX_VERTICES_PER_PIXEL * area).max(1.0);
+    let spacing = |n: f64| (2.0 * area / (3f64.sqrt() * n)).sqrt();
+    let mut s = spacing(target);
+    let min_angle = if opts.min_angle_deg.is_nan() {
+        MeshOptions::default().min_angle_deg
+    } else {
+        opts.min_angle_deg.clamp(0.0, 33.0)
+    };
+
+    let bands = RingBands::new(domain.rings(), (s * 0.866).max(extent * 1e-9));
+
+    // --- Validate constraints -----------------------------------------------------
+    for (i, p) in constraints.points.iter().enumerate() {
+        if !p.is_finite() {
+            return Err(MeshError::NonFinite {
+                what: format!("constraint point {i}"),
+            });
+        }
+        if !bands.contains(*p) {
+            return Err(MeshError::PointOutsideDomain {
+                index: i,
+                x: p.x,
+                y: p.y,
+            });
+        }
+    }
+    let ring_segs: Vec<[DVec2; 2]> = domain
+        .rings()
+        .flat_map(|r| (0..r.len()).map(move |i| [r[i], r[(i + 1) % r.len()]]))
+        .filter(|s| s[0] != s[1])
+        .collect();
+    for (k, line) in constraints.polylines.iter().enumerate() {
+        for (i, p) in line.iter().enumerate() {
+            if !p.is_finite() {
+                return Err(MeshError::NonFinite {
+                    what: format!("point {i} of polyline {k}"),
+                });
+            }
+            if !bands.contains(*p) {
+                return Err(MeshError::PolylinePointOutsideDomain {
+                    polyline: k,
+                    index: i,
+                    x: p.x,
+                    y: p.y,
+                });
+            }
+        }
+        let mut ts = Vec::new();
+        for (i, w) in line.windows(2).enumerate() {
+            let (p, q) = (w[0], w[1]);
+            ts.clear();
+            ts.extend([0.0, 1.0]);
+            for seg in &ring_segs {
+                segment_hits(p, q, seg[0], seg[1], &mut ts);
+            }
+            ts.sort_by(f64::total_cmp);
+            for t in ts.windows(2) {
+                if t[1] - t[0] > 1e-9 && !bands.contains(p.lerp(q, 0.5 * (t[0] + t[1]))) {
+                    return Err(MeshError::PolylineOutsideDomain {
+                        polyline: k,
+                        segment: i,
+                    });
+                }
+            }
+        }
+    }
+
+    // --- Seed vertices, calibrating the spacing once -------------------------------
+    let mut seeds = Seeds::build(domain, constraints, &bands, s);
+    let n0 = seeds.vertices.len() as f64;
+    if opts.target_vertices > 0 && (n0 / target - 1.0).abs() > 0.03 && seeds.lattice_count > 0 {
+        // The boundary and constraints take vertices too; shrink or grow the lattice.
+        let fixed = (seeds.vertices.len() - seeds.lattice_count) as f64;
+        let want_lattice = (target - fixed).max(0.25 * target);
+        let ratio = seeds.lattice_count as f64 / want_lattice;
+        s *= ratio.sqrt().clamp(0.5, 2.0);
+        let bands = RingBands::new(domain.rings(), (s * 0.866).max(extent * 1e-9));
+        seeds = Seeds::build(domain, constraints, &bands, s);
+    }
+
+    // --- Triangulate (spade), guarding against panics in the triangulator ---------
+    let lattice_area = 3f64.sqrt() / 4.0 * s * s;
+    let max_extra = (opts.target_vertices.max(1000)).max(seeds.vertices.len());
+    let result = catch_unwind(AssertUnwindSafe(|| {
+        build_mesh(domain, &seeds, &ring_segs, extent, lattice_area, min_angle, max_extra)
+    }));
+    let built = match result {
+        Ok(r) => r?,
+        Err(payload) => {
+            let msg = payload
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "panic in the triangulator".into());
+            return Err(MeshError::Triangulation(msg));
+        }
+    };
+
+    // --- Map constraint vertices to mesh indices -----------------------------------
+    let map = |seed: u32| built.new_index.get(seed as usize).copied().unwrap_or(u32::MAX);
+    let mut point_vertices = Vec::with_capacity(constraints.points.len());
+    for (i, &seed) in seeds.point_ids.iter().enumerate() {
+        let v = map(seed);
+        if v == u32::MAX {
+            let p = constraints.points[i];
+            return Err(MeshError::PointOutsideDomain {
+                index: i,
+                x: p.x,
+                y: p.y,
+            });
+        }
+        point_vertices.push(v);
+    }
+    let mut polyline_vertices = Vec::with_capacity(constraints.polylines.len());
+    for (k, ids) in seeds.polyline_ids.iter().enumerate() {
+        let mut out = Vec::with_capacity(ids.len());
+        for (i, &seed) in ids.iter().enumerate() {
+            let v = map(seed);
+            if v == u32::MAX {
+                let p = constraints.polylines[k][i];
+                return Err(MeshError::PolylinePointOutsideDomain {
+                    polyline: k,
+                    index: i,
+                    x: p.x,
+                    y: p.y,
+                });
+            }
+            out.push(v);
+        }
+        polyline_vertices.push(out);
+    }
+    let mut polyline_paths = Vec::with_capacity(built.paths.len());
+    for (k, path) in built.paths.iter().enumerate() {
+        let mut out = Vec::with_capacity(path.len());
+        for &h in path {
+            let v = built.new_index.get(h).copied().unwrap_or(u32::MAX);
+            if v == u32::MAX {
+                return Err(MeshError::PolylineOutsideDomain {
+                    polyline: k,
+                    segment: 0,
+                });
+            }
+            out.push(v);
+        }
+        polyline_paths.push(out);
+    }
+    Ok(TriangulatedImage {
+        mesh: built.mesh,
+        point_vertices,
+        polyline_vertices,
+        polyline_paths,
+        is_convex: domain.is_full_rectangle,
+    })
+}
+
+/// The vertices and constraint edges handed to spade.
+struct Seeds {
+    vertices: Vec<Point2<f64>>,
+    /// Boundary edges (indices into `vertices`).
+    boundary_edges: Vec<[usize; 2]>,
+    /// Polyline sub-edges.
+    polyline_edges: Vec<[usize; 2]>,
+    /// Seed index of each constraint point.
+    point_ids: Vec<u32>,
+    /// Seed index of each polyline point.
+    polyline_ids: Vec<Vec<u32>>,
+    /// How many of `vertices` (at the end) are lattice points.
+    lattice_count: usize,
+}
+
+impl Seeds {
+    fn build(domain: &Domain, constraints: &Constraints, bands: &RingBands, s: f64) -> Seeds {
+        let mut seeds = Seeds {
+            vertices: Vec::new(),
+            boundary_edges: Vec::new(),
+            polyline_edges: Vec::new(),
+            point_ids: Vec::new(),
+            polyline_ids: Vec::new(),
+            lattice_count: 0,
+        };
+        let mut index: HashMap<[u64; 2], u32> = HashMap::new();
+        let mut add = |verts: &mut Vec<Point2<f64>>, p: DVec2| -> u32 {
+            // `+ 0.0` turns -0.0 into 0.0 so both hash alike.
+            let key = [(p.x + 0.0).to_bits(), (p.y + 0.0).to_bits()];
+            *index.entry(key).or_insert_with(|| {
+                verts.push(Point2::new(p.x + 0.0, p.y + 0.0));
+                (verts.len() - 1) as u32
+            })
+        };
+        // Pieces that lattice points keep clear of.
+        let mut clear: Vec<[DVec2; 2]> = Vec::new();
+        let pieces = |len: f64| ((len / s).ceil().clamp(1.0, 1e7)) as usize;
+
+        for ring in domain.rings() {
+            let n = ring.len();
+            let first = seeds.vertices.len();
+            let mut ids: Vec<u32> = Vec::new();
+            for i in 0..n {
+                let (a, b) = (ring[i], ring[(i + 1) % n]);
+                let m = pieces(a.distance(b));
+                for j in 0..m {
+                    let p = a.lerp(b, j as f64 / m as f64);
+                    ids.push(add(&mut seeds.vertices, p));
+                }
+                for j in 0..m {
+                    clear.push([a.lerp(b, j as f64 / m as f64), a.lerp(b, (j + 1) as f64 / m as f64)]);
+                }
+            }
+            let _ = first;
+            for i in 0..ids.len() {
+                let (a, b) = (ids[i], ids[(i + 1) % ids.len()]);
+                if a != b {
+                    seeds.boundary_edges.push([a as usize, b as usize]);
+                }
+            }
+        }
+        for &p in constraints.points {
+            seeds.point_ids.push(add(&mut seeds.vertices, p));
+            clear.push([p, p]);
+        }
+        for line in constraints.polylines {
+            let ids: Vec<u32> = line.iter().map(|&p| add(&mut seeds.vertices, p)).collect();
+            for (i, w) in line.windows(2).enumerate() {
+                let (a, b) = (w[0], w[1]);
+                if ids[i] == ids[i + 1] {
+                    continue;
+                }
+                let m = pieces(a.distance(b));
+                let mut prev = ids[i];
+                for j in 1..=m {
+                    let id = if j == m {
+                        ids[i + 1]
+                    } else {
+                        add(&mut seeds.vertices, a.lerp(b, j as f64 / m as f64))
+                    };
+                    if id != prev {
+                        seeds.polyline_edges.push([prev as usize, id as usize]);
+                    }
+                    prev = id;
+                    clear.push([a.lerp(b, (j - 1) as f64 / m as f64), a.lerp(b, j as f64 / m as f64)]);
+                }
+            }
+            if line.len() == 1 {
+                clear.push([line[0], line[0]]);
+            }
+            seeds.polyline_ids.push(ids);
+        }
+
+        // Hexagonal lattice, row by row, inside the domain and clear of the pieces.
+        let grid = SegmentGrid::new(clear, s);
+        let (lo, hi) = domain.rings().flatten().fold(
+            (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+            |(lo, hi), &p| (lo.min(p), hi.max(p)),
+        );
+        let row_h = s * 3f64.sqrt() / 2.0;
+        let rows = ((hi.y - lo.y) / row_h).floor();
+        let before = seeds.vertices.len();
+        if rows.is_finite() && rows < 1e7 {
+            let mut xs = Vec::new();
+            for j in 0..=(rows as usize) {
+                let y = lo.y + (j as f64 + 0.5) * row_h;
+                if y >= hi.y {
+                    break;
+                }
+                bands.crossings(y, &mut xs);
+                let off = lo.x + if j % 2 == 1 { 0.75 * s } else { 0.25 * s };
+                for pair in xs.chunks_exact(2) {
+                    let (xa, xb) = (pair[0], pair[1]);
+                    let k0 = ((xa - off) / s).ceil();
+                    let k1 = ((xb - off) / s).floor();
+                    if !(k0 <= k1) {
+                        continue;
+                    }
+                    for k in (k0 as i64)..=(k1 as i64) {
+                        let p = DVec2::new(off + k as f64 * s, y);
+                        if p.x > xa && p.x < xb && !grid.any_within(p, CLEARANCE * s) {
+                            seeds.vertices.push(Point2::new(p.x, p.y));
+                        }
+                    }
+                }
+            }
+        }
+        seeds.lattice_count = seeds.vertices.len() - before;
+        seeds
+    }
+}
+
+struct Built {
+    mesh: Mesh,
+    /// New mesh index of each spade vertex (`u32::MAX` when unused).
+    new_index: Vec<u32>,
+    /// Spade vertex indices along each polyline.
+    paths: Vec<Vec<usize>>,
+}
+
+fn pos(v: VertexHandle<'_, Point2<f64>, (), CdtEdge<()>, ()>) -> DVec2 {
+    let p = v.position();
+    DVec2::new(p.x, p.y)
+}
+
+fn build_mesh(
+    domain: &Domain,
+    seeds: &Seeds,
+    ring_segs: &[[DVec2; 2]],
+    extent: f64,
+    lattice_area: f64,
+    min_angle: f64,
+    max_extra: usize,
+) -> Result<Built, MeshError> {
+    let mut conflicts = Vec::new();
+    let mut cdt = Cdt::try_bulk_load_cdt(
+        seeds.vertices.clone(),
+        seeds.boundary_edges.clone(),
+        |e| conflicts.push(e),
+    )
+    .map_err(|e| MeshError::Triangulation(format!("{e:?}")))?;
+    if let Some([a, _]) = conflicts.first() {
+        let p = seeds.vertices[*a];
+        return Err(MeshError::InvalidDomain(format!(
+            "domain rings cross each other near ({}, {})",
+            p.x, p.y
+        )));
+    }
+    if cdt.num_vertices() != seeds.vertices.len() {
+        return Err(MeshError::Triangulation("vertices were merged unexpectedly".into()));
+    }
+    for &[a, b] in &seeds.polyline_edges {
+        cdt.add_constraint_and_split(
+            FixedVertexHandle::from_index(a),
+            FixedVertexHandle::from_index(b),
+            |p| p,
+        );
+    }
+
+    let mut params = RefinementParameters::<f64>::new()
+        .exclude_outer_faces(true)
+        .with_angle_limit(AngleLimit::from_deg(min_angle))
+        .with_max_additional_vertices(max_extra);
+    if lattice_area.is_finite() && lattice_area > 0.0 {
+        params = params
+            .with_max_allowed_area(2.0 * lattice_area)
+            .with_min_required_area(1e-3 * lattice_area);
+    }
+    cdt.refine(params);
+
+    // --- Inside/outside: parity of crossed boundary edges -------------------------
+    let tol = 1e-9 * (1.0 + extent);
+    let boundary_grid = SegmentGrid::new(ring_segs.to_vec(), (extent / 256.0).max(1e-6));
+    let is_boundary = |a: DVec2, b: DVec2| -> bool {
+        let m = 0.5 * (a + b);
+        let t2 = tol * tol;
+        boundary_grid.any_near(m, tol, |i| {
+            let [p, q] = boundary_grid.segments()[i];
+            dist2_point_segment(m, p, q) <= t2
+                && dist2_point_segment(a, p, q) <= t2
+                && dist2_point_segment(b, p, q) <= t2
+        })
+    };
+    const UNSEEN: u8 = 0;
+    const OUT: u8 = 1;
+    const IN: u8 = 2;
+    let mut state = vec![UNSEEN; cdt.num_all_faces()];
+    let mut stack = Vec::new();
+    for e in cdt.directed_edges() {
+        if !e.face().is_outer() {
+            continue;
+        }
+        let Some(inner) = e.rev().face().as_inner() else {
+            continue;
+        };
+        let idx = inner.fix().index();
+        if state[idx] != UNSEEN {
+            continue;
+        }
+        let crossing = e.is_constraint_edge() && is_boundary(pos(e.from()), pos(e.to()));
+        state[idx] = if crossing { IN } else { OUT };
+        stack.push(inner.fix());
+    }
+    while let Some(f) = stack.pop() {
+        let st = state[f.index()];
+        for e in cdt.face(f).adjacent_edges() {
+            let Some(g) = e.rev().face().as_inner() else {
+                continue;
+            };
+            let gi = g.fix().index();
+            if state[gi] != UNSEEN {
+                continue;
+            }
+            let crossing = e.is_constraint_edge() && is_boundary(pos(e.from()), pos(e.to()));
+            state[gi] = if crossing { if st == IN { OUT } else { IN } } else { st };
+            stack.push(g.fix());
+        }
+    }
+
+    // --- Polyline paths, in spade indices ------------------------------------------
+    let mut paths = Vec::with_capacity(seeds.polyline_ids.len());
+    for ids in &seeds.polyline_ids {
+        let mut path: Vec<usize> = Vec::new();
+        if let Some(&first) = ids.first() {
+            path.push(first as usize);
+        }
+        for w in ids.windows(2) {
+            if w[0] == w[1] {
+                continue;
+            }
+            let chain = walk_constraint(&cdt, w[0] as usize, w[1] as usize).ok_or_else(|| {
+                MeshError::Triangulation("lost a polyline edge during refinement".into())
+            })?;
+            path.extend(chain.into_iter().skip(1));
+        }
+        paths.push(path);
+    }
+
+    // --- Extract the inside triangles ------------------------------------------------
+    let mut new_index = vec![u32::MAX; cdt.num_vertices()];
+    let mut vertices = Vec::new();
+    let mut triangles = Vec::new();
+    for face in cdt.inner_faces() {
+        if state[face.fix().index()] != IN {
+            continue;
+        }
+        let tri = face.vertices().map(|v| {
+            let i = v.fix().index();
+            if new_index[i] == u32::MAX {
+                new_index[i] = vertices.len() as u32;
+                vertices.push(pos(v));
+            }
+            new_index[i]
+        });
+        triangles.push(tri);
+    }
+    if triangles.is_empty() {
+        return Err(MeshError::EmptyDomain);
+    }
+    let _ = domain;
+    Ok(Built {
+        mesh: Mesh {
+            vertices,
+            triangles,
+        },
+        new_index,
+        paths,
+    })
+}
+
+/// Follows constraint edges from vertex `from` straight towards vertex `to`.
+fn walk_constraint(cdt: &Cdt, from: usize, to: usize) -> Option<Vec<usize>> {
+    let a = pos(cdt.vertex(FixedVertexHandle::from_index(from)));
+    let b = pos(cdt.vertex(FixedVertexHandle::from_index(to)));
+    let len = a.distance(b);
+    let dir = (b - a) / len;
+    let mut path = vec![from];
+    let mut cur = from;
+    for _ in 0..cdt.num_vertices() {
+        if cur == to {
+            return Some(path);
+        }
+        let v = cdt.vertex(FixedVertexHandle::from_index(cur));
+        let here = pos(v);
+        let mut best = None;
+        let mut best_cos = 1.0 - 1e-9;
+        for e in v.out_edges() {
+            if !e.is_constraint_edge() {
+                continue;
+            }
+            let t = e.to();
+            let d = pos(t) - here;
+            let cos = d.dot(dir) / d.length();
+            if cos > best_cos && (pos(t) - a).dot(dir) <= len * (1.0 + 1e-9) {
+                best_cos = cos;
+                best = Some(t.fix().index());
+            }
+        }
+        cur = best?;
+        path.push(cur);
+    }
+    None
+}

@@ -1,0 +1,157 @@
+//! The crate's one error type.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong while loading, drawing or saving an image.
+///
+/// Each message is one line and names the file (or, for in-memory data, the
+/// placeholder `<memory>`) so that an application can show it as is.
+#[derive(thiserror::Error, Debug)]
+#[non_exhaustive]
+pub enum RenderError {
+    /// The file to read does not exist.
+    #[error("{}: no such file", path.display())]
+    NotFound {
+        /// The file that was asked for.
+        path: PathBuf,
+    },
+
+    /// The directory a file should be written into does not exist.
+    #[error("cannot write {}: directory {} does not exist", path.display(), dir.display())]
+    MissingDirectory {
+        /// The file that was to be written.
+        path: PathBuf,
+        /// Its parent directory, which is missing.
+        dir: PathBuf,
+    },
+
+    /// The path names no file (empty, `/`, or ending in `..`).
+    #[error("{}: not a file path", path.display())]
+    InvalidPath {
+        /// The offending path.
+        path: PathBuf,
+    },
+
+    /// Any other operating-system error while reading or writing a file.
+    #[error("cannot {action} {}: {source}", path.display())]
+    Io {
+        /// The file involved.
+        path: PathBuf,
+        /// What was being done, e.g. `"read"` or `"replace"`.
+        action: &'static str,
+        /// The underlying error.
+        #[source]
+        source: std::io::Error,
+    },
+
+    /// The data is not in a format this crate decodes (PNG and JPEG).
+    #[error("{}: not a PNG or JPEG image", path.display())]
+    UnsupportedFormat {
+        /// The file (or `<memory>`).
+        path: PathBuf,
+    },
+
+    /// The data is PNG or JPEG but uses a feature the decoder does not support.
+    #[error("{}: unsupported image variant ({detail})", path.display())]
+    UnsupportedVariant {
+        /// The file (or `<memory>`).
+        path: PathBuf,
+        /// The decoder's explanation.
+        detail: String,
+    },
+
+    /// The data is truncated or malformed.
+    #[error("{}: truncated or corrupt image data ({detail})", path.display())]
+    Corrupt {
+        /// The file (or `<memory>`).
+        path: PathBuf,
+        /// The decoder's explanation.
+        detail: String,
+    },
+
+    /// The image's header claims dimensions beyond [`ImageLimits`](crate::ImageLimits).
+    #[error(
+        "{}: image is {width}x{height} pixels, larger than the {}x{} limit",
+        path.display(), limit.0, limit.1
+    )]
+    TooLarge {
+        /// The file (or `<memory>`).
+        path: PathBuf,
+        /// Claimed width in pixels.
+        width: u32,
+        /// Claimed height in pixels.
+        height: u32,
+        /// The limit (maximum width, maximum height) in pixels.
+        limit: (u32, u32),
+    },
+
+    /// Decoding would need more memory than [`ImageLimits::max_alloc_bytes`](crate::ImageLimits).
+    #[error(
+        "{}: decoding needs more memory than the limit of {limit} bytes",
+        path.display()
+    )]
+    MemoryLimit {
+        /// The file (or `<memory>`).
+        path: PathBuf,
+        /// The configured limit in bytes.
+        limit: u64,
+    },
+
+    /// The PNG encoder refused the image (for example an image with a zero dimension).
+    #[error("cannot encode {} as PNG: {detail}", path.display())]
+    Encode {
+        /// The file that was to be written.
+        path: PathBuf,
+        /// The encoder's explanation.
+        detail: String,
+    },
+
+    /// `rest` and `deformed` have different lengths.
+    #[error("mesh has {rest} rest positions but {deformed} deformed positions")]
+    MeshLengthMismatch {
+        /// Length of `rest`.
+        rest: usize,
+        /// Length of `deformed`.
+        deformed: usize,
+    },
+
+    /// A triangle names a vertex that does not exist.
+    #[error(
+        "triangle {triangle} uses vertex {index}, but the mesh has only {vertex_count} vertices"
+    )]
+    MeshIndexOutOfRange {
+        /// Index of the triangle in `triangles`.
+        triangle: usize,
+        /// The offending vertex index.
+        index: u32,
+        /// Number of vertices in the mesh.
+        vertex_count: usize,
+    },
+
+    /// A vertex position is NaN or infinite.
+    #[error("{which} position of vertex {vertex} is not finite")]
+    NonFinitePosition {
+        /// `"rest"` or `"deformed"`.
+        which: &'static str,
+        /// The vertex index.
+        vertex: usize,
+    },
+
+    /// The texture has no pixels, so there is nothing to sample.
+    #[error("texture is empty ({width}x{height})")]
+    EmptyTexture {
+        /// Texture width in pixels.
+        width: u32,
+        /// Texture height in pixels.
+        height: u32,
+    },
+
+    /// The requested output image cannot be allocated.
+    #[error("output image {width}x{height} is too large to allocate")]
+    OutputTooLarge {
+        /// Requested width in pixels.
+        width: u32,
+        /// Requested height in pixels.
+        height: u32,
+    },
+}

@@ -1,0 +1,604 @@
+//! The sampled domain: sample positions, the triangles between them, the sample graph
+//! (topology with edge lengths) and spatial grids for point queries.
+
+use std::sync::OnceLock;
+
+use glam::DVec2;
+
+use crate::error::DomainError;
+
+/// How distances inside the domain are measured.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Metric {
+    /// Straight-line distance: exact for a convex domain (a full rectangular image).
+    Euclidean,
+    /// Shortest paths along the sample graph: for holes, concave outlines and cuts.
+    Intrinsic,
+}
+
+/// One directed edge of the sample graph.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Edge {
+    pub to: u32,
+    pub len: f32,
+}
+
+/// Adjacency of the samples in compressed rows: the edges of vertex `v` are
+/// `edges[offsets[v]..offsets[v + 1]]`, sorted by target.
+#[derive(Debug)]
+pub(crate) struct Graph {
+    offsets: Vec<u32>,
+    edges: Vec<Edge>,
+}
+
+impl Graph {
+    fn from_triangles(positions: &[DVec2], triangles: &[[u32; 3]]) -> Self {
+        let n = positions.len();
+        let mut degree = vec![0u32; n + 1];
+        for t in triangles {
+            for &v in t {
+                degree[v as usize] += 2;
+            }
+        }
+        let mut offsets = Vec::with_capacity(n + 1);
+        let mut acc = 0u32;
+        for d in &degree[..n] {
+            offsets.push(acc);
+            acc += d;
+        }
+        offsets.push(acc);
+        let mut fill: Vec<u32> = offsets[..n].to_vec();
+        let mut targets = vec![0u32; acc as usize];
+        for t in triangles {
+            for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+                targets[fill[a as usize] as usize] = b;
+                fill[a as usize] += 1;
+                targets[fill[b as usize] as usize] = a;
+                fill[b as usize] += 1;
+            }
+        }
+        // Sort and deduplicate each row (an interior edge is seen from both triangles).
+        let mut new_offsets = Vec::with_capacity(n + 1);
+        let mut edges = Vec::with_capacity(acc as usize / 2 + n);
+        for v in 0..n {
+            new_offsets.push(edges.len() as u32);
+            let row = &mut targets[offsets[v] as usize..offsets[v + 1] as usize];
+            row.sort_unstable();
+            let mut last = u32::MAX;
+            for &to in row.iter() {
+                if to != last {
+                    let len = (positions[v] - positions[to as usize]).length() as f32;
+                    edges.push(Edge { to, len });
+                    last = to;
+                }
+            }
+        }
+        new_offsets.push(edges.len() as u32);
+        Self {
+            offsets: new_offsets,
+            edges,
+        }
+    }
+
+    #[inline]
+    pub fn neighbors(&self, v: u32) -> &[Edge] {
+        let v = v as usize;
+        &self.edges[self.offsets[v] as usize..self.offsets[v + 1] as usize]
+    }
+
+    pub fn edge_count(&self) -> usize {
+        self.edges.len() / 2
+    }
+}
+
+/// A uniform grid over the domain's bounding box whose cells list items (vertex or
+/// triangle indices) in compressed rows.
+#[derive(Debug)]
+pub(crate) struct Grid {
+    origin: DVec2,
+    cell: f64,
+    pub nx: usize,
+    pub ny: usize,
+    starts: Vec<u32>,
+    items: Vec<u32>,
+}
+
+impl Grid {
+    fn new(min: DVec2, max: DVec2, count: usize, per_cell: f64) -> (DVec2, f64, usize, usize) {
+        let size = (max - min).max(DVec2::splat(1e-9));
+        let cells = (count as f64 / per_cell).max(1.0);
+        let cell = (size.x * size.y / cells).sqrt().max(size.max_element() / 4096.0);
+        let nx = ((size.x / cell).ceil() as usize).clamp(1, 4096);
+        let ny = ((size.y / cell).ceil() as usize).clamp(1, 4096);
+        (min, cell, nx, ny)
+    }
+
+    fn build(
+        (origin, cell, nx, ny): (DVec2, f64, usize, usize),
+        count: usize,
+        cells_of: impl Fn(usize) -> (usize, usize, usize, usize),
+    ) -> Self {
+        let mut counts = vec![0u32; nx * ny + 1];
+        for i in 0..count {
+            let (x0, y0, x1, y1) = cells_of(i);
+            for y in y0..=y1 {
+                for x in x0..=x1 {
+                    counts[y * nx + x] += 1;
+                }
+            }
+        }
+        let mut starts = Vec::with_capacity(nx * ny + 1);
+        let mut acc = 0u32;
+        for c in &counts[..nx * ny] {
+            starts.push(acc);
+            acc += c;
+        }
+        starts.push(acc);
+        let mut fill = starts[..nx * ny].to_vec();
+        let mut items = vec![0u32; acc as usize];
+        for i in 0..count {
+            let (x0, y0, x1, y1) = cells_of(i);
+            for y in y0..=y1 {
+                for x in x0..=x1 {
+                    let c = y * nx + x;
+                    items[fill[c] as usize] = i as u32;
+                    fill[c] += 1;
+                }
+            }
+        }
+        Self {
+            origin,
+            cell,
+            nx,
+            ny,
+            starts,
+            items,
+        }
+    }
+
+    /// The cell coordinates of `p`, clamped to the grid.
+    #[inline]
+    pub fn cell_of(&self, p: DVec2) -> (usize, usize) {
+        let q = (p - self.origin) / self.cell;
+        (
+            (q.x.max(0.0) as usize).min(self.nx - 1),
+            (q.y.max(0.0) as usize).min(self.ny - 1),
+        )
+    }
+
+    #[inline]
+    pub fn items(&self, x: usize, y: usize) -> &[u32] {
+        let c = y * self.nx + x;
+        &self.items[self.starts[c] as usize..self.starts[c + 1] as usize]
+    }
+
+    pub fn cell_count(&self) -> usize {
+        self.nx * self.ny
+    }
+
+    /// Items of cell index `c` (row-major).
+    #[inline]
+    pub fn items_of_cell(&self, c: usize) -> &[u32] {
+        &self.items[self.starts[c] as usize..self.starts[c + 1] as usize]
+    }
+
+    /// Squared distance from `p` to the closed box of cell `c`.
+    #[inline]
+    pub fn cell_distance_squared(&self, c: usize, p: DVec2) -> f64 {
+        let (x, y) = (c % self.nx, c / self.nx);
+        let lo = self.origin + DVec2::new(x as f64, y as f64) * self.cell;
+        let hi = lo + DVec2::splat(self.cell);
+        let d = (lo - p).max(p - hi).max(DVec2::ZERO);
+        d.length_squared()
+    }
+
+    /// The inclusive range of cells overlapping the disc of radius `r` around `p`.
+    pub fn cells_in_disc(&self, p: DVec2, r: f64) -> (usize, usize, usize, usize) {
+        let (x0, y0) = self.cell_of(p - DVec2::splat(r));
+        let (x1, y1) = self.cell_of(p + DVec2::splat(r));
+        (x0, y0, x1, y1)
+    }
+
+    pub fn cell_size(&self) -> f64 {
+        self.cell
+    }
+}
+
+/// The domain the weights live on: samples (mesh vertices) in image pixel coordinates
+/// and the triangles between them.
+///
+/// Samples are connected by the triangles' edges; that graph carries the intrinsic
+/// (inside-the-shape) distance when the metric is [`Metric::Intrinsic`].
+#[derive(Debug)]
+pub struct Domain {
+    positions: Vec<DVec2>,
+    triangles: Vec<[u32; 3]>,
+    metric: Metric,
+    min: DVec2,
+    max: DVec2,
+    graph: OnceLock<Graph>,
+    vertex_grid: OnceLock<Grid>,
+    triangle_grid: OnceLock<Grid>,
+    boundary: OnceLock<Vec<Vec<u32>>>,
+}
+
+impl Clone for Domain {
+    fn clone(&self) -> Self {
+        Self::new_unchecked(self.positions.clone(), self.triangles.clone(), self.metric)
+    }
+}
+
+impl Domain {
+    /// A domain from sample positions (pixels) and triangles (indices into `positions`).
+    ///
+    /// # Errors
+    /// Non-finite positions, out-of-range or repeated indices, or no triangles at all.
+    pub fn new(
+        positions: Vec<DVec2>,
+        triangles: Vec<[u32; 3]>,
+        metric: Metric,
+    ) -> Result<Self, DomainError> {
+        if triangles.is_empty() {
+            return Err(DomainError::Empty);
+        }
+        if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(DomainError::NonFinite { vertex: i });
+        }
+        for (i, t) in triangles.iter().enumerate() {
+            if t.iter().any(|&v| v as usize >= positions.len()) {
+                return Err(DomainError::IndexOutOfRange {
+                    triangle: i,
+                    vertices: positions.len(),
+                });
+            }
+            if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+                return Err(DomainError::DegenerateTriangle { triangle: i });
+            }
+        }
+        Ok(Self::new_unchecked(positions, triangles, metric))
+    }
+
+    fn new_unchecked(positions: Vec<DVec2>, triangles: Vec<[u32; 3]>, metric: Metric) -> Self {
+        let (min, max) = positions.iter().fold(
+            (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+            |(lo, hi), &p| (lo.min(p), hi.max(p)),
+        );
+        Self {
+            positions,
+            triangles,
+            metric,
+            min,
+            max,
+            graph: OnceLock::new(),
+            vertex_grid: OnceLock::new(),
+            triangle_grid: OnceLock::new(),
+            boundary: OnceLock::new(),
+        }
+    }
+
+    /// Sample positions in pixels.
+    pub fn positions(&self) -> &[DVec2] {
+        &self.positions
+    }
+
+    /// Triangles as vertex index triples.
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+
+    /// The distance in use.
+    pub fn metric(&self) -> Metric {
+        self.metric
+    }
+
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.positions.len()
+    }
+
+    /// Whether there are no samples (never true for a constructed domain).
+    pub fn is_empty(&self) -> bool {
+        self.positions.is_empty()
+    }
+
+    /// Bounding box `(min, max)` of the samples.
+    pub fn bounds(&self) -> (DVec2, DVec2) {
+        (self.min, self.max)
+    }
+
+    /// Mean length of the graph's edges: the sampling resolution.
+    pub fn mean_edge_length(&self) -> f64 {
+        let mut total = 0.0;
+        let mut count = 0usize;
+        for t in &self.triangles {
+            for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+                total += (self.positions[a as usize] - self.positions[b as usize]).length();
+                count += 1;
+            }
+        }
+        total / count.max(1) as f64
+    }
+
+    /// Builds the lazily computed structures the chosen metric needs, so that later
+    /// timings do not include them.
+    pub fn prepare(&self) {
+        self.vertex_grid();
+        self.triangle_grid();
+        if self.metric == Metric::Intrinsic {
+            self.graph();
+        }
+    }
+
+    pub(crate) fn graph(&self) -> &Graph {
+        self.graph
+            .get_or_init(|| Graph::from_triangles(&self.positions, &self.triangles))
+    }
+
+    pub(crate) fn vertex_grid(&self) -> &Grid {
+        self.vertex_grid.get_or_init(|| {
+            let shape = Grid::new(self.min, self.max, self.positions.len(), 8.0);
+            let probe = Grid::build(shape, 0, |_| (0, 0, 0, 0));
+            Grid::build(shape, self.positions.len(), |i| {
+                let (x, y) = probe.cell_of(self.positions[i]);
+                (x, y, x, y)
+            })
+        })
+    }
+
+    fn triangle_grid(&self) -> &Grid {
+        self.triangle_grid.get_or_init(|| {
+            let shape = Grid::new(self.min, self.max, self.triangles.len(), 4.0);
+            let probe = Grid::build(shape, 0, |_| (0, 0, 0, 0));
+            Grid::build(shape, self.triangles.len(), |i| {
+                let [a, b, c] = self.triangle_corners(i);
+                let (x0, y0) = probe.cell_of(a.min(b).min(c));
+                let (x1, y1) = probe.cell_of(a.max(b).max(c));
+                (x0, y0, x1, y1)
+            })
+        })
+    }
+
+    fn triangle_corners(&self, t: usize) -> [DVec2; 3] {
+        self.triangles[t].map(|v| self.positions[v as usize])
+    }
+
+    /// The triangle containing `p` and `p`'s barycentric coordinates in it, allowing a
+    /// tolerance of `1e-9` (relative to the domain size) on its edges; `None` outside.
+    pub fn locate(&self, p: DVec2) -> Option<(usize, [f64; 3])> {
+        if !p.is_finite() {
+            return None;
+        }
+        let grid = self.triangle_grid();
+        let (x, y) = grid.cell_of(p);
+        let eps = 1e-9;
+        let mut best: Option<(usize, [f64; 3], f64)> = None;
+        for &t in grid.items(x, y) {
+            let Some(bary) = barycentric(self.triangle_corners(t as usize), p) else {
+                continue;
+            };
+            let worst = bary.iter().copied().fold(f64::INFINITY, f64::min);
+            if worst >= -eps && best.as_ref().is_none_or(|b| worst > b.2) {
+                best = Some((t as usize, bary, worst));
+                if worst >= 0.0 {
+                    break;
+                }
+            }
+        }
+        best.map(|(t, b, _)| (t, b))
+    }
+
+    /// The sample nearest to `p` (ties to the lower index).
+    pub fn nearest_vertex(&self, p: DVec2) -> Option<u32> {
+        if !p.is_finite() {
+            return None;
+        }
+        let grid = self.vertex_grid();
+        let (cx, cy) = grid.cell_of(p);
+        let mut best: Option<(f64, u32)> = None;
+        for ring in 0..grid.nx.max(grid.ny) {
+            // Every point of ring k is at least (k − 1) cells away from p.
+            if let Some((d2, _)) = best {
+                let reach = (ring as f64 - 1.0).max(0.0) * grid.cell_size();
+                if reach * reach > d2 {
+                    break;
+                }
+            }
+            let (x0, x1) = (cx.saturating_sub(ring), (cx + ring).min(grid.nx - 1));
+            let (y0, y1) = (cy.saturating_sub(ring), (cy + ring).min(grid.ny - 1));
+            for y in y0..=y1 {
+                for x in x0..=x1 {
+                    let on_ring = x.abs_diff(cx) == ring || y.abs_diff(cy) == ring;
+                    if !on_ring {
+                        continue;
+                    }
+                    for &v in grid.items(x, y) {
+                        let d2 = (self.positions[v as usize] - p).length_squared();
+                        if best.is_none_or(|(b, bv)| d2 < b || (d2 == b && v < bv)) {
+                            best = Some((d2, v));
+                        }
+                    }
+                }
+            }
+        }
+        best.map(|(_, v)| v)
+    }
+
+    /// Closed boundary loops (edges used by exactly one triangle), each as a vertex
+    /// sequence without repeating the first vertex.
+    pub fn boundary_loops(&self) -> &[Vec<u32>] {
+        self.boundary.get_or_init(|| boundary_loops(&self.triangles))
+    }
+
+    /// Whether the domain is one region bounded by a single convex loop (collinear
+    /// boundary vertices allowed): then [`Metric::Euclidean`] is exact.
+    pub fn is_convex(&self) -> bool {
+        let loops = self.boundary_loops();
+        if loops.len() != 1 {
+            return false;
+        }
+        let ring: Vec<DVec2> = loops[0]
+            .iter()
+            .map(|&v| self.positions[v as usize])
+            .collect();
+        let n = ring.len();
+        let scale = (self.max - self.min).length().max(1e-12);
+        let (mut pos, mut neg) = (false, false);
+        for i in 0..n {
+            let (a, b, c) = (ring[i], ring[(i + 1) % n], ring[(i + 2) % n]);
+            let cross = (b - a).perp_dot(c - b);
+            let tol = 1e-9 * scale * (b - a).length().max((c - b).length());
+            if cross > tol {
+                pos = true;
+            } else if cross < -tol {
+                neg = true;
+            }
+        }
+        !(pos && neg)
+    }
+}
+
+/// Barycentric coordinates of `p` in the triangle, `None` for a degenerate triangle.
+pub(crate) fn barycentric([a, b, c]: [DVec2; 3], p: DVec2) -> Option<[f64; 3]> {
+    let area = (b - a).perp_dot(c - a);
+    if area.abs() <= f64::EPSILON * (b - a).length_squared().max((c - a).length_squared()) {
+        return None;
+    }
+    let u = (b - p).perp_dot(c - p) / area;
+    let v = (c - p).perp_dot(a - p) / area;
+    Some([u, v, 1.0 - u - v])
+}
+
+fn boundary_loops(triangles: &[[u32; 3]]) -> Vec<Vec<u32>> {
+    // Undirected edge keys with the directed edge as seen from one triangle.
+    let mut keys: Vec<(u64, u32, u32)> = triangles
+        .iter()
+        .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+        .map(|(a, b)| {
+            let key = (u64::from(a.min(b)) << 32) | u64::from(a.max(b));
+            (key, a, b)
+        })
+        .collect();
+    keys.sort_unstable_by_key(|k| k.0);
+    let mut next: std::collections::HashMap<u32, Vec<u32>> = std::collections::HashMap::new();
+    let mut i = 0;
+    while i < keys.len() {
+        let mut j = i + 1;
+        while j < keys.len() && keys[j].0 == keys[i].0 {
+            j += 1;
+        }
+        if j - i == 1 {
+            next.entry(keys[i].1).or_default().push(keys[i].2);
+        }
+        i = j;
+    }
+    let mut starts: Vec<u32> = next.keys().copied().collect();
+    starts.sort_unstable();
+    let mut loops = Vec::new();
+    for start in starts {
+        while let Some(first) = next.get_mut(&start).and_then(|v| v.pop()) {
+            let mut ring = vec![start];
+            let mut at = first;
+            while at != start {
+                ring.push(at);
+                match next.get_mut(&at).and_then(|v| v.pop()) {
+                    Some(n) => at = n,
+                    None => break,
+                }
+            }
+            loops.push(ring);
+        }
+    }
+    loops
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    /// A regular grid of `nx × ny` cells of size `h`, two triangles per cell, with the
+    /// diagonal mirrored about the vertical centre line.
+    pub fn grid_mesh(nx: usize, ny: usize, h: f64) -> (Vec<DVec2>, Vec<[u32; 3]>) {
+        let mut positions = Vec::new();
+        for y in 0..=ny {
+            for x in 0..=nx {
+                positions.push(DVec2::new(x as f64 * h, y as f64 * h));
+            }
+        }
+        let id = |x: usize, y: usize| (y * (nx + 1) + x) as u32;
+        let mut triangles = Vec::new();
+        for y in 0..ny {
+            for x in 0..nx {
+                let (a, b, c, d) = (id(x, y), id(x + 1, y), id(x + 1, y + 1), id(x, y + 1));
+                if 2 * x < nx {
+                    triangles.push([a, b, c]);
+                    triangles.push([a, c, d]);
+                } else {
+                    triangles.push([a, b, d]);
+                    triangles.push([b, c, d]);
+                }
+            }
+        }
+        (positions, triangles)
+    }
+
+    #[test]
+    fn graph_of_a_grid() {
+        let (p, t) = grid_mesh(3, 2, 1.0);
+        let d = Domain::new(p, t, Metric::Intrinsic).expect("valid");
+        let g = d.graph();
+        // 3x2 cells: 17 horizontal+vertical edges + 6 diagonals.
+        assert_eq!(g.edge_count(), 4 * 2 + 3 * 3 + 6);
+        for v in 0..d.len() as u32 {
+            for e in g.neighbors(v) {
+                assert!(g.neighbors(e.to).iter().any(|b| b.to == v));
+            }
+        }
+    }
+
+    #[test]
+    fn convexity_and_boundary() {
+        let (p, t) = grid_mesh(4, 3, 1.0);
+        let d = Domain::new(p.clone(), t.clone(), Metric::Euclidean).expect("valid");
+        assert_eq!(d.boundary_loops().len(), 1);
+        assert_eq!(d.boundary_loops()[0].len(), 14);
+        assert!(d.is_convex());
+        // Remove the two triangles of the top-right cell's neighbour: an L shape.
+        let l: Vec<_> = t
+            .iter()
+            .copied()
+            .filter(|tri| {
+                let c = tri.iter().map(|&v| p[v as usize]).sum::<DVec2>() / 3.0;
+                !(c.x > 2.0 && c.y < 1.0)
+            })
+            .collect();
+        let d = Domain::new(p, l, Metric::Intrinsic).expect("valid");
+        assert!(!d.is_convex());
+    }
+
+    #[test]
+    fn locate_and_nearest() {
+        let (p, t) = grid_mesh(10, 10, 2.0);
+        let d = Domain::new(p, t, Metric::Euclidean).expect("valid");
+        let (tri, bary) = d.locate(DVec2::new(3.1, 7.3)).expect("inside");
+        let corners = d.triangle_corners(tri);
+        let back = corners[0] * bary[0] + corners[1] * bary[1] + corners[2] * bary[2];
+        assert!((back - DVec2::new(3.1, 7.3)).length() < 1e-12);
+        assert!(d.locate(DVec2::new(-1.0, 3.0)).is_none());
+        assert!(d.locate(DVec2::new(20.0, 20.0)).is_some());
+        let v = d.nearest_vertex(DVec2::new(3.1, 7.3)).expect("some");
+        assert_eq!(d.positions()[v as usize], DVec2::new(4.0, 8.0));
+        let v = d.nearest_vertex(DVec2::new(100.0, -50.0)).expect("some");
+        assert_eq!(d.positions()[v as usize], DVec2::new(20.0, 0.0));
+    }
+
+    #[test]
+    fn bad_input_is_refused() {
+        let p = vec![DVec2::ZERO, DVec2::X, DVec2::Y];
+        assert!(Domain::new(p.clone(), vec![], Metric::Euclidean).is_err());
+        assert!(Domain::new(p.clone(), vec![[0, 1, 3]], Metric::Euclidean).is_err());
+        assert!(Domain::new(p.clone(), vec![[0, 1, 1]], Metric::Euclidean).is_err());
+        let mut bad = p;
+        bad[1].x = f64::NAN;
+        assert!(Domain::new(bad, vec![[0, 1, 2]], Metric::Euclidean).is_err());
+    }
+}

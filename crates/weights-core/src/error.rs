@@ -1,0 +1,90 @@
+//! Errors: what a caller gave that cannot be used.
+
+/// A domain that cannot be built from the given samples and triangles.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum DomainError {
+    /// No triangles were given.
+    #[error("the domain has no triangles")]
+    Empty,
+    /// A sample position is NaN or infinite.
+    #[error("sample {vertex} has a non-finite position")]
+    NonFinite {
+        /// Index of the sample.
+        vertex: usize,
+    },
+    /// A triangle refers to a sample that does not exist.
+    #[error("triangle {triangle} refers to a vertex beyond the {vertices} samples")]
+    IndexOutOfRange {
+        /// Index of the triangle.
+        triangle: usize,
+        /// Number of samples.
+        vertices: usize,
+    },
+    /// A triangle repeats a vertex.
+    #[error("triangle {triangle} repeats a vertex")]
+    DegenerateTriangle {
+        /// Index of the triangle.
+        triangle: usize,
+    },
+}
+
+/// A rig that cannot be built or edited as asked.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum RigError {
+    /// A handle coordinate or transform component is NaN or infinite.
+    #[error("handle {handle} has a non-finite coordinate or transform")]
+    NonFinite {
+        /// Index of the handle.
+        handle: usize,
+    },
+    /// A handle lies outside the domain (off the shape).
+    #[error("handle {handle} at ({x:.2}, {y:.2}) lies outside the shape")]
+    OutsideDomain {
+        /// Index of the handle.
+        handle: usize,
+        /// Rest x in pixels.
+        x: f64,
+        /// Rest y in pixels.
+        y: f64,
+    },
+    /// Two handles coincide, or fall on the same sample of the mesh.
+    #[error("handles {a} and {b} coincide (or fall on the same mesh sample); move them apart")]
+    Coincident {
+        /// The first handle.
+        a: usize,
+        /// The second handle.
+        b: usize,
+    },
+    /// A bar handle whose two ends coincide.
+    #[error("bar handle {handle} has zero length")]
+    ZeroLengthBar {
+        /// Index of the handle.
+        handle: usize,
+    },
+    /// A scale that is not positive.
+    #[error("handle {handle} has a non-positive scale")]
+    BadScale {
+        /// Index of the handle.
+        handle: usize,
+    },
+    /// An index that names no handle.
+    #[error("there is no handle {handle}")]
+    NoSuchHandle {
+        /// The index given.
+        handle: usize,
+    },
+    /// A handle pose of the wrong kind (a bar pose for a point handle or vice versa).
+    #[error("handle {handle} is a {expected} handle")]
+    WrongKind {
+        /// Index of the handle.
+        handle: usize,
+        /// What the handle is.
+        expected: &'static str,
+    },
+    /// Options out of range.
+    #[error("invalid options: {0}")]
+    Options(String),
+    /// A virtual handle given to rebuild a rig names no sample.
+    #[error("virtual handle sample {0} does not exist")]
+    BadVirtual(u32),
+}

@@ -1,0 +1,920 @@
+//! The rig: handles on a domain, their weighted nodes (points, bar samples, pinned
+//! border samples, virtual handles), the partition, weights and transforms, with
+//! incremental insertion and removal of handles.
+
+use std::collections::HashMap;
+use std::time::Instant;
+
+use glam::{DAffine2, DVec2};
+
+use crate::basis::Basis;
+use crate::domain::Domain;
+use crate::error::RigError;
+use crate::harmonic::{dual_edges, harmonic_coordinates};
+use crate::transform::Similarity;
+use crate::virtual_handles::insert_virtual_handles;
+use crate::voronoi::{NONE, Partition};
+use crate::weights::{Change, Scratch, Weights, ball};
+
+/// A handle the user places.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Handle {
+    /// A point handle at `rest` (pixels) with its current transform about `rest`.
+    Point {
+        /// Rest position in pixels.
+        rest: DVec2,
+        /// Current transform, about `rest`.
+        transform: Similarity,
+    },
+    /// A bar (line-segment) handle from `rest[0]` to `rest[1]`, currently posed with its
+    /// ends at `pose`.
+    Bar {
+        /// Rest end points in pixels.
+        rest: [DVec2; 2],
+        /// Current end points in pixels.
+        pose: [DVec2; 2],
+    },
+}
+
+impl Handle {
+    /// A point handle at rest.
+    pub fn point(rest: DVec2) -> Self {
+        Self::Point {
+            rest,
+            transform: Similarity::IDENTITY,
+        }
+    }
+
+    /// A bar handle at rest.
+    pub fn bar(a: DVec2, b: DVec2) -> Self {
+        Self::Bar {
+            rest: [a, b],
+            pose: [a, b],
+        }
+    }
+
+    /// The same handle with its pose reset to rest.
+    pub fn at_rest(&self) -> Self {
+        match self {
+            Self::Point { rest, .. } => Self::point(*rest),
+            Self::Bar { rest, .. } => Self::bar(rest[0], rest[1]),
+        }
+    }
+
+    /// The handle's transform as a similarity about `centre`, with its rotation angle
+    /// and scale.
+    fn similarity(&self) -> (Similarity, DVec2) {
+        match *self {
+            Self::Point { rest, transform } => (transform, rest),
+            Self::Bar { rest, pose } => {
+                let c = (rest[0] + rest[1]) * 0.5;
+                (Similarity::from_segments(c, rest, pose), c)
+            }
+        }
+    }
+
+    fn rest_equal(&self, other: &Self) -> bool {
+        match (self, other) {
+            (Self::Point { rest: a, .. }, Self::Point { rest: b, .. }) => a == b,
+            (Self::Bar { rest: a, .. }, Self::Bar { rest: b, .. }) => a == b,
+            _ => false,
+        }
+    }
+}
+
+/// What a weighted node is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum NodeKind {
+    /// The node of point handle `handle`.
+    Point {
+        /// Index of the handle.
+        handle: usize,
+    },
+    /// A sample of bar handle `handle` at parameter `t ∈ [0, 1]` along it.
+    BarSample {
+        /// Index of the handle.
+        handle: usize,
+        /// Parameter along the bar.
+        t: f64,
+    },
+    /// A pinned sample of the domain's border (with a fixed boundary).
+    Boundary,
+    /// A virtual handle inserted by Algorithm 1.
+    Virtual,
+}
+
+/// A weighted node: one of the handles the weights partition unity over.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Node {
+    /// The sample the node sits on.
+    pub vertex: u32,
+    /// What the node is.
+    pub kind: NodeKind,
+}
+
+/// Radii of one node, in pixels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NodeRadii {
+    /// r_d: distance to the farthest sample of the node's Voronoi cell.
+    pub r_d: f64,
+    /// r_h: distance to the nearest other node (∞ if none is reachable).
+    pub r_h: f64,
+    /// The support radius (1 − α)·r_d + α·r_h: the weight is zero from there on.
+    pub support: f64,
+}
+
+/// Options of the weighting.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RigOptions {
+    /// Shape factor α ∈ [0, 1]: support (1 − α)·r_d + α·r_h. Default 1.
+    pub alpha: f64,
+    /// The basis function. Default: degree 5.
+    pub basis: Basis,
+    /// Pin the domain's border in place (the paper's fixed boundary). Default off.
+    pub fixed_boundary: bool,
+}
+
+impl Default for RigOptions {
+    fn default() -> Self {
+        Self {
+            alpha: 1.0,
+            basis: Basis::default(),
+            fixed_boundary: false,
+        }
+    }
+}
+
+/// Wall-clock time of the phases of the last full build, in milliseconds.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BuildTimings {
+    /// Nearest-node distances of all samples (multi-source Dijkstra or Euclidean).
+    pub distances_ms: f64,
+    /// Region decomposition: cells, r_d and r_h.
+    pub voronoi_ms: f64,
+    /// Virtual-handle insertion (Algorithm 1).
+    pub virtual_ms: f64,
+    /// Supports, sparse weights, dual graph and harmonic transforms.
+    pub weights_ms: f64,
+}
+
+impl BuildTimings {
+    /// Sum of the phases.
+    pub fn total_ms(&self) -> f64 {
+        self.distances_ms + self.voronoi_ms + self.virtual_ms + self.weights_ms
+    }
+}
+
+/// Sizes of a rig.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RigStats {
+    /// Samples (mesh vertices).
+    pub samples: usize,
+    /// User handles.
+    pub real_handles: usize,
+    /// Nodes of the user handles (points and bar samples).
+    pub handle_nodes: usize,
+    /// Pinned border nodes.
+    pub boundary_nodes: usize,
+    /// Virtual handles.
+    pub virtual_nodes: usize,
+    /// Stored non-zero weights.
+    pub nonzeros: usize,
+    /// Bytes used by the sparse weights.
+    pub weight_bytes: usize,
+}
+
+/// Handles on a domain with their C² weights.
+///
+/// ```
+/// use glam::DVec2;
+/// use weights_core::{Domain, Handle, Metric, Rig, RigOptions, Similarity};
+///
+/// // A 10 × 10 square of two triangles... refined into a 11 × 11 grid of samples.
+/// let mut positions = Vec::new();
+/// for y in 0..=10 {
+///     for x in 0..=10 {
+///         positions.push(DVec2::new(x as f64, y as f64));
+///     }
+/// }
+/// let mut triangles = Vec::new();
+/// for y in 0..10u32 {
+///     for x in 0..10u32 {
+///         let a = y * 11 + x;
+///         triangles.push([a, a + 1, a + 12]);
+///         triangles.push([a, a + 12, a + 11]);
+///     }
+/// }
+/// let domain = Domain::new(positions, triangles, Metric::Euclidean).unwrap();
+/// let handles = vec![Handle::point(DVec2::new(2.0, 2.0)), Handle::point(DVec2::new(8.0, 7.0))];
+/// let mut rig = Rig::new(domain, handles, RigOptions::default()).unwrap();
+/// let sum: f64 = rig.weights(60).map(|(_, w)| w).sum();
+/// assert!((sum - 1.0).abs() < 1e-12);
+///
+/// rig.set_point_transform(0, Similarity::translate(DVec2::new(1.0, 0.0))).unwrap();
+/// let moved = rig.deform();
+/// assert_eq!(moved[2 * 11 + 2], DVec2::new(3.0, 2.0)); // the handle's sample follows it
+/// ```
+#[derive(Clone, Debug)]
+pub struct Rig {
+    domain: Domain,
+    options: RigOptions,
+    handles: Vec<Handle>,
+    nodes: Vec<Node>,
+    partition: Partition,
+    radii: Vec<f64>,
+    weights: Weights,
+    harmonic: Vec<Option<Vec<f64>>>,
+    affines: Vec<DAffine2>,
+    resolution: f64,
+    timings: BuildTimings,
+}
+
+impl Rig {
+    /// Builds the rig: nodes for the handles, the partition, virtual handles, weights.
+    ///
+    /// # Errors
+    /// Invalid options; a handle that is not finite, lies outside the domain, coincides
+    /// with another (or lands on the same sample), a zero-length bar, a scale ≤ 0.
+    pub fn new(domain: Domain, handles: Vec<Handle>, options: RigOptions) -> Result<Self, RigError> {
+        Self::with_virtual_handles(domain, handles, &[], options)
+    }
+
+    /// Builds the rig with the given virtual handles (sample indices) already in place,
+    /// adding more only where Algorithm 1 needs them: a saved rig reloads with exactly
+    /// the weights it had.
+    ///
+    /// # Errors
+    /// As [`Rig::new`], and a virtual handle on a sample that does not exist.
+    pub fn with_virtual_handles(
+        domain: Domain,
+        handles: Vec<Handle>,
+        virtual_vertices: &[u32],
+        options: RigOptions,
+    ) -> Result<Self, RigError> {
+        check_options(&options)?;
+        domain.prepare();
+        let resolution = domain.mean_edge_length();
+        let mut nodes = real_nodes(&domain, &handles, &options, resolution)?;
+        let mut taken: std::collections::HashSet<u32> = nodes.iter().map(|n| n.vertex).collect();
+        for &v in virtual_vertices {
+            if v as usize >= domain.len() {
+                return Err(RigError::BadVirtual(v));
+            }
+            if taken.insert(v) {
+                nodes.push(Node {
+                    vertex: v,
+                    kind: NodeKind::Virtual,
+                });
+            }
+        }
+        let mut timings = BuildTimings::default();
+        let clock = Instant::now();
+        let mut partition = Partition::distances(&domain, nodes.iter().map(|n| n.vertex).collect());
+        timings.distances_ms = ms(clock);
+        let clock = Instant::now();
+        partition.decompose(&domain);
+        timings.voronoi_ms = ms(clock);
+        let clock = Instant::now();
+        for v in insert_virtual_handles(&domain, &mut partition) {
+            nodes.push(Node {
+                vertex: v,
+                kind: NodeKind::Virtual,
+            });
+        }
+        timings.virtual_ms = ms(clock);
+        let clock = Instant::now();
+        let radii = support_radii(&partition, options.alpha);
+        let weights = Weights::build(&domain, &partition, &radii, &options.basis);
+        let mut rig = Self {
+            domain,
+            options,
+            handles,
+            nodes,
+            partition,
+            radii,
+            weights,
+            harmonic: Vec::new(),
+            affines: Vec::new(),
+            resolution,
+            timings,
+        };
+        rig.update_transforms();
+        rig.timings.weights_ms = ms(clock);
+        Ok(rig)
+    }
+
+    /// Inserts a handle and brings everything up to date, touching only the cells and
+    /// supports the new handle changes. Returns the new handle's index.
+    ///
+    /// Virtual handles already in place stay, so the warp elsewhere does not jump; the
+    /// result equals [`Rig::with_virtual_handles`] with the same handles and virtual
+    /// handles.
+    ///
+    /// # Errors
+    /// As [`Rig::new`] for the new handle; the rig is unchanged on error.
+    pub fn insert_handle(&mut self, handle: Handle) -> Result<usize, RigError> {
+        let mut handles = self.handles.clone();
+        handles.push(handle);
+        self.set_handles(handles)?;
+        Ok(self.handles.len() - 1)
+    }
+
+    /// Removes handle `index` (later handles shift down by one) and brings everything
+    /// up to date locally.
+    ///
+    /// # Errors
+    /// [`RigError::NoSuchHandle`]; the rig is unchanged on error.
+    pub fn remove_handle(&mut self, index: usize) -> Result<Handle, RigError> {
+        if index >= self.handles.len() {
+            return Err(RigError::NoSuchHandle { handle: index });
+        }
+        let mut handles = self.handles.clone();
+        let removed = handles.remove(index);
+        self.set_handles(handles)?;
+        Ok(removed)
+    }
+
+    /// Replaces the handles. Poses alone are cheap; handles whose rest geometry changed
+    /// are removed and inserted incrementally.
+    ///
+    /// # Errors
+    /// As [`Rig::new`]; the rig is unchanged on error.
+    pub fn set_handles(&mut self, handles: Vec<Handle>) -> Result<(), RigError> {
+        let same_rest = handles.len() == self.handles.len()
+            && handles.iter().zip(&self.handles).all(|(a, b)| a.rest_equal(b));
+        if same_rest {
+            check_handles(&handles)?;
+            self.handles = handles;
+            self.update_affines();
+            return Ok(());
+        }
+        let target = real_nodes(&self.domain, &handles, &self.options, self.resolution)?;
+        self.apply(target);
+        self.handles = handles;
+        self.update_transforms();
+        Ok(())
+    }
+
+    /// Sets the transform of point handle `index`.
+    ///
+    /// # Errors
+    /// No such handle, not a point handle, or a non-finite / non-positive-scale transform.
+    pub fn set_point_transform(&mut self, index: usize, transform: Similarity) -> Result<(), RigError> {
+        match self.handles.get(index) {
+            Some(Handle::Point { rest, .. }) => {
+                let h = Handle::Point {
+                    rest: *rest,
+                    transform,
+                };
+                check_handle(index, &h)?;
+                self.handles[index] = h;
+                self.update_affines();
+                Ok(())
+            }
+            Some(_) => Err(RigError::WrongKind {
+                handle: index,
+                expected: "bar",
+            }),
+            None => Err(RigError::NoSuchHandle { handle: index }),
+        }
+    }
+
+    /// Sets the posed end points of bar handle `index`.
+    ///
+    /// # Errors
+    /// No such handle, not a bar, or non-finite end points.
+    pub fn set_bar_pose(&mut self, index: usize, pose: [DVec2; 2]) -> Result<(), RigError> {
+        match self.handles.get(index) {
+            Some(Handle::Bar { rest, .. }) => {
+                let h = Handle::Bar { rest: *rest, pose };
+                check_handle(index, &h)?;
+                self.handles[index] = h;
+                self.update_affines();
+                Ok(())
+            }
+            Some(_) => Err(RigError::WrongKind {
+                handle: index,
+                expected: "point",
+            }),
+            None => Err(RigError::NoSuchHandle { handle: index }),
+        }
+    }
+
+    /// Moves the node set to `target` real nodes (virtual nodes kept unless a real node
+    /// takes their sample), updating partition, virtual handles and weights locally.
+    fn apply(&mut self, target: Vec<Node>) {
+        let target_vertices: std::collections::HashSet<u32> =
+            target.iter().map(|n| n.vertex).collect();
+        let doomed: Vec<usize> = (0..self.nodes.len())
+            .filter(|&k| {
+                let n = self.nodes[k];
+                let is_real = n.kind != NodeKind::Virtual;
+                (is_real && !target_vertices.contains(&n.vertex))
+                    || (!is_real && target_vertices.contains(&n.vertex))
+            })
+            .collect();
+        // Radii of the surviving nodes, by sample (node numbers change below).
+        let old_radius: HashMap<u32, f64> = (0..self.nodes.len())
+            .filter(|k| doomed.binary_search(k).is_err())
+            .map(|k| (self.nodes[k].vertex, self.radii[k]))
+            .collect();
+        // Samples the doomed nodes reach: their rows must be redone.
+        let mut dirty = Vec::new();
+        let mut scratch = Scratch::new(self.domain.len());
+        for &k in &doomed {
+            let (b, _) = ball(
+                &self.domain,
+                &self.partition,
+                self.nodes[k].vertex,
+                self.radii[k],
+                &mut scratch,
+            );
+            dirty.extend(b.into_iter().map(|(v, _)| v));
+        }
+        let mut map: Vec<u32> = (0..self.nodes.len() as u32).collect();
+        for &k in doomed.iter().rev() {
+            self.partition.remove_node(&self.domain, k);
+            self.nodes.remove(k);
+            map[k] = NONE;
+        }
+        let mut next = 0;
+        for m in map.iter_mut().filter(|m| **m != NONE) {
+            *m = next;
+            next += 1;
+        }
+        // Add the new real nodes, then give every real node its (possibly renumbered)
+        // kind from the target.
+        let present: HashMap<u32, usize> = self
+            .nodes
+            .iter()
+            .enumerate()
+            .map(|(k, n)| (n.vertex, k))
+            .collect();
+        for n in &target {
+            match present.get(&n.vertex) {
+                Some(&k) => self.nodes[k].kind = n.kind,
+                None => {
+                    self.partition.add_node(&self.domain, n.vertex);
+                    self.nodes.push(*n);
+                }
+            }
+        }
+        for v in insert_virtual_handles(&self.domain, &mut self.partition) {
+            self.nodes.push(Node {
+                vertex: v,
+                kind: NodeKind::Virtual,
+            });
+        }
+        self.radii = support_radii(&self.partition, self.options.alpha);
+        let changes: Vec<Change> = self
+            .nodes
+            .iter()
+            .enumerate()
+            .filter_map(|(k, n)| {
+                let old = old_radius.get(&n.vertex).copied();
+                let unchanged = old == Some(self.radii[k]);
+                (!unchanged).then_some(Change {
+                    node: k,
+                    old_radius: old,
+                })
+            })
+            .collect();
+        self.weights.renumber(&map);
+        self.weights.update(
+            &self.domain,
+            &self.partition,
+            &self.radii,
+            &self.options.basis,
+            &changes,
+            &dirty,
+        );
+    }
+
+    /// Recomputes the dual graph, the virtual handles' harmonic coordinates and all
+    /// node transforms.
+    fn update_transforms(&mut self) {
+        let edges = dual_edges(&self.domain, &self.partition);
+        let groups = self.group_count();
+        let node_group: Vec<Option<usize>> = self.nodes.iter().map(|n| self.group_of(n)).collect();
+        self.harmonic = harmonic_coordinates(
+            self.domain.positions(),
+            &self.partition.node_vertex,
+            &node_group,
+            groups,
+            &edges,
+        );
+        self.update_affines();
+    }
+
+    fn group_count(&self) -> usize {
+        self.handles.len() + usize::from(self.options.fixed_boundary)
+    }
+
+    fn group_of(&self, n: &Node) -> Option<usize> {
+        match n.kind {
+            NodeKind::Point { handle } | NodeKind::BarSample { handle, .. } => Some(handle),
+            NodeKind::Boundary => Some(self.handles.len()),
+            NodeKind::Virtual => None,
+        }
+    }
+
+    /// Node transforms from the handles' poses (virtual ones blended harmonically).
+    fn update_affines(&mut self) {
+        // Per group: the similarity, its centre, and its rotation as a unit complex.
+        let mut groups: Vec<(Similarity, DVec2)> = self.handles.iter().map(Handle::similarity).collect();
+        if self.options.fixed_boundary {
+            groups.push((Similarity::IDENTITY, DVec2::ZERO));
+        }
+        let positions = self.domain.positions();
+        self.affines = self
+            .nodes
+            .iter()
+            .enumerate()
+            .map(|(k, n)| match self.group_of(n) {
+                Some(g) => groups[g].0.to_affine(groups[g].1),
+                None => {
+                    let c = positions[n.vertex as usize];
+                    let Some(coefficients) = self.harmonic.get(k).and_then(Option::as_ref) else {
+                        return DAffine2::IDENTITY;
+                    };
+                    blend(&groups, coefficients, c)
+                }
+            })
+            .collect();
+    }
+
+    /// Deformed positions of all samples.
+    pub fn deform(&self) -> Vec<DVec2> {
+        let mut out = vec![DVec2::ZERO; self.domain.len()];
+        self.deform_into(&mut out);
+        out
+    }
+
+    /// Writes the deformed position of every sample into `out` (length = samples).
+    ///
+    /// # Panics
+    /// If `out` has the wrong length.
+    pub fn deform_into(&self, out: &mut [DVec2]) {
+        assert_eq!(out.len(), self.domain.len(), "output length");
+        self.weights
+            .deform(self.domain.positions(), &self.partition.owner, &self.affines, out);
+    }
+
+    /// Where the rest point `p` goes, interpolated barycentrically from the deformed
+    /// samples `deformed` (as returned by [`Rig::deform`]); `None` outside the domain.
+    pub fn deform_point(&self, deformed: &[DVec2], p: DVec2) -> Option<DVec2> {
+        let (t, bary) = self.domain.locate(p)?;
+        let tri = self.domain.triangles()[t];
+        Some((0..3).map(|i| deformed.get(tri[i] as usize).copied().unwrap_or(p) * bary[i]).sum())
+    }
+
+    /// The non-zero weights of sample `v` as (node index, weight).
+    ///
+    /// # Panics
+    /// If `v` is not a sample index.
+    pub fn weights(&self, v: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
+        self.weights.row(v, &self.partition.owner)
+    }
+
+    /// Distances from node `k` to every sample (∞ where unreachable), in the rig's
+    /// metric: for heat maps, isolines and tests.
+    pub fn distances_from_node(&self, k: usize) -> Vec<f64> {
+        let mut out = vec![f64::INFINITY; self.domain.len()];
+        let mut scratch = Scratch::new(self.domain.len());
+        let (b, _) = ball(
+            &self.domain,
+            &self.partition,
+            self.nodes[k].vertex,
+            f64::INFINITY,
+            &mut scratch,
+        );
+        for (v, d) in b {
+            out[v as usize] = d;
+        }
+        out
+    }
+
+    /// The weighted nodes.
+    pub fn nodes(&self) -> &[Node] {
+        &self.nodes
+    }
+
+    /// The user handles.
+    pub fn handles(&self) -> &[Handle] {
+        &self.handles
+    }
+
+    /// The domain.
+    pub fn domain(&self) -> &Domain {
+        &self.domain
+    }
+
+    /// The options.
+    pub fn options(&self) -> &RigOptions {
+        &self.options
+    }
+
+    /// Radii of node `k`.
+    pub fn radii(&self, k: usize) -> NodeRadii {
+        let s = self.partition.stats[k];
+        NodeRadii {
+            r_d: s.r_d,
+            r_h: s.r_h,
+            support: self.radii[k],
+        }
+    }
+
+    /// The Voronoi cell (owning node) of every sample.
+    pub fn cells(&self) -> &[u32] {
+        &self.partition.owner
+    }
+
+    /// The dual graph of the cells: node pairs whose cells touch.
+    pub fn dual_graph(&self) -> Vec<(u32, u32)> {
+        dual_edges(&self.domain, &self.partition)
+    }
+
+    /// Harmonic coordinates of node `k` over the real handles (and, last, the fixed
+    /// border): `None` for the nodes of real handles.
+    pub fn harmonic_coordinates(&self, k: usize) -> Option<&[f64]> {
+        self.harmonic.get(k).and_then(|c| c.as_deref())
+    }
+
+    /// The transform of node `k` as an affine map of image coordinates.
+    pub fn node_transform(&self, k: usize) -> DAffine2 {
+        self.affines[k]
+    }
+
+    /// The real handle a node belongs to: its own for points and bar samples, the one
+    /// with the largest harmonic coordinate for a virtual handle.
+    pub fn owner_handle(&self, k: usize) -> Option<usize> {
+        match self.nodes[k].kind {
+            NodeKind::Point { handle } | NodeKind::BarSample { handle, .. } => Some(handle),
+            NodeKind::Boundary => None,
+            NodeKind::Virtual => self.harmonic_coordinates(k).and_then(|c| {
+                c.iter()
+                    .take(self.handles.len())
+                    .enumerate()
+                    .filter(|(_, w)| **w > 0.0)
+                    .max_by(|a, b| a.1.total_cmp(b.1))
+                    .map(|(i, _)| i)
+            }),
+        }
+    }
+
+    /// Sizes.
+    pub fn stats(&self) -> RigStats {
+        let count = |f: fn(&NodeKind) -> bool| self.nodes.iter().filter(|n| f(&n.kind)).count();
+        RigStats {
+            samples: self.domain.len(),
+            real_handles: self.handles.len(),
+            handle_nodes: count(|k| matches!(k, NodeKind::Point { .. } | NodeKind::BarSample { .. })),
+            boundary_nodes: count(|k| matches!(k, NodeKind::Boundary)),
+            virtual_nodes: count(|k| matches!(k, NodeKind::Virtual)),
+            nonzeros: self.weights.nonzeros(),
+            weight_bytes: self.weights.memory_bytes(),
+        }
+    }
+
+    /// Phase timings of the full build.
+    pub fn timings(&self) -> BuildTimings {
+        self.timings
+    }
+
+    /// Samples of the virtual handles, in node order (to save and rebuild exactly).
+    pub fn virtual_vertices(&self) -> Vec<u32> {
+        self.nodes
+            .iter()
+            .filter(|n| n.kind == NodeKind::Virtual)
+            .map(|n| n.vertex)
+            .collect()
+    }
+
+    /// Whether the rig equals `other` node for node (up to node numbering) and weight
+    /// for weight, bit for bit. For tests of incremental updates.
+    pub fn same_weights_as(&self, other: &Rig) -> Result<(), String> {
+        self.weights.same_as(
+            (&self.partition.node_vertex, &self.partition.owner),
+            &other.weights,
+            (&other.partition.node_vertex, &other.partition.owner),
+        )
+    }
+}
+
+fn ms(since: Instant) -> f64 {
+    since.elapsed().as_secs_f64() * 1e3
+}
+
+/// Support radius per node: (1 − α)·r_d + α·r_h, never beyond r_h, ∞ for a node alone
+/// in its component.
+fn support_radii(partition: &Partition, alpha: f64) -> Vec<f64> {
+    partition
+        .stats
+        .iter()
+        .map(|s| {
+            if s.r_h.is_infinite() {
+                f64::INFINITY
+            } else {
+                ((1.0 - alpha) * s.r_d + alpha * s.r_h).min(s.r_h)
+            }
+        })
+        .collect()
+}
+
+/// The virtual handle at `c`: the groups' rotations (unit complex numbers), scales and
+/// the images of `c` blended with the harmonic coefficients.
+fn blend(groups: &[(Similarity, DVec2)], coefficients: &[f64], c: DVec2) -> DAffine2 {
+    let (mut rot, mut scale, mut pos, mut total) = (DVec2::ZERO, 0.0, DVec2::ZERO, 0.0);
+    for ((s, centre), &w) in groups.iter().zip(coefficients) {
+        if w == 0.0 {
+            continue;
+        }
+        rot += w * DVec2::from_angle(s.rotation);
+        scale += w * s.scale;
+        pos += w * s.apply(*centre, c);
+        total += w;
+    }
+    if total <= 0.0 {
+        return DAffine2::IDENTITY;
+    }
+    let angle = if rot.length_squared() > 0.0 { rot.to_angle() } else { 0.0 };
+    let blended = Similarity {
+        translation: pos / total - c,
+        rotation: angle,
+        scale: scale / total,
+    };
+    blended.to_affine(c)
+}
+
+fn check_options(o: &RigOptions) -> Result<(), RigError> {
+    if !(0.0..=1.0).contains(&o.alpha) {
+        return Err(RigError::Options(format!("alpha must be in [0, 1], got {}", o.alpha)));
+    }
+    Ok(())
+}
+
+fn check_handle(i: usize, h: &Handle) -> Result<(), RigError> {
+    match h {
+        Handle::Point { rest, transform } => {
+            if !rest.is_finite() || !transform.is_finite() {
+                return Err(RigError::NonFinite { handle: i });
+            }
+            if transform.scale <= 0.0 {
+                return Err(RigError::BadScale { handle: i });
+            }
+        }
+        Handle::Bar { rest, pose } => {
+            if !rest.iter().chain(pose).all(|p| p.is_finite()) {
+                return Err(RigError::NonFinite { handle: i });
+            }
+            if rest[0] == rest[1] {
+                return Err(RigError::ZeroLengthBar { handle: i });
+            }
+        }
+    }
+    Ok(())
+}
+
+fn check_handles(handles: &[Handle]) -> Result<(), RigError> {
+    handles.iter().enumerate().try_for_each(|(i, h)| check_handle(i, h))
+}
+
+fn segment_distance(a: [DVec2; 2], b: [DVec2; 2]) -> f64 {
+    let point_seg = |p: DVec2, s: [DVec2; 2]| {
+        let d = s[1] - s[0];
+        let t = if d.length_squared() > 0.0 {
+            ((p - s[0]).dot(d) / d.length_squared()).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (p - (s[0] + d * t)).length()
+    };
+    let (da, db) = (a[1] - a[0], b[1] - b[0]);
+    let cross = |u: DVec2, v: DVec2| u.perp_dot(v);
+    let o1 = cross(da, b[0] - a[0]);
+    let o2 = cross(da, b[1] - a[0]);
+    let o3 = cross(db, a[0] - b[0]);
+    let o4 = cross(db, a[1] - b[0]);
+    if o1 * o2 < 0.0 && o3 * o4 < 0.0 {
+        return 0.0;
+    }
+    point_seg(a[0], b)
+        .min(point_seg(a[1], b))
+        .min(point_seg(b[0], a))
+        .min(point_seg(b[1], a))
+}
+
+fn segment_of(h: &Handle) -> [DVec2; 2] {
+    match *h {
+        Handle::Point { rest, .. } => [rest, rest],
+        Handle::Bar { rest, .. } => rest,
+    }
+}
+
+/// The nodes of the handles (and of the pinned border), each on a sample: a point on
+/// the nearest corner of the triangle containing it, bars split into ⌈L/d⌉ pieces with
+/// d the smallest distance between two handles (no smaller than the mean edge length).
+fn real_nodes(
+    domain: &Domain,
+    handles: &[Handle],
+    options: &RigOptions,
+    resolution: f64,
+) -> Result<Vec<Node>, RigError> {
+    check_handles(handles)?;
+    let (lo, hi) = domain.bounds();
+    let tiny = 1e-9 * (hi - lo).length().max(1.0);
+    let mut spacing = f64::INFINITY;
+    for i in 0..handles.len() {
+        for j in 0..i {
+            let d = segment_distance(segment_of(&handles[i]), segment_of(&handles[j]));
+            if d <= tiny {
+                return Err(RigError::Coincident { a: j, b: i });
+            }
+            spacing = spacing.min(d);
+        }
+    }
+    // With fewer than two handles d is undefined: split bars into eight pieces.
+    let longest_bar = handles
+        .iter()
+        .map(|h| match h {
+            Handle::Bar { rest, .. } => (rest[1] - rest[0]).length(),
+            Handle::Point { .. } => 0.0,
+        })
+        .fold(0.0, f64::max);
+    let spacing = spacing.min(longest_bar / 8.0).max(resolution);
+    let snap = |i: usize, p: DVec2| -> Result<u32, RigError> {
+        let (t, bary) = domain.locate(p).ok_or(RigError::OutsideDomain {
+            handle: i,
+            x: p.x,
+            y: p.y,
+        })?;
+        let tri = domain.triangles()[t];
+        let best = (0..3)
+            .max_by(|&a, &b| bary[a].total_cmp(&bary[b]).then(tri[b].cmp(&tri[a])))
+            .unwrap_or(0);
+        Ok(tri[best])
+    };
+    let mut nodes: Vec<Node> = Vec::new();
+    let mut used: HashMap<u32, usize> = HashMap::new();
+    for (i, h) in handles.iter().enumerate() {
+        let mut own: Vec<Node> = Vec::new();
+        match *h {
+            Handle::Point { rest, .. } => own.push(Node {
+                vertex: snap(i, rest)?,
+                kind: NodeKind::Point { handle: i },
+            }),
+            Handle::Bar { rest, .. } => {
+                // The whole bar must lie on the shape, not only its samples.
+                let steps = ((rest[1] - rest[0]).length() / resolution).ceil() as usize;
+                for s in 0..=steps.min(1 << 16) {
+                    let p = rest[0].lerp(rest[1], s as f64 / steps.max(1) as f64);
+                    if domain.locate(p).is_none() {
+                        return Err(RigError::OutsideDomain {
+                            handle: i,
+                            x: p.x,
+                            y: p.y,
+                        });
+                    }
+                }
+                let pieces = ((rest[1] - rest[0]).length() / spacing).ceil().max(1.0) as usize;
+                for s in 0..=pieces {
+                    let t = s as f64 / pieces as f64;
+                    let v = snap(i, rest[0].lerp(rest[1], t))?;
+                    if own.iter().all(|n| n.vertex != v) {
+                        own.push(Node {
+                            vertex: v,
+                            kind: NodeKind::BarSample { handle: i, t },
+                        });
+                    }
+                }
+            }
+        }
+        for n in own {
+            if let Some(&j) = used.get(&n.vertex) {
+                return Err(RigError::Coincident { a: j, b: i });
+            }
+            used.insert(n.vertex, i);
+            nodes.push(n);
+        }
+    }
+    if options.fixed_boundary {
+        let positions = domain.positions();
+        for ring in domain.boundary_loops() {
+            let mut since = f64::INFINITY;
+            let mut prev = positions[ring[0] as usize];
+            for &v in ring {
+                since += (positions[v as usize] - prev).length();
+                prev = positions[v as usize];
+                if since >= spacing && !used.contains_key(&v) {
+                    used.insert(v, usize::MAX);
+                    nodes.push(Node {
+                        vertex: v,
+                        kind: NodeKind::Boundary,
+                    });
+                    since = 0.0;
+                }
+            }
+        }
+    }
+    Ok(nodes)
+}

@@ -1,0 +1,117 @@
+//! Algorithm 1 of the paper: insert virtual handles until every node's cell fits
+//! inside the ball that reaches its nearest neighbour (r_d < r_h).
+//!
+//! We insert while r_d ≥ r_h (the paper writes r_d > r_h): with a strict r_d < r_h
+//! every sample lies strictly inside its own node's support when α = 1, so the sum of
+//! basis values never vanishes. Each insertion puts a node on a sample that carried
+//! none (the farthest sample of a cell with r_d > 0), so the loop ends after at most as
+//! many insertions as there are samples.
+
+use glam::DVec2;
+
+use crate::domain::{Domain, Metric};
+use crate::voronoi::Partition;
+
+/// Relative tolerance under which two violation ratios count as tied.
+const TIE: f64 = 1e-9;
+
+/// Inserts virtual nodes into `partition` until the r_d < r_h condition holds for every
+/// node, and every sample is reached by some node. Returns the new nodes' samples in
+/// insertion order (they are appended to the partition's nodes in that order).
+pub(crate) fn insert_virtual_handles(domain: &Domain, partition: &mut Partition) -> Vec<u32> {
+    let mut added = Vec::new();
+    if partition.len() == 0 {
+        // No handles: nothing moves, nothing to weigh.
+        return added;
+    }
+    if domain.metric() == Metric::Intrinsic {
+        // One node for every component of the sample graph that no node reaches.
+        for v in partition.unreached() {
+            if partition.owner[v as usize] == crate::voronoi::NONE {
+                partition.add_node(domain, v);
+                added.push(v);
+            }
+        }
+    }
+    let positions = domain.positions();
+    loop {
+        let mut violators: Vec<(f64, usize)> = partition
+            .stats
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| s.r_d > 0.0 && s.r_d >= s.r_h)
+            .map(|(k, s)| ((s.r_d - s.r_h) / s.r_d, k))
+            .collect();
+        if violators.is_empty() {
+            break;
+        }
+        let key = |k: usize| partition.node_vertex[k];
+        violators.sort_by(|a, b| b.0.total_cmp(&a.0).then(key(a.1).cmp(&key(b.1))));
+        let top = violators[0].0;
+        // Tied violators far apart from each other are fixed together, so that mirror
+        // images of a symmetric rig get mirror-image virtual handles.
+        let mut batch: Vec<(u32, DVec2, f64)> = Vec::new();
+        for &(ratio, k) in &violators {
+            if ratio < top - TIE * top.abs().max(TIE) {
+                break;
+            }
+            let s = partition.stats[k];
+            let at = positions[s.farthest as usize];
+            let clear = batch
+                .iter()
+                .all(|&(_, q, r)| (q - at).length() >= r.max(s.r_d));
+            if clear {
+                batch.push((s.farthest, at, s.r_d));
+            }
+        }
+        for (v, _, _) in batch {
+            partition.add_node(domain, v);
+            added.push(v);
+        }
+    }
+    added
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::domain::tests::grid_mesh;
+
+    #[test]
+    fn two_handles_one_sample_apart_terminate() {
+        for metric in [Metric::Intrinsic, Metric::Euclidean] {
+            let (p, t) = grid_mesh(40, 30, 1.0);
+            let d = Domain::new(p, t, metric).expect("valid");
+            let mut part = Partition::new(&d, vec![41 * 10 + 20, 41 * 10 + 21]);
+            let added = insert_virtual_handles(&d, &mut part);
+            assert!(!added.is_empty());
+            for s in &part.stats {
+                assert!(s.r_d < s.r_h, "{s:?}");
+            }
+            part.assert_matches_rebuild(&d);
+        }
+    }
+
+    #[test]
+    fn a_single_handle_needs_nothing() {
+        let (p, t) = grid_mesh(10, 10, 1.0);
+        let d = Domain::new(p, t, Metric::Intrinsic).expect("valid");
+        let mut part = Partition::new(&d, vec![0]);
+        assert!(insert_virtual_handles(&d, &mut part).is_empty());
+    }
+
+    #[test]
+    fn unreached_components_get_a_node() {
+        // Two separate squares.
+        let (mut p, mut t) = grid_mesh(3, 3, 1.0);
+        let n = p.len() as u32;
+        let (p2, t2) = grid_mesh(3, 3, 1.0);
+        p.extend(p2.iter().map(|q| *q + DVec2::new(10.0, 0.0)));
+        t.extend(t2.iter().map(|tri| tri.map(|v| v + n)));
+        let d = Domain::new(p, t, Metric::Intrinsic).expect("valid");
+        let mut part = Partition::new(&d, vec![5]);
+        let added = insert_virtual_handles(&d, &mut part);
+        assert!(added.contains(&n));
+        assert!(part.unreached().is_empty());
+    }
+}

@@ -1,0 +1,538 @@
+//! The graph Voronoi decomposition of the samples by handle (one cell per weighted
+//! handle node), kept up to date when nodes are added or removed, and the per-cell
+//! radii r_d (farthest sample of the cell) and r_h (nearest other node).
+//!
+//! Ties between nodes at equal distance go to the node on the lower sample index, so
+//! the partition depends on the set of nodes, not on the order they were added in.
+
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+use glam::DVec2;
+
+use crate::domain::{Domain, Metric};
+
+/// "No node": an unreachable sample, or a removed node.
+pub(crate) const NONE: u32 = u32::MAX;
+
+/// A heap entry: tentative distance, the tie-break key of its node, the sample.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Entry {
+    pub d: f64,
+    pub key: u32,
+    pub v: u32,
+}
+
+impl PartialEq for Entry {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == Ordering::Equal
+    }
+}
+impl Eq for Entry {}
+impl PartialOrd for Entry {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for Entry {
+    /// Reversed, so that `BinaryHeap` pops the smallest (distance, key, sample).
+    fn cmp(&self, other: &Self) -> Ordering {
+        other
+            .d
+            .total_cmp(&self.d)
+            .then(other.key.cmp(&self.key))
+            .then(other.v.cmp(&self.v))
+    }
+}
+
+/// Radii of one cell.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct CellStats {
+    /// Distance from the node to the farthest sample of its cell.
+    pub r_d: f64,
+    /// That farthest sample (`NONE` for an empty cell).
+    pub farthest: u32,
+    /// Distance to the nearest other node (∞ when no other node is reachable).
+    pub r_h: f64,
+}
+
+/// The partition of samples into cells, one per node.
+#[derive(Clone, Debug)]
+pub(crate) struct Partition {
+    /// The sample each node sits on; also the node's tie-break key.
+    pub node_vertex: Vec<u32>,
+    /// Owning node of each sample (`NONE` if unreachable).
+    pub owner: Vec<u32>,
+    /// Distance from each sample to its owning node.
+    pub dist: Vec<f64>,
+    /// Samples of each cell (unordered).
+    members: Vec<Vec<u32>>,
+    /// Position of each sample in its owner's member list.
+    slot: Vec<u32>,
+    /// Euclidean metric only: the largest `dist` in each vertex-grid cell.
+    bin_max: Vec<f64>,
+    /// Radii of each cell.
+    pub stats: Vec<CellStats>,
+}
+
+#[inline]
+fn less(a: (f64, u32), b: (f64, u32)) -> bool {
+    a.0 < b.0 || (a.0 == b.0 && a.1 < b.1)
+}
+
+impl Partition {
+    /// The partition of `domain` by nodes on the given samples, built in one pass.
+    #[cfg(test)]
+    pub fn new(domain: &Domain, node_vertex: Vec<u32>) -> Self {
+        let mut p = Self::distances(domain, node_vertex);
+        p.decompose(domain);
+        p
+    }
+
+    /// Nearest-node distances and cells of all samples; radii are left for
+    /// [`Partition::decompose`].
+    pub fn distances(domain: &Domain, node_vertex: Vec<u32>) -> Self {
+        let n = domain.len();
+        let mut p = Self {
+            node_vertex: Vec::new(),
+            owner: vec![NONE; n],
+            dist: vec![f64::INFINITY; n],
+            members: Vec::new(),
+            slot: vec![0; n],
+            bin_max: Vec::new(),
+            stats: Vec::new(),
+        };
+        match domain.metric() {
+            Metric::Intrinsic => {
+                p.node_vertex = node_vertex;
+                p.members = vec![Vec::new(); p.node_vertex.len()];
+                let mut heap = BinaryHeap::new();
+                for (k, &v) in p.node_vertex.iter().enumerate() {
+                    let entry = Entry { d: 0.0, key: v, v };
+                    if less((0.0, v), (p.dist[v as usize], p.key_of(v))) {
+                        p.dist[v as usize] = 0.0;
+                        p.owner[v as usize] = k as u32;
+                        heap.push(entry);
+                    }
+                }
+                p.propagate(domain, &mut heap, None);
+                for v in 0..n {
+                    let o = p.owner[v];
+                    if o != NONE {
+                        p.slot[v] = p.members[o as usize].len() as u32;
+                        p.members[o as usize].push(v as u32);
+                    }
+                }
+            }
+            Metric::Euclidean => {
+                p.bin_max = vec![f64::INFINITY; domain.vertex_grid().cell_count()];
+                for v in node_vertex {
+                    p.add_node_euclidean(domain, v);
+                }
+            }
+        }
+        p
+    }
+
+    /// Radii r_d and r_h of every cell.
+    pub fn decompose(&mut self, domain: &Domain) {
+        use rayon::prelude::*;
+        let this = &*self;
+        self.stats = (0..this.node_vertex.len())
+            .into_par_iter()
+            .map(|k| this.cell_stats(domain, k))
+            .collect();
+    }
+
+    /// Number of nodes.
+    pub fn len(&self) -> usize {
+        self.node_vertex.len()
+    }
+
+    /// Samples in cell `k`.
+    pub fn members(&self, k: usize) -> &[u32] {
+        &self.members[k]
+    }
+
+    /// Whether sample `v` carries a node.
+    #[inline]
+    pub fn is_node(&self, v: u32) -> bool {
+        let o = self.owner[v as usize];
+        o != NONE && self.node_vertex[o as usize] == v
+    }
+
+    #[inline]
+    fn key_of(&self, v: u32) -> u32 {
+        let o = self.owner[v as usize];
+        if o == NONE {
+            NONE
+        } else {
+            self.node_vertex[o as usize]
+        }
+    }
+
+    fn set_owner(&mut self, v: u32, k: u32) {
+        let old = self.owner[v as usize];
+        if old == k {
+            return;
+        }
+        if old != NONE {
+            let list = &mut self.members[old as usize];
+            let at = self.slot[v as usize] as usize;
+            list.swap_remove(at);
+            if let Some(&moved) = list.get(at) {
+                self.slot[moved as usize] = at as u32;
+            }
+        }
+        self.owner[v as usize] = k;
+        if k != NONE {
+            self.slot[v as usize] = self.members[k as usize].len() as u32;
+            self.members[k as usize].push(v);
+        }
+    }
+
+    /// Multi-source Dijkstra from the entries in `heap`, claiming samples for the
+    /// popped entry's owner wherever that is lexicographically closer. With `changed`,
+    /// member lists are kept current and each sample whose owner changed is recorded
+    /// with its previous owner.
+    fn propagate(
+        &mut self,
+        domain: &Domain,
+        heap: &mut BinaryHeap<Entry>,
+        mut changed: Option<&mut Vec<(u32, u32)>>,
+    ) {
+        let graph = domain.graph();
+        while let Some(Entry { d, key, v }) = heap.pop() {
+            if d != self.dist[v as usize] || key != self.key_of(v) {
+                continue;
+            }
+            let k = self.owner[v as usize];
+            for e in graph.neighbors(v) {
+                let nd = d + f64::from(e.len);
+                let w = e.to as usize;
+                if less((nd, key), (self.dist[w], self.key_of(e.to))) {
+                    self.dist[w] = nd;
+                    if let Some(changed) = changed.as_deref_mut() {
+                        let old = self.owner[w];
+                        if old != k {
+                            changed.push((e.to, old));
+                            self.set_owner(e.to, k);
+                        }
+                    } else {
+                        self.owner[w] = k;
+                    }
+                    heap.push(Entry { d: nd, key, v: e.to });
+                }
+            }
+        }
+    }
+
+    /// Adds a node on sample `v` (which must not carry one) and returns the indices of
+    /// the cells whose radii may have changed (the new one included).
+    pub fn add_node(&mut self, domain: &Domain, v: u32) -> Vec<usize> {
+        let k = self.node_vertex.len();
+        let mut touched = match domain.metric() {
+            Metric::Intrinsic => {
+                self.node_vertex.push(v);
+                self.members.push(Vec::new());
+                let mut changed = Vec::new();
+                let mut heap = BinaryHeap::new();
+                if less((0.0, v), (self.dist[v as usize], self.key_of(v))) {
+                    changed.push((v, self.owner[v as usize]));
+                    self.dist[v as usize] = 0.0;
+                    self.set_owner(v, k as u32);
+                    heap.push(Entry { d: 0.0, key: v, v });
+                }
+                self.propagate(domain, &mut heap, Some(&mut changed));
+                self.neighbour_cells(domain, &changed)
+            }
+            Metric::Euclidean => self.add_node_euclidean(domain, v),
+        };
+        touched.push(k);
+        self.stats.push(CellStats {
+            r_d: 0.0,
+            farthest: NONE,
+            r_h: f64::INFINITY,
+        });
+        if domain.metric() == Metric::Euclidean {
+            // r_h of any node may have dropped to its distance from the new node.
+            let p = domain.positions()[v as usize];
+            for j in 0..k {
+                let d = (domain.positions()[self.node_vertex[j] as usize] - p).length();
+                if d < self.stats[j].r_h {
+                    touched.push(j);
+                }
+            }
+        }
+        self.refresh(domain, touched)
+    }
+
+    fn add_node_euclidean(&mut self, domain: &Domain, v: u32) -> Vec<usize> {
+        let k = self.node_vertex.len() as u32;
+        self.node_vertex.push(v);
+        self.members.push(Vec::new());
+        let grid = domain.vertex_grid();
+        let p = domain.positions()[v as usize];
+        let mut touched = Vec::new();
+        for c in 0..grid.cell_count() {
+            let reach = self.bin_max[c];
+            if reach.is_finite() && grid.cell_distance_squared(c, p) >= reach * reach {
+                continue;
+            }
+            let mut max = 0.0f64;
+            for &w in grid.items_of_cell(c) {
+                let d = (domain.positions()[w as usize] - p).length();
+                let wi = w as usize;
+                if less((d, v), (self.dist[wi], self.key_of(w))) {
+                    let old = self.owner[wi];
+                    if old != NONE {
+                        touched.push(old as usize);
+                    }
+                    self.dist[wi] = d;
+                    self.set_owner(w, k);
+                }
+                max = max.max(self.dist[wi]);
+            }
+            self.bin_max[c] = max;
+        }
+        touched
+    }
+
+    /// Removes node `k` (later nodes shift down by one), hands its samples to the
+    /// remaining nodes, and returns the cells whose radii may have changed.
+    pub fn remove_node(&mut self, domain: &Domain, k: usize) -> Vec<usize> {
+        let freed = std::mem::take(&mut self.members[k]);
+        for &v in &freed {
+            self.owner[v as usize] = NONE;
+            self.dist[v as usize] = f64::INFINITY;
+        }
+        self.members.remove(k);
+        self.node_vertex.remove(k);
+        self.stats.remove(k);
+        let k32 = k as u32;
+        for o in self.owner.iter_mut() {
+            if *o != NONE && *o > k32 {
+                *o -= 1;
+            }
+        }
+        let mut changed: Vec<(u32, u32)> = freed.iter().map(|&v| (v, NONE)).collect();
+        let mut touched = Vec::new();
+        match domain.metric() {
+            Metric::Intrinsic => {
+                let graph = domain.graph();
+                let mut heap = BinaryHeap::new();
+                for &v in &freed {
+                    for e in graph.neighbors(v) {
+                        let o = self.owner[e.to as usize];
+                        if o != NONE {
+                            heap.push(Entry {
+                                d: self.dist[e.to as usize],
+                                key: self.node_vertex[o as usize],
+                                v: e.to,
+                            });
+                        }
+                    }
+                }
+                self.propagate(domain, &mut heap, Some(&mut changed));
+                touched.extend(self.neighbour_cells(domain, &changed));
+            }
+            Metric::Euclidean => {
+                let positions = domain.positions();
+                for &v in &freed {
+                    let p = positions[v as usize];
+                    let mut best = (f64::INFINITY, NONE, NONE);
+                    for (j, &nv) in self.node_vertex.iter().enumerate() {
+                        let d = (positions[nv as usize] - p).length();
+                        if less((d, nv), (best.0, best.1)) {
+                            best = (d, nv, j as u32);
+                        }
+                    }
+                    self.dist[v as usize] = best.0;
+                    self.set_owner(v, best.2);
+                    if best.2 != NONE {
+                        touched.push(best.2 as usize);
+                    }
+                }
+                let grid = domain.vertex_grid();
+                let mut cells: Vec<usize> = freed
+                    .iter()
+                    .map(|&v| {
+                        let (x, y) = grid.cell_of(positions[v as usize]);
+                        y * grid.nx + x
+                    })
+                    .collect();
+                cells.sort_unstable();
+                cells.dedup();
+                for c in cells {
+                    self.bin_max[c] = grid
+                        .items_of_cell(c)
+                        .iter()
+                        .map(|&w| self.dist[w as usize])
+                        .fold(0.0, f64::max);
+                }
+                // Any node may have had the removed one as its nearest.
+                touched.extend(0..self.node_vertex.len());
+            }
+        }
+        self.refresh(domain, touched)
+    }
+
+    /// Owners (before and after) of the changed samples and of their neighbours.
+    fn neighbour_cells(&self, domain: &Domain, changed: &[(u32, u32)]) -> Vec<usize> {
+        let graph = domain.graph();
+        let mut cells = Vec::new();
+        for &(v, old) in changed {
+            if old != NONE {
+                cells.push(old as usize);
+            }
+            for e in graph.neighbors(v) {
+                let o = self.owner[e.to as usize];
+                if o != NONE {
+                    cells.push(o as usize);
+                }
+            }
+            let o = self.owner[v as usize];
+            if o != NONE {
+                cells.push(o as usize);
+            }
+        }
+        cells
+    }
+
+    /// Recomputes the radii of the given cells and returns them, deduplicated.
+    fn refresh(&mut self, domain: &Domain, mut cells: Vec<usize>) -> Vec<usize> {
+        cells.sort_unstable();
+        cells.dedup();
+        cells.retain(|&c| c < self.node_vertex.len());
+        for &c in &cells {
+            self.stats[c] = self.cell_stats(domain, c);
+        }
+        cells
+    }
+
+    /// r_d, the farthest sample and r_h of cell `k`, from scratch.
+    fn cell_stats(&self, domain: &Domain, k: usize) -> CellStats {
+        let mut r_d = 0.0;
+        let mut farthest = NONE;
+        for &v in &self.members[k] {
+            let d = self.dist[v as usize];
+            if d > r_d || (d == r_d && v < farthest) {
+                r_d = d;
+                farthest = v;
+            }
+        }
+        let r_h = match domain.metric() {
+            Metric::Intrinsic => {
+                let graph = domain.graph();
+                let k32 = k as u32;
+                let mut best = f64::INFINITY;
+                for &u in &self.members[k] {
+                    let du = self.dist[u as usize];
+                    for e in graph.neighbors(u) {
+                        let o = self.owner[e.to as usize];
+                        if o != k32 && o != NONE {
+                            best = best.min(du + f64::from(e.len) + self.dist[e.to as usize]);
+                        }
+                    }
+                }
+                best
+            }
+            Metric::Euclidean => {
+                let positions = domain.positions();
+                let p: DVec2 = positions[self.node_vertex[k] as usize];
+                self.node_vertex
+                    .iter()
+                    .enumerate()
+                    .filter(|&(j, _)| j != k)
+                    .map(|(_, &v)| (positions[v as usize] - p).length())
+                    .fold(f64::INFINITY, f64::min)
+            }
+        };
+        CellStats { r_d, farthest, r_h }
+    }
+
+    /// Samples no node reaches (other components of the graph), lowest first.
+    pub fn unreached(&self) -> Vec<u32> {
+        (0..self.owner.len() as u32)
+            .filter(|&v| self.owner[v as usize] == NONE)
+            .collect()
+    }
+
+    /// Checks the partition against a rebuild from scratch; for tests.
+    #[cfg(test)]
+    pub fn assert_matches_rebuild(&self, domain: &Domain) {
+        let fresh = Partition::new(domain, self.node_vertex.clone());
+        assert_eq!(self.owner, fresh.owner, "owners differ from a rebuild");
+        assert_eq!(self.dist, fresh.dist, "distances differ from a rebuild");
+        assert_eq!(self.stats, fresh.stats, "cell radii differ from a rebuild");
+        for k in 0..self.len() {
+            let mut a = self.members[k].clone();
+            let mut b = fresh.members[k].clone();
+            a.sort_unstable();
+            b.sort_unstable();
+            assert_eq!(a, b);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::domain::tests::grid_mesh;
+
+    fn jittered(nx: usize, ny: usize, seed: u64, metric: Metric) -> Domain {
+        let (mut p, t) = grid_mesh(nx, ny, 1.0);
+        let mut s = seed;
+        for q in p.iter_mut() {
+            if q.x > 0.0 && q.y > 0.0 && q.x < nx as f64 && q.y < ny as f64 {
+                s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                let a = ((s >> 33) as f64 / (1u64 << 31) as f64 - 0.5) * 0.3;
+                let b = ((s >> 13 & 0xfffff) as f64 / (1u64 << 20) as f64 - 0.5) * 0.3;
+                *q += DVec2::new(a, b);
+            }
+        }
+        Domain::new(p, t, metric).expect("valid")
+    }
+
+    #[test]
+    fn incremental_add_and_remove_match_rebuilds() {
+        for metric in [Metric::Intrinsic, Metric::Euclidean] {
+            let d = jittered(30, 20, 7, metric);
+            let mut p = Partition::new(&d, vec![5, 300, 77]);
+            p.assert_matches_rebuild(&d);
+            for v in [400u32, 123, 601, 2] {
+                p.add_node(&d, v);
+                p.assert_matches_rebuild(&d);
+            }
+            p.remove_node(&d, 1);
+            p.assert_matches_rebuild(&d);
+            p.remove_node(&d, 3);
+            p.assert_matches_rebuild(&d);
+        }
+    }
+
+    #[test]
+    fn intrinsic_r_h_is_the_graph_distance_between_nodes() {
+        let d = jittered(12, 9, 3, Metric::Intrinsic);
+        let p = Partition::new(&d, vec![0, 50, 100]);
+        // Plain single-source Dijkstra from node 0.
+        let mut dist = vec![f64::INFINITY; d.len()];
+        let mut heap = BinaryHeap::new();
+        dist[0] = 0.0;
+        heap.push(Entry { d: 0.0, key: 0, v: 0 });
+        while let Some(Entry { d: du, v, .. }) = heap.pop() {
+            if du > dist[v as usize] {
+                continue;
+            }
+            for e in d.graph().neighbors(v) {
+                let nd = du + f64::from(e.len);
+                if nd < dist[e.to as usize] {
+                    dist[e.to as usize] = nd;
+                    heap.push(Entry { d: nd, key: 0, v: e.to });
+                }
+            }
+        }
+        let expected = dist[50].min(dist[100]);
+        assert!((p.stats[0].r_h - expected).abs() < 1e-9);
+    }
+}
