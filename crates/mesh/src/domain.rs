@@ -195,7 +195,7 @@ pub fn domain_from_image(
         return Ok(Domain::full_rectangle(width, height));
     }
 
-    let labels = label_components(&mask, w, h, true, false).0;
+    let (labels, sizes) = label_components(&mask, w, h, true, false);
     let traced = trace(&mask, w, h);
     let raw: Vec<Vec<[i64; 2]>> = traced.iter().map(|r| r.pts.clone()).collect();
     let simplified = simplify_rings(&raw, tol);
@@ -207,7 +207,7 @@ pub fn domain_from_image(
             .map(|p| DVec2::new(p[0] as f64, p[1] as f64))
             .collect()
     };
-    let ncomp = labels.iter().copied().max().map_or(0, |m| m as usize + 1);
+    let ncomp = sizes.len();
     let mut outers: Vec<Vec<usize>> = vec![Vec::new(); ncomp];
     let mut holes: Vec<Vec<usize>> = vec![Vec::new(); ncomp];
     let areas: Vec<f64> = simplified

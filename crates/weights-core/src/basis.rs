@@ -95,7 +95,11 @@ impl Basis {
         if t.is_nan() || t >= 1.0 {
             return 0.0;
         }
-        let value = self.coefficients.iter().rev().fold(0.0, |acc, &c| acc * t + c);
+        let value = self
+            .coefficients
+            .iter()
+            .rev()
+            .fold(0.0, |acc, &c| acc * t + c);
         value.clamp(0.0, 1.0)
     }
 

@@ -86,6 +86,7 @@ impl Graph {
         &self.edges[self.offsets[v] as usize..self.offsets[v + 1] as usize]
     }
 
+    #[cfg(test)]
     pub fn edge_count(&self) -> usize {
         self.edges.len() / 2
     }
@@ -107,7 +108,9 @@ impl Grid {
     fn new(min: DVec2, max: DVec2, count: usize, per_cell: f64) -> (DVec2, f64, usize, usize) {
         let size = (max - min).max(DVec2::splat(1e-9));
         let cells = (count as f64 / per_cell).max(1.0);
-        let cell = (size.x * size.y / cells).sqrt().max(size.max_element() / 4096.0);
+        let cell = (size.x * size.y / cells)
+            .sqrt()
+            .max(size.max_element() / 4096.0);
         let nx = ((size.x / cell).ceil() as usize).clamp(1, 4096);
         let ny = ((size.y / cell).ceil() as usize).clamp(1, 4096);
         (min, cell, nx, ny)
@@ -426,7 +429,8 @@ impl Domain {
     /// Closed boundary loops (edges used by exactly one triangle), each as a vertex
     /// sequence without repeating the first vertex.
     pub fn boundary_loops(&self) -> &[Vec<u32>] {
-        self.boundary.get_or_init(|| boundary_loops(&self.triangles))
+        self.boundary
+            .get_or_init(|| boundary_loops(&self.triangles))
     }
 
     /// Whether the domain is one region bounded by a single convex loop (collinear

@@ -30,6 +30,7 @@ pub use basis::{Basis, MAX_DEGREE, MIN_DEGREE, MiddleControls};
 pub use domain::{Domain, Metric};
 pub use error::{DomainError, RigError};
 pub use rig::{
-    BuildTimings, Handle, Node, NodeKind, NodeRadii, Rig, RigOptions, RigStats,
+    BuildTimings, Handle, Node, NodeKind, NodeRadii, Rig, RigOptions, RigStats, bar_samples,
+    bar_spacing,
 };
 pub use transform::Similarity;

@@ -235,7 +235,11 @@ impl Rig {
     /// # Errors
     /// Invalid options; a handle that is not finite, lies outside the domain, coincides
     /// with another (or lands on the same sample), a zero-length bar, a scale ≤ 0.
-    pub fn new(domain: Domain, handles: Vec<Handle>, options: RigOptions) -> Result<Self, RigError> {
+    pub fn new(
+        domain: Domain,
+        handles: Vec<Handle>,
+        options: RigOptions,
+    ) -> Result<Self, RigError> {
         Self::with_virtual_handles(domain, handles, &[], options)
     }
 
@@ -341,7 +345,10 @@ impl Rig {
     /// As [`Rig::new`]; the rig is unchanged on error.
     pub fn set_handles(&mut self, handles: Vec<Handle>) -> Result<(), RigError> {
         let same_rest = handles.len() == self.handles.len()
-            && handles.iter().zip(&self.handles).all(|(a, b)| a.rest_equal(b));
+            && handles
+                .iter()
+                .zip(&self.handles)
+                .all(|(a, b)| a.rest_equal(b));
         if same_rest {
             check_handles(&handles)?;
             self.handles = handles;
@@ -359,7 +366,11 @@ impl Rig {
     ///
     /// # Errors
     /// No such handle, not a point handle, or a non-finite / non-positive-scale transform.
-    pub fn set_point_transform(&mut self, index: usize, transform: Similarity) -> Result<(), RigError> {
+    pub fn set_point_transform(
+        &mut self,
+        index: usize,
+        transform: Similarity,
+    ) -> Result<(), RigError> {
         match self.handles.get(index) {
             Some(Handle::Point { rest, .. }) => {
                 let h = Handle::Point {
@@ -521,7 +532,8 @@ impl Rig {
     /// Node transforms from the handles' poses (virtual ones blended harmonically).
     fn update_affines(&mut self) {
         // Per group: the similarity, its centre, and its rotation as a unit complex.
-        let mut groups: Vec<(Similarity, DVec2)> = self.handles.iter().map(Handle::similarity).collect();
+        let mut groups: Vec<(Similarity, DVec2)> =
+            self.handles.iter().map(Handle::similarity).collect();
         if self.options.fixed_boundary {
             groups.push((Similarity::IDENTITY, DVec2::ZERO));
         }
@@ -556,8 +568,12 @@ impl Rig {
     /// If `out` has the wrong length.
     pub fn deform_into(&self, out: &mut [DVec2]) {
         assert_eq!(out.len(), self.domain.len(), "output length");
-        self.weights
-            .deform(self.domain.positions(), &self.partition.owner, &self.affines, out);
+        self.weights.deform(
+            self.domain.positions(),
+            &self.partition.owner,
+            &self.affines,
+            out,
+        );
     }
 
     /// Where the rest point `p` goes, interpolated barycentrically from the deformed
@@ -565,7 +581,11 @@ impl Rig {
     pub fn deform_point(&self, deformed: &[DVec2], p: DVec2) -> Option<DVec2> {
         let (t, bary) = self.domain.locate(p)?;
         let tri = self.domain.triangles()[t];
-        Some((0..3).map(|i| deformed.get(tri[i] as usize).copied().unwrap_or(p) * bary[i]).sum())
+        Some(
+            (0..3)
+                .map(|i| deformed.get(tri[i] as usize).copied().unwrap_or(p) * bary[i])
+                .sum(),
+        )
     }
 
     /// The non-zero weights of sample `v` as (node index, weight).
@@ -668,7 +688,9 @@ impl Rig {
         RigStats {
             samples: self.domain.len(),
             real_handles: self.handles.len(),
-            handle_nodes: count(|k| matches!(k, NodeKind::Point { .. } | NodeKind::BarSample { .. })),
+            handle_nodes: count(|k| {
+                matches!(k, NodeKind::Point { .. } | NodeKind::BarSample { .. })
+            }),
             boundary_nodes: count(|k| matches!(k, NodeKind::Boundary)),
             virtual_nodes: count(|k| matches!(k, NodeKind::Virtual)),
             nonzeros: self.weights.nonzeros(),
@@ -737,7 +759,11 @@ fn blend(groups: &[(Similarity, DVec2)], coefficients: &[f64], c: DVec2) -> DAff
     if total <= 0.0 {
         return DAffine2::IDENTITY;
     }
-    let angle = if rot.length_squared() > 0.0 { rot.to_angle() } else { 0.0 };
+    let angle = if rot.length_squared() > 0.0 {
+        rot.to_angle()
+    } else {
+        0.0
+    };
     let blended = Similarity {
         translation: pos / total - c,
         rotation: angle,
@@ -748,7 +774,10 @@ fn blend(groups: &[(Similarity, DVec2)], coefficients: &[f64], c: DVec2) -> DAff
 
 fn check_options(o: &RigOptions) -> Result<(), RigError> {
     if !(0.0..=1.0).contains(&o.alpha) {
-        return Err(RigError::Options(format!("alpha must be in [0, 1], got {}", o.alpha)));
+        return Err(RigError::Options(format!(
+            "alpha must be in [0, 1], got {}",
+            o.alpha
+        )));
     }
     Ok(())
 }
@@ -776,7 +805,10 @@ fn check_handle(i: usize, h: &Handle) -> Result<(), RigError> {
 }
 
 fn check_handles(handles: &[Handle]) -> Result<(), RigError> {
-    handles.iter().enumerate().try_for_each(|(i, h)| check_handle(i, h))
+    handles
+        .iter()
+        .enumerate()
+        .try_for_each(|(i, h)| check_handle(i, h))
 }
 
 fn segment_distance(a: [DVec2; 2], b: [DVec2; 2]) -> f64 {
@@ -804,6 +836,53 @@ fn segment_distance(a: [DVec2; 2], b: [DVec2; 2]) -> f64 {
         .min(point_seg(b[1], a))
 }
 
+/// The closest two handles `(a, b, distance)` with `a < b`, by segment distance.
+fn closest_pair(handles: &[Handle]) -> Option<(usize, usize, f64)> {
+    let mut best: Option<(usize, usize, f64)> = None;
+    for i in 0..handles.len() {
+        for j in 0..i {
+            let d = segment_distance(segment_of(&handles[i]), segment_of(&handles[j]));
+            if best.is_none_or(|b| d < b.2) {
+                best = Some((j, i, d));
+            }
+        }
+    }
+    best
+}
+
+/// The sample spacing d of bar handles: the smallest distance between two handles
+/// (the paper's rule), or an eighth of the longest bar when there is only one handle.
+/// A rig never samples finer than its mesh's mean edge length.
+pub fn bar_spacing(handles: &[Handle]) -> f64 {
+    let longest_bar = handles
+        .iter()
+        .map(|h| match h {
+            Handle::Bar { rest, .. } => (rest[1] - rest[0]).length(),
+            Handle::Point { .. } => 0.0,
+        })
+        .fold(0.0, f64::max);
+    match closest_pair(handles) {
+        Some((_, _, d)) => d,
+        None => longest_bar / 8.0,
+    }
+}
+
+/// The ⌈L/d⌉ + 1 samples `(t, point)` of the bar `rest` at spacing `d`, ends included.
+pub fn bar_samples(rest: [DVec2; 2], spacing: f64) -> Vec<(f64, DVec2)> {
+    let ratio = (rest[1] - rest[0]).length() / spacing;
+    let pieces = if ratio.is_finite() {
+        ratio.ceil().clamp(1.0, 1e6) as usize
+    } else {
+        1
+    };
+    (0..=pieces)
+        .map(|s| {
+            let t = s as f64 / pieces as f64;
+            (t, rest[0].lerp(rest[1], t))
+        })
+        .collect()
+}
+
 fn segment_of(h: &Handle) -> [DVec2; 2] {
     match *h {
         Handle::Point { rest, .. } => [rest, rest],
@@ -823,25 +902,13 @@ fn real_nodes(
     check_handles(handles)?;
     let (lo, hi) = domain.bounds();
     let tiny = 1e-9 * (hi - lo).length().max(1.0);
-    let mut spacing = f64::INFINITY;
-    for i in 0..handles.len() {
-        for j in 0..i {
-            let d = segment_distance(segment_of(&handles[i]), segment_of(&handles[j]));
-            if d <= tiny {
-                return Err(RigError::Coincident { a: j, b: i });
-            }
-            spacing = spacing.min(d);
-        }
+    if let Some((a, b)) = closest_pair(handles)
+        .filter(|p| p.2 <= tiny)
+        .map(|p| (p.0, p.1))
+    {
+        return Err(RigError::Coincident { a, b });
     }
-    // With fewer than two handles d is undefined: split bars into eight pieces.
-    let longest_bar = handles
-        .iter()
-        .map(|h| match h {
-            Handle::Bar { rest, .. } => (rest[1] - rest[0]).length(),
-            Handle::Point { .. } => 0.0,
-        })
-        .fold(0.0, f64::max);
-    let spacing = spacing.min(longest_bar / 8.0).max(resolution);
+    let spacing = bar_spacing(handles).max(resolution);
     let snap = |i: usize, p: DVec2| -> Result<u32, RigError> {
         let (t, bary) = domain.locate(p).ok_or(RigError::OutsideDomain {
             handle: i,
@@ -876,10 +943,8 @@ fn real_nodes(
                         });
                     }
                 }
-                let pieces = ((rest[1] - rest[0]).length() / spacing).ceil().max(1.0) as usize;
-                for s in 0..=pieces {
-                    let t = s as f64 / pieces as f64;
-                    let v = snap(i, rest[0].lerp(rest[1], t))?;
+                for (t, p) in bar_samples(rest, spacing) {
+                    let v = snap(i, p)?;
                     if own.iter().all(|n| n.vertex != v) {
                         own.push(Node {
                             vertex: v,

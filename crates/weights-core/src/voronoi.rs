@@ -149,11 +149,6 @@ impl Partition {
         self.node_vertex.len()
     }
 
-    /// Samples in cell `k`.
-    pub fn members(&self, k: usize) -> &[u32] {
-        &self.members[k]
-    }
-
     /// Whether sample `v` carries a node.
     #[inline]
     pub fn is_node(&self, v: u32) -> bool {
@@ -221,7 +216,11 @@ impl Partition {
                     } else {
                         self.owner[w] = k;
                     }
-                    heap.push(Entry { d: nd, key, v: e.to });
+                    heap.push(Entry {
+                        d: nd,
+                        key,
+                        v: e.to,
+                    });
                 }
             }
         }
@@ -485,7 +484,9 @@ mod tests {
         let mut s = seed;
         for q in p.iter_mut() {
             if q.x > 0.0 && q.y > 0.0 && q.x < nx as f64 && q.y < ny as f64 {
-                s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                s = s
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
                 let a = ((s >> 33) as f64 / (1u64 << 31) as f64 - 0.5) * 0.3;
                 let b = ((s >> 13 & 0xfffff) as f64 / (1u64 << 20) as f64 - 0.5) * 0.3;
                 *q += DVec2::new(a, b);
@@ -519,7 +520,11 @@ mod tests {
         let mut dist = vec![f64::INFINITY; d.len()];
         let mut heap = BinaryHeap::new();
         dist[0] = 0.0;
-        heap.push(Entry { d: 0.0, key: 0, v: 0 });
+        heap.push(Entry {
+            d: 0.0,
+            key: 0,
+            v: 0,
+        });
         while let Some(Entry { d: du, v, .. }) = heap.pop() {
             if du > dist[v as usize] {
                 continue;
@@ -528,7 +533,11 @@ mod tests {
                 let nd = du + f64::from(e.len);
                 if nd < dist[e.to as usize] {
                     dist[e.to as usize] = nd;
-                    heap.push(Entry { d: nd, key: 0, v: e.to });
+                    heap.push(Entry {
+                        d: nd,
+                        key: 0,
+                        v: e.to,
+                    });
                 }
             }
         }

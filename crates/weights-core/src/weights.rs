@@ -154,17 +154,18 @@ pub(crate) struct Change {
 
 impl Weights {
     /// Weights from scratch.
-    pub fn build(
-        domain: &Domain,
-        partition: &Partition,
-        radii: &[f64],
-        basis: &Basis,
-    ) -> Self {
+    pub fn build(domain: &Domain, partition: &Partition, radii: &[f64], basis: &Basis) -> Self {
         let n = domain.len();
         let supports: Vec<Vec<(u32, f32)>> = (0..partition.len())
             .into_par_iter()
             .map_init(
-                || Scratch::new(if domain.metric() == Metric::Intrinsic { n } else { 0 }),
+                || {
+                    Scratch::new(if domain.metric() == Metric::Intrinsic {
+                        n
+                    } else {
+                        0
+                    })
+                },
                 |scratch, k| {
                     let r = radii[k];
                     let (ball, cut) = ball(domain, partition, partition.node_vertex[k], r, scratch);
@@ -238,12 +239,23 @@ impl Weights {
         let results: Vec<(usize, Vec<(u32, f64)>, Vec<(u32, f32)>)> = changes
             .par_iter()
             .map_init(
-                || Scratch::new(if domain.metric() == Metric::Intrinsic { n } else { 0 }),
+                || {
+                    Scratch::new(if domain.metric() == Metric::Intrinsic {
+                        n
+                    } else {
+                        0
+                    })
+                },
                 |scratch, c| {
                     let r = radii[c.node];
                     let reach = c.old_radius.map_or(r, |o| o.max(r));
-                    let (ball, cut) =
-                        ball(domain, partition, partition.node_vertex[c.node], reach, scratch);
+                    let (ball, cut) = ball(
+                        domain,
+                        partition,
+                        partition.node_vertex[c.node],
+                        reach,
+                        scratch,
+                    );
                     let entries = support(basis, &ball, r, cut);
                     (c.node, ball, entries)
                 },

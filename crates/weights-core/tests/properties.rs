@@ -37,7 +37,10 @@ fn check_invariants(rig: &Rig) -> Result<(), String> {
     for (k, node) in nodes.iter().enumerate() {
         let row: Vec<(usize, f64)> = rig.weights(node.vertex as usize).collect();
         if row != vec![(k, 1.0)] {
-            return Err(format!("node {k} ({:?}) has weights {row:?} at its own sample", node.kind));
+            return Err(format!(
+                "node {k} ({:?}) has weights {row:?} at its own sample",
+                node.kind
+            ));
         }
     }
     // r_d < r_h after virtual-handle insertion.
@@ -99,7 +102,11 @@ fn random_handles(domain: &Domain, rng: &mut Rng, points: usize, bars: usize) ->
 }
 
 fn shape_of(convex: bool) -> Shape {
-    if convex { Shape::Rectangle } else { Shape::Holed }
+    if convex {
+        Shape::Rectangle
+    } else {
+        Shape::Holed
+    }
 }
 
 proptest! {
@@ -256,20 +263,36 @@ fn mirror_symmetric_rigs_give_mirror_symmetric_weights_and_warps() {
             .collect();
         for (k, n) in rig.nodes().iter().enumerate() {
             let m = find(mirror(positions[n.vertex as usize])) as u32;
-            assert!(node_at.contains_key(&m), "node {k} ({:?}) has no mirror image", n.kind);
+            assert!(
+                node_at.contains_key(&m),
+                "node {k} ({:?}) has no mirror image",
+                n.kind
+            );
         }
         let moved = rig.deform();
         for v in 0..domain.len() {
             let mv = find(mirror(positions[v]));
-            let a: Vec<(u32, f64)> = rig.weights(v).map(|(k, w)| (rig.nodes()[k].vertex, w)).collect();
+            let a: Vec<(u32, f64)> = rig
+                .weights(v)
+                .map(|(k, w)| (rig.nodes()[k].vertex, w))
+                .collect();
             for (kv, w) in a {
                 let mk = find(mirror(positions[kv as usize])) as u32;
                 let k2 = node_at[&mk];
-                let w2 = rig.weights(mv).find(|&(k, _)| k == k2).map_or(0.0, |(_, w)| w);
-                assert!((w - w2).abs() < 1e-9, "{shape:?}: w at {v} = {w}, mirrored {w2}");
+                let w2 = rig
+                    .weights(mv)
+                    .find(|&(k, _)| k == k2)
+                    .map_or(0.0, |(_, w)| w);
+                assert!(
+                    (w - w2).abs() < 1e-9,
+                    "{shape:?}: w at {v} = {w}, mirrored {w2}"
+                );
             }
             let expected = mirror(moved[v]);
-            assert!((moved[mv] - expected).length() < 1e-6, "{shape:?}: warp not symmetric at {v}");
+            assert!(
+                (moved[mv] - expected).length() < 1e-6,
+                "{shape:?}: warp not symmetric at {v}"
+            );
         }
     }
 }
@@ -287,27 +310,136 @@ fn degenerate_rigs_never_panic() {
     let nan = DVec2::new(f64::NAN, 1.0);
     let cases: Vec<(&str, &Domain, Vec<Handle>, Option<fn(&RigError) -> bool>)> = vec![
         ("no handles", &convex, vec![], None),
-        ("one handle", &convex, vec![Handle::point(DVec2::new(3.0, 3.0))], None),
-        ("corner handles", &convex, vec![Handle::point(DVec2::ZERO), Handle::point(DVec2::new(20.0, 15.0))], None),
-        ("boundary handles", &holed, vec![Handle::point(DVec2::new(0.0, 7.0)), Handle::point(DVec2::new(8.0, 8.0))], None),
-        ("one sample apart", &holed, vec![Handle::point(DVec2::new(2.0, 2.0)), Handle::point(DVec2::new(3.0, 2.0))], None),
-        ("one sample apart, convex", &convex, vec![Handle::point(DVec2::new(0.0, 0.0)), Handle::point(DVec2::new(1.0, 0.0))], None),
-        ("collinear", &convex, (0..8).map(|i| Handle::point(DVec2::new(2.0 + 2.0 * i as f64, 0.0))).collect(), None),
-        ("bar on the border", &convex, vec![Handle::bar(DVec2::new(0.0, 0.0), DVec2::new(20.0, 0.0))], None),
-        ("bar across the hole", &holed, vec![Handle::bar(DVec2::new(1.0, 10.0), DVec2::new(19.0, 10.0))], Some(|e| matches!(e, RigError::OutsideDomain { .. }))),
-        ("every sample a handle", &tiny, (0..3).map(|i| Handle::point(tiny.positions()[i])).collect(), None),
-        ("coincident", &convex, vec![Handle::point(DVec2::new(3.0, 3.0)), Handle::point(DVec2::new(3.0, 3.0))], Some(|e| matches!(e, RigError::Coincident { .. }))),
-        ("same sample", &convex, vec![Handle::point(DVec2::new(3.0, 3.0)), Handle::point(DVec2::new(3.01, 3.0))], Some(|e| matches!(e, RigError::Coincident { .. }))),
-        ("zero-length bar", &convex, vec![Handle::bar(DVec2::ONE, DVec2::ONE)], Some(|e| matches!(e, RigError::ZeroLengthBar { .. }))),
-        ("NaN", &convex, vec![Handle::point(nan)], Some(|e| matches!(e, RigError::NonFinite { .. }))),
-        ("outside", &convex, vec![Handle::point(DVec2::new(-5.0, 3.0))], Some(|e| matches!(e, RigError::OutsideDomain { .. }))),
-        ("in the hole", &holed, vec![Handle::point(DVec2::new(10.0, 10.0))], Some(|e| matches!(e, RigError::OutsideDomain { .. }))),
-        ("crossing bars", &convex, vec![Handle::bar(DVec2::new(2.0, 2.0), DVec2::new(10.0, 10.0)), Handle::bar(DVec2::new(2.0, 10.0), DVec2::new(10.0, 2.0))], Some(|e| matches!(e, RigError::Coincident { .. }))),
+        (
+            "one handle",
+            &convex,
+            vec![Handle::point(DVec2::new(3.0, 3.0))],
+            None,
+        ),
+        (
+            "corner handles",
+            &convex,
+            vec![
+                Handle::point(DVec2::ZERO),
+                Handle::point(DVec2::new(20.0, 15.0)),
+            ],
+            None,
+        ),
+        (
+            "boundary handles",
+            &holed,
+            vec![
+                Handle::point(DVec2::new(0.0, 7.0)),
+                Handle::point(DVec2::new(8.0, 8.0)),
+            ],
+            None,
+        ),
+        (
+            "one sample apart",
+            &holed,
+            vec![
+                Handle::point(DVec2::new(2.0, 2.0)),
+                Handle::point(DVec2::new(3.0, 2.0)),
+            ],
+            None,
+        ),
+        (
+            "one sample apart, convex",
+            &convex,
+            vec![
+                Handle::point(DVec2::new(0.0, 0.0)),
+                Handle::point(DVec2::new(1.0, 0.0)),
+            ],
+            None,
+        ),
+        (
+            "collinear",
+            &convex,
+            (0..8)
+                .map(|i| Handle::point(DVec2::new(2.0 + 2.0 * i as f64, 0.0)))
+                .collect(),
+            None,
+        ),
+        (
+            "bar on the border",
+            &convex,
+            vec![Handle::bar(DVec2::new(0.0, 0.0), DVec2::new(20.0, 0.0))],
+            None,
+        ),
+        (
+            "bar across the hole",
+            &holed,
+            vec![Handle::bar(DVec2::new(1.0, 10.0), DVec2::new(19.0, 10.0))],
+            Some(|e| matches!(e, RigError::OutsideDomain { .. })),
+        ),
+        (
+            "every sample a handle",
+            &tiny,
+            (0..3).map(|i| Handle::point(tiny.positions()[i])).collect(),
+            None,
+        ),
+        (
+            "coincident",
+            &convex,
+            vec![
+                Handle::point(DVec2::new(3.0, 3.0)),
+                Handle::point(DVec2::new(3.0, 3.0)),
+            ],
+            Some(|e| matches!(e, RigError::Coincident { .. })),
+        ),
+        (
+            "same sample",
+            &convex,
+            vec![
+                Handle::point(DVec2::new(3.0, 3.0)),
+                Handle::point(DVec2::new(3.01, 3.0)),
+            ],
+            Some(|e| matches!(e, RigError::Coincident { .. })),
+        ),
+        (
+            "zero-length bar",
+            &convex,
+            vec![Handle::bar(DVec2::ONE, DVec2::ONE)],
+            Some(|e| matches!(e, RigError::ZeroLengthBar { .. })),
+        ),
+        (
+            "NaN",
+            &convex,
+            vec![Handle::point(nan)],
+            Some(|e| matches!(e, RigError::NonFinite { .. })),
+        ),
+        (
+            "outside",
+            &convex,
+            vec![Handle::point(DVec2::new(-5.0, 3.0))],
+            Some(|e| matches!(e, RigError::OutsideDomain { .. })),
+        ),
+        (
+            "in the hole",
+            &holed,
+            vec![Handle::point(DVec2::new(10.0, 10.0))],
+            Some(|e| matches!(e, RigError::OutsideDomain { .. })),
+        ),
+        (
+            "crossing bars",
+            &convex,
+            vec![
+                Handle::bar(DVec2::new(2.0, 2.0), DVec2::new(10.0, 10.0)),
+                Handle::bar(DVec2::new(2.0, 10.0), DVec2::new(10.0, 2.0)),
+            ],
+            Some(|e| matches!(e, RigError::Coincident { .. })),
+        ),
     ];
     for (name, domain, handles, expected_error) in cases {
         for fixed_boundary in [false, true] {
-            let options = RigOptions { fixed_boundary, ..RigOptions::default() };
-            match (Rig::new(domain.clone(), handles.clone(), options), expected_error) {
+            let options = RigOptions {
+                fixed_boundary,
+                ..RigOptions::default()
+            };
+            match (
+                Rig::new(domain.clone(), handles.clone(), options),
+                expected_error,
+            ) {
                 (Ok(rig), None) => {
                     check_invariants(&rig).unwrap_or_else(|e| panic!("{name}: {e}"));
                     let _ = rig.deform();
@@ -318,7 +450,10 @@ fn degenerate_rigs_never_panic() {
             }
         }
     }
-    let bad_alpha = RigOptions { alpha: 1.5, ..RigOptions::default() };
+    let bad_alpha = RigOptions {
+        alpha: 1.5,
+        ..RigOptions::default()
+    };
     assert!(Rig::new(convex.clone(), vec![], bad_alpha).is_err());
 }
 
@@ -330,7 +465,11 @@ fn bars_are_sampled_and_follow_their_pose() {
         Handle::point(DVec2::new(15.0, 5.0)),
     ];
     let mut rig = Rig::new(domain, handles, RigOptions::default()).expect("valid");
-    let samples = rig.nodes().iter().filter(|n| matches!(n.kind, NodeKind::BarSample { .. })).count();
+    let samples = rig
+        .nodes()
+        .iter()
+        .filter(|n| matches!(n.kind, NodeKind::BarSample { .. }))
+        .count();
     // d = 5 (point to bar): ⌈20 / 5⌉ = 4 pieces, 5 samples.
     assert_eq!(samples, 5);
     let pose = [DVec2::new(5.0, 12.0), DVec2::new(25.0, 14.0)];

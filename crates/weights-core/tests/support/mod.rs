@@ -72,10 +72,14 @@ pub fn grid_domain(nx: usize, ny: usize, h: f64, jitter: f64, shape: Shape, seed
             }
         }
     }
-    compact(positions, triangles, match shape {
-        Shape::Rectangle => Metric::Euclidean,
-        Shape::Holed => Metric::Intrinsic,
-    })
+    compact(
+        positions,
+        triangles,
+        match shape {
+            Shape::Rectangle => Metric::Euclidean,
+            Shape::Holed => Metric::Intrinsic,
+        },
+    )
 }
 
 /// Drops unused vertices and renumbers.
