@@ -1,1 +1,168 @@
-fn main() {}
+//! `c2warp`: warp images with C² handle weights from the command line.
+
+mod bench;
+mod export;
+mod pipeline;
+mod progress;
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+use clap::{Args, Parser, Subcommand};
+use project::Project;
+
+/// The image the demo warps (public domain, see assets/LICENSES.md).
+pub const DEFAULT_IMAGE: &[u8] = include_bytes!("../../../assets/lizard.png");
+/// The rig the demo applies to it.
+pub const DEFAULT_RIG: &str = include_str!("../../../assets/lizard-rig.json");
+
+#[derive(Parser)]
+#[command(name = "c2warp", version, about = "Handle-driven image warping with closed-form C² weights")]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Warp an image by a rig and write a PNG of the same size (alpha kept).
+    Render {
+        /// The image (PNG or JPEG).
+        image: PathBuf,
+        /// The rig file (RIG.json).
+        #[arg(long)]
+        rig: PathBuf,
+        /// Where to write the PNG.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Target number of mesh vertices (overrides the rig's `density`).
+        #[arg(long)]
+        density: Option<usize>,
+    },
+    /// Write the nodes actually used and every mesh vertex's non-zero weights as JSON.
+    Weights {
+        #[command(flatten)]
+        source: Source,
+        /// The rig file (RIG.json).
+        #[arg(long)]
+        rig: PathBuf,
+        /// Where to write the JSON.
+        #[arg(short, long)]
+        output: PathBuf,
+    },
+    /// Time the rig build, handle insertion and removal, and deformation; print JSON.
+    Bench {
+        #[command(flatten)]
+        source: Source,
+        /// The rig file (RIG.json).
+        #[arg(long)]
+        rig: PathBuf,
+        /// Random positions to insert and remove a handle at.
+        #[arg(long, default_value_t = 31)]
+        positions: usize,
+    },
+    /// Render the sample rig on the built-in image and say where the PNG went.
+    Demo {
+        /// Where to write the PNG.
+        #[arg(short, long, default_value = "c2warp-demo.png")]
+        output: PathBuf,
+    },
+}
+
+/// Where the samples come from.
+#[derive(Args)]
+#[group(required = true, multiple = false)]
+struct Source {
+    /// A 2-D mesh as Wavefront OBJ (`v x y [z]`, `f a b c`); vertices used as given.
+    #[arg(long)]
+    mesh: Option<PathBuf>,
+    /// An image to mesh (alpha outlines, or the full rectangle).
+    #[arg(long)]
+    image: Option<PathBuf>,
+    /// Target number of mesh vertices when meshing an image.
+    #[arg(long)]
+    density: Option<usize>,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command.unwrap_or(Command::Demo {
+        output: PathBuf::from("c2warp-demo.png"),
+    }) {
+        Command::Render {
+            image,
+            rig,
+            output,
+            density,
+        } => render(&image, &rig, &output, density),
+        Command::Weights {
+            source,
+            rig,
+            output,
+        } => export::weights(&source, &rig, &output),
+        Command::Bench {
+            source,
+            rig,
+            positions,
+        } => bench::run(&source, &rig, positions),
+        Command::Demo { output } => demo(&output),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// Reads and parses a rig file.
+fn load_project(path: &Path) -> Result<Project> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("cannot read rig file {}", path.display()))?;
+    Project::from_json(&text).with_context(|| format!("rig file {}", path.display()))
+}
+
+fn load_image(path: &Path) -> Result<image::RgbaImage> {
+    Ok(render::load_image(path, &render::ImageLimits::default())?)
+}
+
+fn render(image: &Path, rig: &Path, output: &Path, density: Option<usize>) -> Result<()> {
+    let progress = progress::Steps::new(4);
+    progress.step("reading");
+    let project = load_project(rig)?;
+    let picture = load_image(image)?;
+    progress.step("meshing and weighting");
+    let prepared = pipeline::prepare(&picture, &project, density)?;
+    progress.step("rendering");
+    let warped = pipeline::warp(&picture, &prepared.rig)?;
+    progress.step("writing");
+    render::save_png_atomic(output, &warped)?;
+    progress.finish();
+    Ok(())
+}
+
+fn demo(output: &Path) -> Result<()> {
+    let picture = render::decode_image(DEFAULT_IMAGE, &render::ImageLimits::default())?;
+    let project = Project::from_json(DEFAULT_RIG).context("built-in rig")?;
+    let progress = progress::Steps::new(3);
+    progress.step("meshing and weighting");
+    let prepared = pipeline::prepare(&picture, &project, None)?;
+    progress.step("rendering");
+    let warped = pipeline::warp(&picture, &prepared.rig)?;
+    progress.step("writing");
+    render::save_png_atomic(output, &warped)?;
+    progress.finish();
+    let stats = prepared.rig.stats();
+    println!(
+        "Warped the built-in lizard ({} × {} px, {} mesh vertices, {} handles + {} virtual) into {}",
+        picture.width(),
+        picture.height(),
+        stats.samples,
+        stats.real_handles,
+        stats.virtual_nodes,
+        std::path::absolute(output).unwrap_or_else(|_| output.to_path_buf()).display()
+    );
+    Ok(())
+}

@@ -327,18 +327,6 @@ impl RingBands {
         out.sort_by(f64::total_cmp);
     }
 
-    /// Whether `p` lies on a ring (within a tiny absolute tolerance).
-    pub(crate) fn on_boundary(&self, p: DVec2) -> bool {
-        let Some(items) = self.band(p.y) else {
-            return false;
-        };
-        let e2 = self.eps * self.eps;
-        items.iter().any(|&i| {
-            let [a, b] = self.segs[i as usize];
-            dist2_point_segment(p, a, b) <= e2
-        })
-    }
-
     /// Even-odd test; points on a ring count as inside.
     pub(crate) fn contains(&self, p: DVec2) -> bool {
         let Some(items) = self.band(p.y) else {
@@ -360,11 +348,6 @@ impl RingBands {
         }
         inside
     }
-
-    /// Whether `p` is strictly inside (inside and not on a ring).
-    pub(crate) fn strictly_contains(&self, p: DVec2) -> bool {
-        self.contains(p) && !self.on_boundary(p)
-    }
 }
 
 #[cfg(test)]
@@ -385,8 +368,6 @@ mod tests {
         assert!(bands.contains(DVec2::new(4.0, 4.0)));
         assert!(!bands.contains(DVec2::new(4.5, 2.0)));
         assert!(!bands.contains(DVec2::new(2.0, -0.1)));
-        assert!(bands.strictly_contains(DVec2::new(1.0, 1.0)));
-        assert!(!bands.strictly_contains(DVec2::new(1.0, 0.0)));
         let mut xs = Vec::new();
         bands.crossings(1.5, &mut xs);
         assert_eq!(xs, vec![0.0, 4.0]);

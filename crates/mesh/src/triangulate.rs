@@ -506,8 +506,10 @@ fn build_mesh(
         );
     }
 
+    // Outer faces exist unless the domain is one convex polygon without holes.
+    let convex = matches!(domain.polygons.as_slice(), [p] if p.holes.is_empty() && is_convex(&p.outer));
     let mut params = RefinementParameters::<f64>::new()
-        .exclude_outer_faces(true)
+        .exclude_outer_faces(!convex)
         .with_angle_limit(AngleLimit::from_deg(min_angle))
         .with_max_additional_vertices(max_extra);
     if lattice_area.is_finite() && lattice_area > 0.0 {
@@ -606,7 +608,6 @@ fn build_mesh(
     if triangles.is_empty() {
         return Err(MeshError::EmptyDomain);
     }
-    let _ = domain;
     Ok(Built {
         mesh: Mesh {
             vertices,
@@ -615,6 +616,18 @@ fn build_mesh(
         new_index,
         paths,
     })
+}
+
+/// Whether a ring is convex (collinear vertices allowed).
+fn is_convex(ring: &[DVec2]) -> bool {
+    let n = ring.len();
+    let (mut pos, mut neg) = (false, false);
+    for i in 0..n {
+        let o = crate::geometry::orient(ring[i], ring[(i + 1) % n], ring[(i + 2) % n]);
+        pos |= o > 0.0;
+        neg |= o < 0.0;
+    }
+    !(pos && neg)
 }
 
 /// Follows constraint edges from vertex `from` straight towards vertex `to`.

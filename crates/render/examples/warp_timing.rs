@@ -1,6 +1,6 @@
 //! Times `warp_cpu` on a swirled grid mesh of about 200k triangles.
 //!
-//! `cargo run -p render --release --example warp_timing [runs]`
+//! `cargo run -p render --release --example warp_timing [runs] [sizes...]`
 
 use std::time::Instant;
 
@@ -50,7 +50,10 @@ fn swirl_mesh(size: f32, cells: u32) -> (Vec<Vec2>, Vec<Vec2>, Vec<[u32; 3]>) {
 }
 
 fn main() {
-    let runs: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(5);
+    let runs: usize = std::env::args()
+        .nth(1)
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(5);
     println!("rayon threads: {}", rayon::current_num_threads());
     for size in [1024u32, 4096] {
         let tex = texture(size);

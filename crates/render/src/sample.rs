@@ -1,16 +1,43 @@
 //! Bilinear texture sampling in premultiplied alpha.
+//!
+//! Texture positions are handled in 32.32 fixed point, so that stepping along
+//! a span is an exact integer addition and splitting a position into texel
+//! index and fraction needs no floating-point rounding.
+
+use glam::Vec4;
 
 /// Sampling positions closer than this (in texels) to a texel centre are
 /// snapped onto it, so that an identity map reproduces texels exactly despite
 /// floating-point rounding.
 pub(crate) const SNAP_TEXELS: f64 = 1e-4;
 
+/// Fractional bits of a fixed-point texture position.
+const FRAC_BITS: u32 = 32;
+/// One texel in fixed point.
+pub(crate) const FIXED_ONE: f64 = (1u64 << FRAC_BITS) as f64;
+const FRAC_MASK: i64 = (1 << FRAC_BITS) - 1;
+const HALF_TEXEL: i64 = 1 << (FRAC_BITS - 1);
+/// [`SNAP_TEXELS`] in fixed point, and one texel minus it.
+const SNAP_LO: i64 = (SNAP_TEXELS * FIXED_ONE) as i64;
+const SNAP_HI: i64 = (1 << FRAC_BITS) - SNAP_LO;
+/// Fixed-point positions may range over `±FIXED_RANGE` texels; beyond that
+/// a position is clamped before conversion (it lies far outside any texture).
+pub(crate) const FIXED_RANGE: f64 = (1u64 << 30) as f64;
+
+/// Converts a texture coordinate to fixed point, clamping far-away values
+/// (and mapping NaN to 0).
+#[inline]
+pub(crate) fn to_fixed(coordinate: f64) -> i64 {
+    (coordinate.max(-FIXED_RANGE).min(FIXED_RANGE) * FIXED_ONE) as i64
+}
+
 /// A borrowed RGBA8 texture with clamp-to-edge bilinear sampling.
 pub(crate) struct Texture<'a> {
     data: &'a [u8],
     width: usize,
-    max_x: f64,
-    max_y: f64,
+    /// Position of the last texel column / row, in fixed point.
+    max_x: i64,
+    max_y: i64,
 }
 
 impl<'a> Texture<'a> {
@@ -19,8 +46,8 @@ impl<'a> Texture<'a> {
         Self {
             data,
             width: width as usize,
-            max_x: f64::from(width.saturating_sub(1)),
-            max_y: f64::from(height.saturating_sub(1)),
+            max_x: i64::from(width.saturating_sub(1)) << FRAC_BITS,
+            max_y: i64::from(height.saturating_sub(1)) << FRAC_BITS,
         }
     }
 
@@ -35,71 +62,90 @@ impl<'a> Texture<'a> {
 
     /// Samples at texture position `(u, v)` in source pixels (texel `(i, j)`
     /// has its centre at `(i + 0.5, j + 0.5)`).
+    #[cfg(test)]
+    pub(crate) fn sample(&self, u: f64, v: f64) -> [u8; 4] {
+        self.sample_fixed(to_fixed(u), to_fixed(v))
+    }
+
+    /// Samples at texture position `(u, v)` given in fixed point (see
+    /// [`to_fixed`]).
     ///
     /// Colours are premultiplied by alpha before filtering and divided by the
     /// filtered alpha afterwards, so a transparent neighbour contributes
     /// coverage but no colour (no dark fringes on cut-outs).
     #[inline]
-    pub(crate) fn sample(&self, u: f64, v: f64) -> [u8; 4] {
+    pub(crate) fn sample_fixed(&self, u: i64, v: i64) -> [u8; 4] {
         let (x0, x1, fx) = axis(u, self.max_x);
         let (y0, y1, fy) = axis(v, self.max_y);
         if fx == 0.0 && fy == 0.0 {
             return self.texel(x0, y0);
         }
-        let (fx, fy) = (fx as f32, fy as f32);
-        let taps = [
+        blend(&[
             (self.texel(x0, y0), (1.0 - fx) * (1.0 - fy)),
             (self.texel(x1, y0), fx * (1.0 - fy)),
             (self.texel(x0, y1), (1.0 - fx) * fy),
             (self.texel(x1, y1), fx * fy),
-        ];
-        blend(&taps)
+        ])
     }
 }
 
-/// Splits one texture coordinate into the two texel indices to blend and the
-/// weight of the second.
+/// Splits one fixed-point texture coordinate into the two texel indices to
+/// blend and the weight of the second, clamping to the texel centres
+/// `[0, max]` and snapping onto a texel centre within [`SNAP_TEXELS`].
 #[inline]
-fn axis(coordinate: f64, max: f64) -> (usize, usize, f64) {
-    let mut s = coordinate - 0.5;
-    let nearest = s.round();
-    if (s - nearest).abs() < SNAP_TEXELS {
-        s = nearest;
+fn axis(coordinate: i64, max: i64) -> (usize, usize, f32) {
+    let s = (coordinate - HALF_TEXEL).clamp(0, max);
+    let i0 = (s >> FRAC_BITS) as usize;
+    let frac = s & FRAC_MASK;
+    if frac < SNAP_LO {
+        (i0, i0, 0.0)
+    } else if frac > SNAP_HI {
+        // `i0 < s <= max` and `max` is whole, so `i0 + 1 <= max`.
+        (i0 + 1, i0 + 1, 0.0)
+    } else {
+        (i0, i0 + 1, frac as f32 * (1.0 / FIXED_ONE as f32))
     }
-    let s = s.clamp(0.0, max);
-    let i0 = s.floor();
-    let frac = s - i0;
-    let i0 = i0 as usize;
-    let i1 = if frac > 0.0 { i0 + 1 } else { i0 };
-    (i0, i1, frac)
+}
+
+/// The RGBA of a texel as floats, with alpha replaced by one.
+#[inline]
+fn colour(texel: [u8; 4]) -> Vec4 {
+    Vec4::new(
+        f32::from(texel[0]),
+        f32::from(texel[1]),
+        f32::from(texel[2]),
+        1.0,
+    )
+}
+
+/// Rounds a float channel to a byte (saturating; NaN becomes 0).
+#[inline]
+fn to_u8(v: f32) -> u8 {
+    (v + 0.5) as u8
 }
 
 /// Weighted premultiplied average of texels; weights sum to one.
 #[inline]
 fn blend(taps: &[([u8; 4], f32); 4]) -> [u8; 4] {
-    let mut alpha = 0.0f32;
-    let mut premultiplied = [0.0f32; 3];
+    // xyz: Σ w·a·rgb (premultiplied colour), w: Σ w·a (alpha).
+    let mut acc = Vec4::ZERO;
     for &(texel, weight) in taps {
-        let wa = weight * f32::from(texel[3]);
-        alpha += wa;
-        for (acc, &c) in premultiplied.iter_mut().zip(&texel[..3]) {
-            *acc += wa * f32::from(c);
-        }
+        acc += colour(texel) * (weight * f32::from(texel[3]));
     }
-    let to_u8 = |v: f32| (v + 0.5).clamp(0.0, 255.0) as u8;
-    if alpha > 0.0 {
-        let [r, g, b] = premultiplied.map(|c| to_u8(c / alpha));
-        [r, g, b, to_u8(alpha)]
+    if acc.w > 0.0 {
+        let straight = acc * acc.w.recip();
+        [
+            to_u8(straight.x),
+            to_u8(straight.y),
+            to_u8(straight.z),
+            to_u8(acc.w),
+        ]
     } else {
         // Fully transparent: keep the (straight) filtered colour under it.
-        let mut straight = [0.0f32; 3];
-        for &(texel, weight) in taps {
-            for (acc, &c) in straight.iter_mut().zip(&texel[..3]) {
-                *acc += weight * f32::from(c);
-            }
-        }
-        let [r, g, b] = straight.map(to_u8);
-        [r, g, b, 0]
+        let straight = taps.iter().fold(Vec4::ZERO, |sum, &(texel, weight)| {
+            sum + colour(texel) * weight
+        });
+        [to_u8(straight.x), to_u8(straight.y), to_u8(straight.z), 0]
     }
 }
 

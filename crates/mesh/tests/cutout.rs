@@ -1,0 +1,139 @@
+//! Cut-out images: the mesh follows the alpha outline, covers every opaque pixel and
+//! respects holes.
+
+mod support;
+
+use glam::DVec2;
+use mesh::{Constraints, DomainOptions, MeshOptions, domain_from_image, mesh_image, triangulate};
+use support::{Locator, disc_with_hole_and_island, in_disc_with_hole_and_island};
+
+#[test]
+fn disc_with_hole_and_island_meshes_well() {
+    let img = disc_with_hole_and_island();
+    let domain = domain_from_image(&img, &DomainOptions::default()).unwrap();
+    assert!(!domain.is_full_rectangle);
+    assert_eq!(domain.polygons.len(), 2);
+    let holes: usize = domain.polygons.iter().map(|p| p.holes.len()).sum();
+    assert_eq!(holes, 1);
+
+    let opts = MeshOptions {
+        target_vertices: 8_000,
+        ..Default::default()
+    };
+    let t = triangulate(&domain, &Constraints::default(), &opts).unwrap();
+    assert!(!t.is_convex);
+    t.mesh.sanity_check().unwrap();
+    let n = t.mesh.vertices.len() as f64;
+    assert!((n / 8_000.0 - 1.0).abs() < 0.3, "{n} vertices");
+
+    // Area: the alpha area plus the one-pixel outward margin (about perimeter × 1 px).
+    let alpha_area = img.pixels().filter(|p| p.0[3] > 8).count() as f64;
+    let area = t.mesh.area();
+    assert!((area - domain.area()).abs() < 1e-6 * area);
+    assert!(area > alpha_area, "{area} vs {alpha_area}");
+    assert!(area < alpha_area * 1.06, "mesh area {area}, alpha area {alpha_area}");
+
+    // Every opaque pixel centre is inside the mesh.
+    let loc = Locator::new(&t.mesh);
+    for (x, y, p) in img.enumerate_pixels() {
+        if p.0[3] > 8 {
+            let c = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
+            assert!(loc.contains(c), "opaque pixel ({x}, {y}) is not covered");
+        }
+    }
+    // No triangle lies far from the opaque pixels: every centroid is within 2 px of one.
+    let opaque = |x: i64, y: i64| {
+        x >= 0 && y >= 0 && x < 200 && y < 160 && img.get_pixel(x as u32, y as u32).0[3] > 8
+    };
+    for k in 0..t.mesh.triangles.len() {
+        let [a, b, c] = t.mesh.triangle_positions(k);
+        let g = (a + b + c) / 3.0;
+        let near = (-3i64..=3).any(|dy| {
+            (-3i64..=3).any(|dx| {
+                let (px, py) = (g.x.floor() as i64 + dx, g.y.floor() as i64 + dy);
+                let centre = DVec2::new(px as f64 + 0.5, py as f64 + 0.5);
+                opaque(px, py) && centre.distance(g) <= 2.0 + 0.71
+            })
+        });
+        assert!(near, "triangle {k} centroid {g} is far from the shape");
+    }
+    // The hole is a hole, and the gap between the components stays empty.
+    assert!(!loc.contains(DVec2::new(80.0, 80.0)));
+    assert!(!loc.contains(DVec2::new(150.5, 60.5)));
+    assert!(!loc.contains(DVec2::new(5.0, 5.0)));
+    assert!(in_disc_with_hole_and_island(DVec2::new(170.0, 40.0)));
+    assert!(loc.contains(DVec2::new(170.0, 40.0)));
+}
+
+#[test]
+fn rings_are_oriented_and_disjoint() {
+    let img = disc_with_hole_and_island();
+    let domain = domain_from_image(&img, &DomainOptions::default()).unwrap();
+    let signed = |r: &[DVec2]| {
+        0.5 * (0..r.len())
+            .map(|i| r[i].perp_dot(r[(i + 1) % r.len()]))
+            .sum::<f64>()
+    };
+    for p in &domain.polygons {
+        assert!(signed(&p.outer) > 0.0);
+        for h in &p.holes {
+            assert!(signed(h) < 0.0);
+        }
+    }
+    // Every ring vertex lies in the image rectangle.
+    for r in domain.rings() {
+        for v in r {
+            assert!(v.x >= 0.0 && v.y >= 0.0 && v.x <= 200.0 && v.y <= 160.0);
+        }
+    }
+}
+
+#[test]
+fn small_islands_are_dropped_and_small_holes_filled() {
+    let img = support::image_from(100, 100, |p| {
+        let big = (p.x - 50.0).abs() < 30.0 && (p.y - 50.0).abs() < 30.0;
+        let pinhole = (p.x - 40.5).abs() < 1.0 && (p.y - 40.5).abs() < 1.0;
+        let speck = (p.x - 95.5).abs() < 1.0 && (p.y - 95.5).abs() < 1.0;
+        (big && !pinhole) || speck
+    });
+    let d = domain_from_image(&img, &DomainOptions::default()).unwrap();
+    assert_eq!(d.polygons.len(), 1);
+    assert!(d.polygons[0].holes.is_empty());
+    let keep_all = DomainOptions {
+        min_component_area: 0.0,
+        ..Default::default()
+    };
+    let d = domain_from_image(&img, &keep_all).unwrap();
+    assert_eq!(d.polygons.len(), 2);
+}
+
+#[test]
+fn soft_edges_are_inside() {
+    // Anti-aliased disc: every pixel with alpha above the threshold is covered.
+    let img = image::RgbaImage::from_fn(64, 64, |x, y| {
+        let d = DVec2::new(x as f64 + 0.5, y as f64 + 0.5).distance(DVec2::splat(32.0));
+        let a = ((20.0 - d + 0.5).clamp(0.0, 1.0) * 255.0) as u8;
+        image::Rgba([255, 255, 255, a])
+    });
+    let t = mesh_image(
+        &img,
+        &DomainOptions::default(),
+        &MeshOptions {
+            target_vertices: 1_000,
+            ..Default::default()
+        },
+        &Constraints::default(),
+    )
+    .unwrap();
+    t.mesh.sanity_check().unwrap();
+    let loc = Locator::new(&t.mesh);
+    for (x, y, p) in img.enumerate_pixels() {
+        if p.0[3] > 8 {
+            // Corners of the pixel too, not just the centre.
+            for (dx, dy) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0), (0.5, 0.5)] {
+                let q = DVec2::new(x as f64 + dx, y as f64 + dy);
+                assert!(loc.contains(q), "pixel ({x}, {y}) corner {q} uncovered");
+            }
+        }
+    }
+}
