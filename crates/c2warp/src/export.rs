@@ -36,7 +36,8 @@ pub fn build(source: &Source, project: &Project) -> Result<Built> {
         });
     }
     let path = source.mesh.as_deref().context("give --mesh or --image")?;
-    let file = std::fs::File::open(path).with_context(|| format!("cannot open mesh {}", path.display()))?;
+    let file = std::fs::File::open(path)
+        .with_context(|| format!("cannot open mesh {}", path.display()))?;
     let mut mesh = mesh::Mesh::read_obj(BufReader::new(file))
         .with_context(|| format!("mesh {}", path.display()))?;
     mesh.sanity_check()

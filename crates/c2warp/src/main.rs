@@ -18,7 +18,11 @@ pub const DEFAULT_IMAGE: &[u8] = include_bytes!("../../../assets/lizard.png");
 pub const DEFAULT_RIG: &str = include_str!("../../../assets/lizard-rig.json");
 
 #[derive(Parser)]
-#[command(name = "c2warp", version, about = "Handle-driven image warping with closed-form C² weights")]
+#[command(
+    name = "c2warp",
+    version,
+    about = "Handle-driven image warping with closed-form C² weights"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
@@ -72,16 +76,16 @@ enum Command {
 
 /// Where the samples come from.
 #[derive(Args)]
-#[group(required = true, multiple = false)]
+#[group(skip)]
 struct Source {
     /// A 2-D mesh as Wavefront OBJ (`v x y [z]`, `f a b c`); vertices used as given.
-    #[arg(long)]
+    #[arg(long, required_unless_present = "image", conflicts_with = "image")]
     mesh: Option<PathBuf>,
     /// An image to mesh (alpha outlines, or the full rectangle).
     #[arg(long)]
     image: Option<PathBuf>,
     /// Target number of mesh vertices when meshing an image.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "mesh")]
     density: Option<usize>,
 }
 
@@ -162,7 +166,9 @@ fn demo(output: &Path) -> Result<()> {
         stats.samples,
         stats.real_handles,
         stats.virtual_nodes,
-        std::path::absolute(output).unwrap_or_else(|_| output.to_path_buf()).display()
+        std::path::absolute(output)
+            .unwrap_or_else(|_| output.to_path_buf())
+            .display()
     );
     Ok(())
 }

@@ -4,7 +4,7 @@ use anyhow::{Context, Result, bail};
 use glam::{DVec2, Vec2};
 use image::RgbaImage;
 use mesh::{Constraints, DomainOptions, MeshOptions};
-use project::{HandleSpec, Middle, MetricChoice, Project};
+use project::{HandleSpec, MetricChoice, Middle, Project};
 use weights_core::{Basis, Domain, Handle, Metric, MiddleControls, Rig, RigOptions, Similarity};
 
 /// Target vertex count of the mesh when neither the project nor the command says.
@@ -118,7 +118,8 @@ pub fn prepare(image: &RgbaImage, project: &Project, density: Option<usize>) -> 
         },
     )
     .context("cannot mesh the image")?;
-    let virtual_vertices: Vec<u32> = mesh.point_vertices[points.len() - project.virtual_handles.len()..].to_vec();
+    let virtual_vertices: Vec<u32> =
+        mesh.point_vertices[points.len() - project.virtual_handles.len()..].to_vec();
     let domain = Domain::new(
         mesh.mesh.vertices.clone(),
         mesh.mesh.triangles.clone(),
@@ -137,7 +138,12 @@ pub fn warp(image: &RgbaImage, rig: &Rig) -> Result<RgbaImage> {
     if deformed.iter().any(|p| !p.is_finite()) {
         bail!("the deformation produced non-finite positions");
     }
-    let rest: Vec<Vec2> = rig.domain().positions().iter().map(|p| p.as_vec2()).collect();
+    let rest: Vec<Vec2> = rig
+        .domain()
+        .positions()
+        .iter()
+        .map(|p| p.as_vec2())
+        .collect();
     let deformed: Vec<Vec2> = deformed.iter().map(|p| p.as_vec2()).collect();
     let mesh = render::WarpMesh {
         rest: &rest,
@@ -145,5 +151,11 @@ pub fn warp(image: &RgbaImage, rig: &Rig) -> Result<RgbaImage> {
         triangles: rig.domain().triangles(),
     };
     let (w, h) = image.dimensions();
-    Ok(render::warp_cpu(image, &mesh, w, h, &render::RasterOptions::default())?)
+    Ok(render::warp_cpu(
+        image,
+        &mesh,
+        w,
+        h,
+        &render::RasterOptions::default(),
+    )?)
 }

@@ -18,7 +18,11 @@ fn cutout(size: u32) -> image::RgbaImage {
         let in_blob = d.length() < r;
         let in_hole = (d.x - 40.0).abs() < 60.0 && (d.y + 30.0).abs() < 60.0;
         let in_disc = (p - DVec2::new(c * 1.75, c * 1.75)).length() < c * 0.2;
-        let a = if (in_blob && !in_hole) || in_disc { 255 } else { 0 };
+        let a = if (in_blob && !in_hole) || in_disc {
+            255
+        } else {
+            0
+        };
         image::Rgba([128, 64, 32, a])
     })
 }
@@ -41,7 +45,10 @@ fn min_angle_deg(m: &mesh::Mesh) -> (f64, f64) {
 
 fn main() {
     let images = [
-        ("opaque", image::RgbaImage::from_pixel(1024, 1024, image::Rgba([1, 2, 3, 255]))),
+        (
+            "opaque",
+            image::RgbaImage::from_pixel(1024, 1024, image::Rgba([1, 2, 3, 255])),
+        ),
         ("cut-out", cutout(1024)),
     ];
     for (name, img) in &images {

@@ -453,7 +453,12 @@ mod tests {
         assert!(m[w + 2] && m[2 * w + 1]);
         for y in 0..h - 1 {
             for x in 0..w - 1 {
-                let (a, b, c, d) = (m[y * w + x], m[y * w + x + 1], m[(y + 1) * w + x], m[(y + 1) * w + x + 1]);
+                let (a, b, c, d) = (
+                    m[y * w + x],
+                    m[y * w + x + 1],
+                    m[(y + 1) * w + x],
+                    m[(y + 1) * w + x + 1],
+                );
                 assert!(!(a == d && b == c && a != b));
             }
         }

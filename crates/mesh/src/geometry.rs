@@ -28,6 +28,13 @@ pub(crate) fn ring_signed_area(ring: &[DVec2]) -> f64 {
     0.5 * twice
 }
 
+/// `a + (b - a) * t`: exact on axis-aligned segments (unlike `DVec2::lerp`), so points
+/// split off a straight image edge stay exactly on it.
+#[inline]
+pub(crate) fn lerp(a: DVec2, b: DVec2, t: f64) -> DVec2 {
+    a + (b - a) * t
+}
+
 /// Squared distance from `p` to the segment `a b`.
 #[inline]
 pub(crate) fn dist2_point_segment(p: DVec2, a: DVec2, b: DVec2) -> f64 {
@@ -101,7 +108,9 @@ impl SegmentGrid {
             ext.max_element()
         };
         let max_cells_per_axis = 2048.0;
-        cell = cell.max(ext.x / max_cells_per_axis).max(ext.y / max_cells_per_axis);
+        cell = cell
+            .max(ext.x / max_cells_per_axis)
+            .max(ext.y / max_cells_per_axis);
         let nx = ((ext.x / cell).floor() as usize + 1).max(1);
         let ny = ((ext.y / cell).floor() as usize + 1).max(1);
         let mut grid = SegmentGrid {
@@ -123,8 +132,8 @@ impl SegmentGrid {
         let pieces = ((len / self.cell).ceil() as usize).max(1);
         let mut last = usize::MAX;
         for k in 0..pieces {
-            let a = s[0].lerp(s[1], k as f64 / pieces as f64);
-            let b = s[0].lerp(s[1], (k + 1) as f64 / pieces as f64);
+            let a = lerp(s[0], s[1], k as f64 / pieces as f64);
+            let b = lerp(s[0], s[1], (k + 1) as f64 / pieces as f64);
             let (x0, y0) = self.cell_xy(a.min(b));
             let (x1, y1) = self.cell_xy(a.max(b));
             for cy in y0..=y1 {
@@ -325,6 +334,19 @@ impl RingBands {
             }
         }
         out.sort_by(f64::total_cmp);
+    }
+
+    /// Whether `p` lies within `tol` of a ring (`tol` at most the band height).
+    pub(crate) fn near_boundary(&self, p: DVec2, tol: f64) -> bool {
+        let t2 = tol * tol;
+        [p.y - tol, p.y, p.y + tol].iter().any(|&y| {
+            self.band(y).is_some_and(|items| {
+                items.iter().any(|&i| {
+                    let [a, b] = self.segs[i as usize];
+                    dist2_point_segment(p, a, b) <= t2
+                })
+            })
+        })
     }
 
     /// Even-odd test; points on a ring count as inside.

@@ -46,7 +46,9 @@ impl Mesh {
     /// # Panics
     /// Panics if a triangle index is out of range (see [`Mesh::sanity_check`]).
     pub fn area(&self) -> f64 {
-        (0..self.triangles.len()).map(|t| self.triangle_area(t)).sum()
+        (0..self.triangles.len())
+            .map(|t| self.triangle_area(t))
+            .sum()
     }
 
     /// The smallest axis-aligned box `(min, max)` holding every vertex; `(0, 0)` twice for
@@ -181,7 +183,13 @@ impl Mesh {
             }
         }
         // Check the new triangles before touching the mesh.
-        let pos_of = |i: u32| if i == new { p } else { self.vertices[i as usize] };
+        let pos_of = |i: u32| {
+            if i == new {
+                p
+            } else {
+                self.vertices[i as usize]
+            }
+        };
         let all_ok = replaced
             .iter()
             .map(|(_, tr)| tr)

@@ -107,7 +107,10 @@ impl Mesh {
             if let Some(&bad) = f.iter().find(|&&i| i >= n || i > u32::MAX as i64) {
                 return Err(MeshError::Obj {
                     line,
-                    message: format!("vertex index {} out of range (file has {n} vertices)", bad + 1),
+                    message: format!(
+                        "vertex index {} out of range (file has {n} vertices)",
+                        bad + 1
+                    ),
                 });
             }
             triangles.push(f.map(|i| i as u32));

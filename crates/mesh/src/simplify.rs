@@ -116,7 +116,8 @@ fn douglas_peucker(ring: &[P], tol: f64) -> Vec<bool> {
         .filter(|(_, k)| **k)
         .map(|(p, _)| to_f(*p))
         .collect();
-    let before = crate::geometry::ring_signed_area(&ring.iter().map(|&p| to_f(p)).collect::<Vec<_>>());
+    let before =
+        crate::geometry::ring_signed_area(&ring.iter().map(|&p| to_f(p)).collect::<Vec<_>>());
     let after = crate::geometry::ring_signed_area(&kept);
     if kept.len() < 3 || after == 0.0 || after.signum() != before.signum() {
         return vec![true; n];
@@ -131,7 +132,10 @@ fn orient_i(a: P, b: P, c: P) -> i128 {
 }
 
 fn on_segment(a: P, b: P, p: P) -> bool {
-    p[0] >= a[0].min(b[0]) && p[0] <= a[0].max(b[0]) && p[1] >= a[1].min(b[1]) && p[1] <= a[1].max(b[1])
+    p[0] >= a[0].min(b[0])
+        && p[0] <= a[0].max(b[0])
+        && p[1] >= a[1].min(b[1])
+        && p[1] <= a[1].max(b[1])
 }
 
 /// Whether closed segments `a b` and `c d` share any point (exact integer arithmetic).
@@ -209,7 +213,8 @@ fn find_conflicts(rings: &[Vec<P>], keep: &[Vec<bool>]) -> Vec<(usize, usize, us
 }
 
 fn dot(a: P, b: P, c: P, d: P) -> i128 {
-    i128::from(b[0] - a[0]) * i128::from(d[0] - c[0]) + i128::from(b[1] - a[1]) * i128::from(d[1] - c[1])
+    i128::from(b[0] - a[0]) * i128::from(d[0] - c[0])
+        + i128::from(b[1] - a[1]) * i128::from(d[1] - c[1])
 }
 
 #[cfg(test)]

@@ -11,7 +11,9 @@ use spade::{
     Triangulation,
 };
 
-use crate::geometry::{RingBands, SegmentGrid, dist2_point_segment, ring_signed_area, segment_hits};
+use crate::geometry::{
+    RingBands, SegmentGrid, dist2_point_segment, lerp, ring_signed_area, segment_hits,
+};
 use crate::{Domain, DomainOptions, Mesh, MeshError, domain_from_image};
 
 type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
@@ -159,7 +161,10 @@ pub fn triangulate(
                 )));
             }
             if ring_signed_area(ring) == 0.0 {
-                return Err(MeshError::InvalidDomain(format!("{} has zero area", name())));
+                return Err(MeshError::InvalidDomain(format!(
+                    "{} has zero area",
+                    name()
+                )));
             }
             for p in ring {
                 extent = extent.max(p.abs().max_element());
@@ -172,7 +177,9 @@ pub fn triangulate(
     }
 
     // --- Lattice spacing ----------------------------------------------------------
-    let target = (opts.target_vertices as f64).min(MAX_VERTICES_PER_PIXEL * area).max(1.0);
+    let target = (opts.target_vertices as f64)
+        .min(MAX_VERTICES_PER_PIXEL * area)
+        .max(1.0);
     let spacing = |n: f64| (2.0 * area / (3f64.sqrt() * n)).sqrt();
     let mut s = spacing(target);
     let min_angle = if opts.min_angle_deg.is_nan() {
@@ -229,7 +236,7 @@ pub fn triangulate(
             }
             ts.sort_by(f64::total_cmp);
             for t in ts.windows(2) {
-                if t[1] - t[0] > 1e-9 && !bands.contains(p.lerp(q, 0.5 * (t[0] + t[1]))) {
+                if t[1] - t[0] > 1e-9 && !bands.contains(lerp(p, q, 0.5 * (t[0] + t[1]))) {
                     return Err(MeshError::PolylineOutsideDomain {
                         polyline: k,
                         segment: i,
@@ -240,7 +247,7 @@ pub fn triangulate(
     }
 
     // --- Seed vertices, calibrating the spacing once -------------------------------
-    let mut seeds = Seeds::build(domain, constraints, &bands, s);
+    let mut seeds = Seeds::build(domain, constraints, &bands, s, extent);
     let n0 = seeds.vertices.len() as f64;
     if opts.target_vertices > 0 && (n0 / target - 1.0).abs() > 0.03 && seeds.lattice_count > 0 {
         // The boundary and constraints take vertices too; shrink or grow the lattice.
@@ -249,14 +256,22 @@ pub fn triangulate(
         let ratio = seeds.lattice_count as f64 / want_lattice;
         s *= ratio.sqrt().clamp(0.5, 2.0);
         let bands = RingBands::new(domain.rings(), (s * 0.866).max(extent * 1e-9));
-        seeds = Seeds::build(domain, constraints, &bands, s);
+        seeds = Seeds::build(domain, constraints, &bands, s, extent);
     }
 
     // --- Triangulate (spade), guarding against panics in the triangulator ---------
     let lattice_area = 3f64.sqrt() / 4.0 * s * s;
     let max_extra = (opts.target_vertices.max(1000)).max(seeds.vertices.len());
     let result = catch_unwind(AssertUnwindSafe(|| {
-        build_mesh(domain, &seeds, &ring_segs, extent, lattice_area, min_angle, max_extra)
+        build_mesh(
+            domain,
+            &seeds,
+            &ring_segs,
+            extent,
+            lattice_area,
+            min_angle,
+            max_extra,
+        )
     }));
     let built = match result {
         Ok(r) => r?,
@@ -271,7 +286,13 @@ pub fn triangulate(
     };
 
     // --- Map constraint vertices to mesh indices -----------------------------------
-    let map = |seed: u32| built.new_index.get(seed as usize).copied().unwrap_or(u32::MAX);
+    let map = |seed: u32| {
+        built
+            .new_index
+            .get(seed as usize)
+            .copied()
+            .unwrap_or(u32::MAX)
+    };
     let mut point_vertices = Vec::with_capacity(constraints.points.len());
     for (i, &seed) in seeds.point_ids.iter().enumerate() {
         let v = map(seed);
@@ -343,7 +364,13 @@ struct Seeds {
 }
 
 impl Seeds {
-    fn build(domain: &Domain, constraints: &Constraints, bands: &RingBands, s: f64) -> Seeds {
+    fn build(
+        domain: &Domain,
+        constraints: &Constraints,
+        bands: &RingBands,
+        s: f64,
+        extent: f64,
+    ) -> Seeds {
         let mut seeds = Seeds {
             vertices: Vec::new(),
             boundary_edges: Vec::new(),
@@ -365,22 +392,50 @@ impl Seeds {
         let mut clear: Vec<[DVec2; 2]> = Vec::new();
         let pieces = |len: f64| ((len / s).ceil().clamp(1.0, 1e7)) as usize;
 
+        // Constraint points on (or within a hair of) the boundary become ring vertices,
+        // so the boundary passes exactly through them.
+        let tol = 1e-9 * (1.0 + extent);
+        let on_boundary: Vec<DVec2> = constraints
+            .points
+            .iter()
+            .chain(constraints.polylines.iter().flatten())
+            .copied()
+            .filter(|&p| bands.near_boundary(p, tol))
+            .collect();
+        let mut splits: Vec<(f64, DVec2)> = Vec::new();
         for ring in domain.rings() {
             let n = ring.len();
-            let first = seeds.vertices.len();
             let mut ids: Vec<u32> = Vec::new();
             for i in 0..n {
                 let (a, b) = (ring[i], ring[(i + 1) % n]);
-                let m = pieces(a.distance(b));
+                let len2 = a.distance_squared(b);
+                if len2 == 0.0 {
+                    continue;
+                }
+                let m = pieces(len2.sqrt());
+                splits.clear();
+                for &p in &on_boundary {
+                    if p != a && p != b && dist2_point_segment(p, a, b) <= tol * tol {
+                        splits.push(((p - a).dot(b - a) / len2, p));
+                    }
+                }
+                // Regular split points, except those crowding a constraint point.
+                let step = 1.0 / m as f64;
                 for j in 0..m {
-                    let p = a.lerp(b, j as f64 / m as f64);
+                    let t = j as f64 * step;
+                    if j == 0 || splits.iter().all(|&(u, _)| (u - t).abs() > 0.3 * step) {
+                        splits.push((t, lerp(a, b, t)));
+                    }
+                }
+                splits.sort_by(|x, y| x.0.total_cmp(&y.0));
+                let mut prev = a;
+                for &(_, p) in splits.iter() {
                     ids.push(add(&mut seeds.vertices, p));
+                    clear.push([prev, p]);
+                    prev = p;
                 }
-                for j in 0..m {
-                    clear.push([a.lerp(b, j as f64 / m as f64), a.lerp(b, (j + 1) as f64 / m as f64)]);
-                }
+                clear.push([prev, b]);
             }
-            let _ = first;
             for i in 0..ids.len() {
                 let (a, b) = (ids[i], ids[(i + 1) % ids.len()]);
                 if a != b {
@@ -405,13 +460,16 @@ impl Seeds {
                     let id = if j == m {
                         ids[i + 1]
                     } else {
-                        add(&mut seeds.vertices, a.lerp(b, j as f64 / m as f64))
+                        add(&mut seeds.vertices, lerp(a, b, j as f64 / m as f64))
                     };
                     if id != prev {
                         seeds.polyline_edges.push([prev as usize, id as usize]);
                     }
                     prev = id;
-                    clear.push([a.lerp(b, (j - 1) as f64 / m as f64), a.lerp(b, j as f64 / m as f64)]);
+                    clear.push([
+                        lerp(a, b, (j - 1) as f64 / m as f64),
+                        lerp(a, b, j as f64 / m as f64),
+                    ]);
                 }
             }
             if line.len() == 1 {
@@ -482,12 +540,11 @@ fn build_mesh(
     max_extra: usize,
 ) -> Result<Built, MeshError> {
     let mut conflicts = Vec::new();
-    let mut cdt = Cdt::try_bulk_load_cdt(
-        seeds.vertices.clone(),
-        seeds.boundary_edges.clone(),
-        |e| conflicts.push(e),
-    )
-    .map_err(|e| MeshError::Triangulation(format!("{e:?}")))?;
+    let mut cdt =
+        Cdt::try_bulk_load_cdt(seeds.vertices.clone(), seeds.boundary_edges.clone(), |e| {
+            conflicts.push(e)
+        })
+        .map_err(|e| MeshError::Triangulation(format!("{e:?}")))?;
     if let Some([a, _]) = conflicts.first() {
         let p = seeds.vertices[*a];
         return Err(MeshError::InvalidDomain(format!(
@@ -496,7 +553,9 @@ fn build_mesh(
         )));
     }
     if cdt.num_vertices() != seeds.vertices.len() {
-        return Err(MeshError::Triangulation("vertices were merged unexpectedly".into()));
+        return Err(MeshError::Triangulation(
+            "vertices were merged unexpectedly".into(),
+        ));
     }
     for &[a, b] in &seeds.polyline_edges {
         cdt.add_constraint_and_split(
@@ -507,7 +566,8 @@ fn build_mesh(
     }
 
     // Outer faces exist unless the domain is one convex polygon without holes.
-    let convex = matches!(domain.polygons.as_slice(), [p] if p.holes.is_empty() && is_convex(&p.outer));
+    let convex =
+        matches!(domain.polygons.as_slice(), [p] if p.holes.is_empty() && is_convex(&p.outer));
     let mut params = RefinementParameters::<f64>::new()
         .exclude_outer_faces(!convex)
         .with_angle_limit(AngleLimit::from_deg(min_angle))
@@ -563,7 +623,11 @@ fn build_mesh(
                 continue;
             }
             let crossing = e.is_constraint_edge() && is_boundary(pos(e.from()), pos(e.to()));
-            state[gi] = if crossing { if st == IN { OUT } else { IN } } else { st };
+            state[gi] = if crossing {
+                if st == IN { OUT } else { IN }
+            } else {
+                st
+            };
             stack.push(g.fix());
         }
     }

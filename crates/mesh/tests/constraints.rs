@@ -29,7 +29,11 @@ fn points_and_polylines_are_exact_vertices_and_edges() {
         DVec2::new(150.0, 100.0),   // also on a polyline
     ];
     let polylines = vec![
-        vec![DVec2::new(100.0, 100.0), DVec2::new(200.0, 100.0), DVec2::new(250.3, 180.7)],
+        vec![
+            DVec2::new(100.0, 100.0),
+            DVec2::new(200.0, 100.0),
+            DVec2::new(250.3, 180.7),
+        ],
         // Crosses the first polyline.
         vec![DVec2::new(170.0, 40.0), DVec2::new(170.0, 160.0)],
         // Along the top edge of the image.
@@ -37,7 +41,11 @@ fn points_and_polylines_are_exact_vertices_and_edges() {
         vec![DVec2::new(50.0, 250.0)],
         vec![],
         // Repeated point.
-        vec![DVec2::new(60.0, 60.0), DVec2::new(60.0, 60.0), DVec2::new(80.0, 61.0)],
+        vec![
+            DVec2::new(60.0, 60.0),
+            DVec2::new(60.0, 60.0),
+            DVec2::new(80.0, 61.0),
+        ],
     ];
     let c = Constraints {
         points: &points,
@@ -71,7 +79,10 @@ fn points_and_polylines_are_exact_vertices_and_edges() {
         assert_eq!(path.first(), t.polyline_vertices[k].first());
         assert_eq!(path.last(), t.polyline_vertices[k].last());
         for w in path.windows(2) {
-            assert!(e.contains(&(w[0].min(w[1]), w[0].max(w[1]))), "polyline {k}: {w:?} is no edge");
+            assert!(
+                e.contains(&(w[0].min(w[1]), w[0].max(w[1]))),
+                "polyline {k}: {w:?} is no edge"
+            );
         }
         let mut at = 0;
         for &v in &t.polyline_vertices[k] {
@@ -93,8 +104,18 @@ fn points_and_polylines_are_exact_vertices_and_edges() {
                     };
                     (a + ab * s).distance(p)
                 })
-                .fold(if line.len() == 1 { line[0].distance(p) } else { f64::INFINITY }, f64::min);
-            assert!(d < 1e-9, "polyline {k} path vertex {p} is {d} px off the line");
+                .fold(
+                    if line.len() == 1 {
+                        line[0].distance(p)
+                    } else {
+                        f64::INFINITY
+                    },
+                    f64::min,
+                );
+            assert!(
+                d < 1e-9,
+                "polyline {k} path vertex {p} is {d} px off the line"
+            );
         }
     }
     // The two crossing polylines share a vertex at (170, 100).
@@ -131,7 +152,10 @@ fn constraints_in_a_cut_out() {
     };
     assert!(matches!(
         triangulate(&domain, &c, &opts(4_000)),
-        Err(MeshError::PolylineOutsideDomain { polyline: 0, segment: 0 })
+        Err(MeshError::PolylineOutsideDomain {
+            polyline: 0,
+            segment: 0
+        })
     ));
     // A point in the hole is outside.
     let c = Constraints {
@@ -165,7 +189,11 @@ fn bad_constraints_are_errors() {
     ));
     assert!(matches!(
         check(&[], &[vec![DVec2::new(1.0, 1.0), DVec2::new(-1.0, 1.0)]]),
-        MeshError::PolylinePointOutsideDomain { polyline: 0, index: 1, .. }
+        MeshError::PolylinePointOutsideDomain {
+            polyline: 0,
+            index: 1,
+            ..
+        }
     ));
     assert!(matches!(
         check(&[], &[vec![], vec![DVec2::new(1.0, f64::NAN)]]),
@@ -187,7 +215,11 @@ fn hand_made_domains() {
             DVec2::new(20.0, 60.0),
             DVec2::new(0.0, 60.0),
         ],
-        holes: vec![vec![DVec2::new(5.0, 5.0), DVec2::new(12.0, 5.0), DVec2::new(5.0, 12.0)]],
+        holes: vec![vec![
+            DVec2::new(5.0, 5.0),
+            DVec2::new(12.0, 5.0),
+            DVec2::new(5.0, 12.0),
+        ]],
     };
     let domain = Domain {
         polygons: vec![l_shape],
@@ -196,7 +228,11 @@ fn hand_made_domains() {
         height: 60,
     };
     // A bar along the inner corner's edges is fine; one cutting the notch is not.
-    let inside = vec![DVec2::new(30.0, 20.0), DVec2::new(20.0, 20.0), DVec2::new(20.0, 40.0)];
+    let inside = vec![
+        DVec2::new(30.0, 20.0),
+        DVec2::new(20.0, 20.0),
+        DVec2::new(20.0, 40.0),
+    ];
     let t = triangulate(
         &domain,
         &Constraints {
@@ -226,11 +262,21 @@ fn hand_made_domains() {
     let bowtie = Domain {
         polygons: vec![
             Polygon {
-                outer: vec![DVec2::new(0.0, 0.0), DVec2::new(10.0, 0.0), DVec2::new(10.0, 10.0), DVec2::new(0.0, 10.0)],
+                outer: vec![
+                    DVec2::new(0.0, 0.0),
+                    DVec2::new(10.0, 0.0),
+                    DVec2::new(10.0, 10.0),
+                    DVec2::new(0.0, 10.0),
+                ],
                 holes: vec![],
             },
             Polygon {
-                outer: vec![DVec2::new(5.0, 5.0), DVec2::new(15.0, 5.0), DVec2::new(15.0, 15.0), DVec2::new(5.0, 15.0)],
+                outer: vec![
+                    DVec2::new(5.0, 5.0),
+                    DVec2::new(15.0, 5.0),
+                    DVec2::new(15.0, 15.0),
+                    DVec2::new(5.0, 15.0),
+                ],
                 holes: vec![],
             },
         ],
@@ -263,7 +309,9 @@ fn hand_made_domains() {
 #[test]
 fn insert_point_splits_and_preserves_area() {
     let domain = Domain::full_rectangle(50, 40);
-    let mut m = triangulate(&domain, &Constraints::default(), &opts(200)).unwrap().mesh;
+    let mut m = triangulate(&domain, &Constraints::default(), &opts(200))
+        .unwrap()
+        .mesh;
     let area = m.area();
     let n = m.vertices.len();
     // Inside a triangle, on an interior edge, on the boundary, on a vertex.
@@ -283,7 +331,10 @@ fn insert_point_splits_and_preserves_area() {
     let u = m.insert_point(on_boundary).unwrap();
     assert_eq!(m.vertices[u as usize], on_boundary);
     assert_eq!(m.insert_point(DVec2::new(50.0, 40.0)).unwrap() as usize, {
-        m.vertices.iter().position(|&p| p == DVec2::new(50.0, 40.0)).unwrap()
+        m.vertices
+            .iter()
+            .position(|&p| p == DVec2::new(50.0, 40.0))
+            .unwrap()
     });
     m.sanity_check().unwrap();
     assert!((m.area() - area).abs() < 1e-9 * area);
@@ -296,8 +347,13 @@ fn insert_point_splits_and_preserves_area() {
 #[test]
 fn locate_agrees_with_the_mesh() {
     let img = disc_with_hole_and_island();
-    let t = mesh::mesh_image(&img, &DomainOptions::default(), &opts(1_500), &Constraints::default())
-        .unwrap();
+    let t = mesh::mesh_image(
+        &img,
+        &DomainOptions::default(),
+        &opts(1_500),
+        &Constraints::default(),
+    )
+    .unwrap();
     let loc = Locator::new(&t.mesh);
     for k in 0..200 {
         let p = DVec2::new((k * 37 % 200) as f64 + 0.3, (k * 53 % 160) as f64 + 0.7);

@@ -93,7 +93,10 @@ fn malformed_lines_report_their_number() {
     assert_eq!(obj_line("v 0 0\nv 1 0\nv 0 1\nf 1 2 -4\n"), 4);
     assert_eq!(obj_line("v 0 0\nv 1 0\nv 0 1\nf 1 2 2\n"), 4);
     assert_eq!(obj_line("v 0 0\nv 1 0\nv 0 1\nf 1 2 3\nf 1 2 a\n"), 5);
-    assert_eq!(obj_line("v 0 0\nv 1 0\nv 0 1\n# x\nf 1 2 -1/2\nf 1 2 9\n"), 6);
+    assert_eq!(
+        obj_line("v 0 0\nv 1 0\nv 0 1\n# x\nf 1 2 -1/2\nf 1 2 9\n"),
+        6
+    );
     let err = read("v 0 0\nv 1 0\nv 0 1\nf 1 2 7\n").unwrap_err();
     assert!(err.to_string().contains("line 4"), "{err}");
 }

@@ -14,14 +14,27 @@ fn opts(target: usize) -> MeshOptions {
 
 #[test]
 fn opaque_rectangle_covers_the_image_exactly() {
-    for (w, h, target) in [(320u32, 200u32, 5_000usize), (97, 331, 2_000), (640, 480, 20_000)] {
+    for (w, h, target) in [
+        (320u32, 200u32, 5_000usize),
+        (97, 331, 2_000),
+        (640, 480, 20_000),
+    ] {
         let img = image::RgbaImage::from_pixel(w, h, image::Rgba([10, 20, 30, 255]));
-        let t = mesh_image(&img, &DomainOptions::default(), &opts(target), &Constraints::default())
-            .unwrap();
+        let t = mesh_image(
+            &img,
+            &DomainOptions::default(),
+            &opts(target),
+            &Constraints::default(),
+        )
+        .unwrap();
         assert!(t.is_convex);
         t.mesh.sanity_check().unwrap();
         let area = (w * h) as f64;
-        assert!((t.mesh.area() - area).abs() <= 1e-6 * area, "area {}", t.mesh.area());
+        assert!(
+            (t.mesh.area() - area).abs() <= 1e-6 * area,
+            "area {}",
+            t.mesh.area()
+        );
         for c in [
             DVec2::new(0.0, 0.0),
             DVec2::new(w as f64, 0.0),
@@ -33,7 +46,10 @@ fn opaque_rectangle_covers_the_image_exactly() {
         let (lo, hi) = t.mesh.bounding_box();
         assert_eq!((lo, hi), (DVec2::ZERO, DVec2::new(w as f64, h as f64)));
         let n = t.mesh.vertices.len() as f64;
-        assert!((n / target as f64 - 1.0).abs() < 0.3, "{n} vertices for target {target}");
+        assert!(
+            (n / target as f64 - 1.0).abs() < 0.3,
+            "{n} vertices for target {target}"
+        );
     }
 }
 
@@ -55,8 +71,13 @@ fn opaque_domain_is_the_full_rectangle() {
 #[test]
 fn minimum_angle_is_respected_in_the_interior() {
     let img = image::RgbaImage::from_pixel(300, 300, image::Rgba([1, 1, 1, 255]));
-    let t = mesh_image(&img, &DomainOptions::default(), &opts(10_000), &Constraints::default())
-        .unwrap();
+    let t = mesh_image(
+        &img,
+        &DomainOptions::default(),
+        &opts(10_000),
+        &Constraints::default(),
+    )
+    .unwrap();
     let mut worst = 180.0f64;
     for k in 0..t.mesh.triangles.len() {
         let [a, b, c] = t.mesh.triangle_positions(k);
@@ -73,11 +94,20 @@ fn degenerate_images() {
     let m = MeshOptions::default();
     let c = Constraints::default();
     let empty = image::RgbaImage::new(0, 0);
-    assert!(matches!(mesh_image(&empty, &o, &m, &c), Err(MeshError::EmptyDomain)));
+    assert!(matches!(
+        mesh_image(&empty, &o, &m, &c),
+        Err(MeshError::EmptyDomain)
+    ));
     let wide_empty = image::RgbaImage::new(10, 0);
-    assert!(matches!(mesh_image(&wide_empty, &o, &m, &c), Err(MeshError::EmptyDomain)));
+    assert!(matches!(
+        mesh_image(&wide_empty, &o, &m, &c),
+        Err(MeshError::EmptyDomain)
+    ));
     let clear = image::RgbaImage::new(30, 20);
-    assert!(matches!(mesh_image(&clear, &o, &m, &c), Err(MeshError::EmptyDomain)));
+    assert!(matches!(
+        mesh_image(&clear, &o, &m, &c),
+        Err(MeshError::EmptyDomain)
+    ));
 
     let one = image::RgbaImage::from_pixel(1, 1, image::Rgba([1, 2, 3, 255]));
     let t = mesh_image(&one, &o, &m, &c).unwrap();
@@ -94,18 +124,35 @@ fn degenerate_images() {
     // An opaque pixel in a corner, and a one-pixel-wide line.
     let mut corner = image::RgbaImage::new(4, 4);
     corner.put_pixel(0, 0, image::Rgba([0, 0, 0, 255]));
-    mesh_image(&corner, &o, &m, &c).unwrap().mesh.sanity_check().unwrap();
+    mesh_image(&corner, &o, &m, &c)
+        .unwrap()
+        .mesh
+        .sanity_check()
+        .unwrap();
     let line = image::RgbaImage::from_pixel(50, 1, image::Rgba([0, 0, 0, 255]));
-    mesh_image(&line, &o, &m, &c).unwrap().mesh.sanity_check().unwrap();
-    let column = image::RgbaImage::from_fn(1, 40, |_, y| image::Rgba([0, 0, 0, (y % 3 * 120) as u8]));
-    mesh_image(&column, &o, &m, &c).unwrap().mesh.sanity_check().unwrap();
+    mesh_image(&line, &o, &m, &c)
+        .unwrap()
+        .mesh
+        .sanity_check()
+        .unwrap();
+    let column =
+        image::RgbaImage::from_fn(1, 40, |_, y| image::Rgba([0, 0, 0, (y % 3 * 120) as u8]));
+    mesh_image(&column, &o, &m, &c)
+        .unwrap()
+        .mesh
+        .sanity_check()
+        .unwrap();
 
     // Silly options still give an answer.
     let weird = MeshOptions {
         target_vertices: 0,
         min_angle_deg: f64::NAN,
     };
-    mesh_image(&one, &o, &weird, &c).unwrap().mesh.sanity_check().unwrap();
+    mesh_image(&one, &o, &weird, &c)
+        .unwrap()
+        .mesh
+        .sanity_check()
+        .unwrap();
     let weird = MeshOptions {
         target_vertices: usize::MAX,
         min_angle_deg: 89.0,
@@ -117,7 +164,11 @@ fn degenerate_images() {
         simplify_tolerance: f64::NAN,
         min_component_area: f64::INFINITY,
     };
-    mesh_image(&dot, &weird_domain, &m, &c).unwrap().mesh.sanity_check().unwrap();
+    mesh_image(&dot, &weird_domain, &m, &c)
+        .unwrap()
+        .mesh
+        .sanity_check()
+        .unwrap();
 }
 
 #[test]

@@ -188,15 +188,22 @@ impl Project {
             return bad(format!("alpha must be in [0, 1], got {}", self.alpha));
         }
         if !(5..=25).contains(&self.degree) {
-            return bad(format!("degree must be between 5 and 25, got {}", self.degree));
+            return bad(format!(
+                "degree must be between 5 and 25, got {}",
+                self.degree
+            ));
         }
         if let Some(d) = self.density
             && !(16..=4_000_000).contains(&d)
         {
-            return bad(format!("density must be between 16 and 4000000 vertices, got {d}"));
+            return bad(format!(
+                "density must be between 16 and 4000000 vertices, got {d}"
+            ));
         }
         let inside = |p: [f64; 2]| match image_size {
-            Some((w, h)) => p[0] >= 0.0 && p[1] >= 0.0 && p[0] <= f64::from(w) && p[1] <= f64::from(h),
+            Some((w, h)) => {
+                p[0] >= 0.0 && p[1] >= 0.0 && p[0] <= f64::from(w) && p[1] <= f64::from(h)
+            }
             None => true,
         };
         for (i, h) in self.handles.iter().enumerate() {
@@ -210,7 +217,10 @@ impl Project {
                     if *scale <= 0.0 {
                         return bad(format!("handle {i}: scale must be positive, got {scale}"));
                     }
-                    (vec![*rest], vec![translate[0], translate[1], *rotate, *scale])
+                    (
+                        vec![*rest],
+                        vec![translate[0], translate[1], *rotate, *scale],
+                    )
                 }
                 HandleSpec::Bar { rest, pose } => {
                     if rest[0] == rest[1] {
@@ -220,7 +230,12 @@ impl Project {
                     (rest.to_vec(), pose.iter().flatten().copied().collect())
                 }
             };
-            if points.iter().flatten().chain(&numbers).any(|x| !x.is_finite()) {
+            if points
+                .iter()
+                .flatten()
+                .chain(&numbers)
+                .any(|x| !x.is_finite())
+            {
                 return bad(format!("handle {i}: coordinates must be finite numbers"));
             }
             if let Some(p) = points.iter().find(|p| !inside(**p)) {
@@ -230,7 +245,11 @@ impl Project {
                 ));
             }
         }
-        if let Some(p) = self.virtual_handles.iter().find(|p| !p[0].is_finite() || !p[1].is_finite()) {
+        if let Some(p) = self
+            .virtual_handles
+            .iter()
+            .find(|p| !p[0].is_finite() || !p[1].is_finite())
+        {
             return bad(format!("virtual handle ({}, {}) is not finite", p[0], p[1]));
         }
         Ok(())
@@ -300,13 +319,28 @@ mod tests {
             ("{", "malformed"),
             (r#"{"version":2,"handles":[]}"#, "version 2"),
             (r#"{"handles":[]}"#, "version"),
-            (r#"{"version":1,"handles":[{"type":"point","rest":[NaN,1]}]}"#, "malformed"),
-            (r#"{"version":1,"handles":[{"type":"point","rest":[1e999,1]}]}"#, ""),
-            (r#"{"version":1,"handles":[{"type":"blob","rest":[1,1]}]}"#, "malformed"),
+            (
+                r#"{"version":1,"handles":[{"type":"point","rest":[NaN,1]}]}"#,
+                "malformed",
+            ),
+            (
+                r#"{"version":1,"handles":[{"type":"point","rest":[1e999,1]}]}"#,
+                "",
+            ),
+            (
+                r#"{"version":1,"handles":[{"type":"blob","rest":[1,1]}]}"#,
+                "malformed",
+            ),
             (r#"{"version":1,"alpha":2,"handles":[]}"#, "alpha"),
             (r#"{"version":1,"degree":3,"handles":[]}"#, "degree"),
-            (r#"{"version":1,"handles":[{"type":"bar","rest":[[1,1],[1,1]]}]}"#, "zero length"),
-            (r#"{"version":1,"handles":[{"type":"point","rest":[1,1],"scale":0}]}"#, "scale"),
+            (
+                r#"{"version":1,"handles":[{"type":"bar","rest":[[1,1],[1,1]]}]}"#,
+                "zero length",
+            ),
+            (
+                r#"{"version":1,"handles":[{"type":"point","rest":[1,1],"scale":0}]}"#,
+                "scale",
+            ),
             (r#"{"version":1,"handels":[]}"#, "malformed"),
         ];
         for (text, expected) in cases {
@@ -319,7 +353,9 @@ mod tests {
     fn handles_must_lie_on_the_image() {
         let p = sample();
         assert!(p.validate(Some((100, 100))).is_ok());
-        let err = p.validate(Some((20, 20))).expect_err("bar end off the image");
+        let err = p
+            .validate(Some((20, 20)))
+            .expect_err("bar end off the image");
         assert!(err.to_string().contains("outside the image"), "{err}");
     }
 }

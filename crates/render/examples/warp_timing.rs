@@ -50,12 +50,17 @@ fn swirl_mesh(size: f32, cells: u32) -> (Vec<Vec2>, Vec<Vec2>, Vec<[u32; 3]>) {
 }
 
 fn main() {
-    let runs: usize = std::env::args()
-        .nth(1)
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(5);
+    let args: Vec<u32> = std::env::args()
+        .skip(1)
+        .filter_map(|s| s.parse().ok())
+        .collect();
+    let runs = args.first().copied().unwrap_or(5) as usize;
+    let sizes = match args.get(1..) {
+        Some(sizes) if !sizes.is_empty() => sizes.to_vec(),
+        _ => vec![1024, 4096],
+    };
     println!("rayon threads: {}", rayon::current_num_threads());
-    for size in [1024u32, 4096] {
+    for size in sizes {
         let tex = texture(size);
         let (rest, deformed, triangles) = swirl_mesh(size as f32, 317);
         for (label, positions) in [("swirl", &deformed), ("identity", &rest)] {

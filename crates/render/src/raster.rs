@@ -27,14 +27,19 @@ const HALF: i64 = ONE / 2;
 /// that every edge-function product fits in an `i64` (|value| < 2^60).
 pub(crate) const COORD_LIMIT: f64 = (1u64 << 20) as f64;
 /// Height of one unit of parallel work, in output rows.
-const BAND_ROWS: u32 = 16;
+const BAND_ROWS: u32 = 32;
 
-/// One edge function `E(X, Y) = a·X + b·Y + c` in fixed point, positive inside.
+/// One edge function `E(X, Y) = a·X + b·Y + c` in fixed point, positive inside,
+/// arranged for scanning pixel centres row by row.
 #[derive(Clone, Copy, Debug)]
 struct Edge {
-    a: i64,
+    /// `E` grows by `step` from one pixel centre to the next on a row (`a·ONE`).
+    step: i64,
+    /// `1 / step`, to estimate span ends without an integer division.
+    inv_step: f64,
+    /// `E` at column 0 of a row is `base + b·Y` (`base = a·HALF + c`).
+    base: i64,
     b: i64,
-    c: i64,
     /// A pixel centre is inside this edge when `E >= min` (0 on a top or left
     /// edge, which owns the centres lying exactly on it; 1 otherwise).
     min: i64,
@@ -49,27 +54,53 @@ impl Edge {
         // the interior lies to the right of p→q as seen on screen: a left edge
         // runs upwards (dy < 0) and a top edge runs rightwards (dy = 0, dx > 0).
         let top_left = dy < 0 || (dy == 0 && dx > 0);
+        let (a, b, c) = (-dy, dx, dy * p[0] - dx * p[1]);
+        let step = a * ONE;
         Self {
-            a: -dy,
-            b: dx,
-            c: dy * p[0] - dx * p[1],
+            step,
+            inv_step: if step == 0 { 0.0 } else { 1.0 / step as f64 },
+            base: a * HALF + c,
+            b,
             min: if top_left { 0 } else { 1 },
         }
     }
 
-    /// Pixel columns `x` (unbounded) whose centre on row centre `y_fixed` is
-    /// inside this edge, as an inclusive range `lo..=hi` in `i64`.
+    /// Narrows the columns `lo..=hi` of the row with centre `y_fixed` to those
+    /// whose centres are inside this edge (empty when `lo > hi`).
+    ///
+    /// The span end is estimated in floating point and then settled exactly
+    /// with integer tests, so the result is exact and division-free.
     #[inline]
-    fn columns(&self, y_fixed: i64) -> (i64, i64) {
-        // E(x) = step·x + e0 at X = x·ONE + HALF.
-        let step = self.a * ONE;
-        let e0 = self.a * HALF + self.b * y_fixed + self.c;
-        let need = self.min - e0; // step·x >= need
-        match step.signum() {
-            1 => (div_ceil(need, step), i64::MAX),
-            -1 => (i64::MIN, div_floor(-need, -step)),
-            _ if need <= 0 => (i64::MIN, i64::MAX),
-            _ => (1, 0),
+    fn clip(&self, y_fixed: i64, lo: i64, hi: i64) -> (i64, i64) {
+        // Inside ⇔ step·x >= need.
+        let need = self.min - (self.base + self.b * y_fixed);
+        let inside = |x: i64| self.step * x >= need;
+        // `as` saturates, and the clamp bounds every product below.
+        let estimate = (need as f64 * self.inv_step) as i64;
+        if self.step > 0 {
+            // The first inside column in lo..=hi+1.
+            let mut x = estimate.clamp(lo, hi + 1);
+            while x > lo && inside(x - 1) {
+                x -= 1;
+            }
+            while x <= hi && !inside(x) {
+                x += 1;
+            }
+            (x, hi)
+        } else if self.step < 0 {
+            // The last inside column in lo-1..=hi.
+            let mut x = estimate.clamp(lo - 1, hi);
+            while x < hi && inside(x + 1) {
+                x += 1;
+            }
+            while x >= lo && !inside(x) {
+                x -= 1;
+            }
+            (lo, x)
+        } else if need <= 0 {
+            (lo, hi)
+        } else {
+            (lo, lo - 1)
         }
     }
 }
@@ -126,8 +157,9 @@ impl AffineMap {
         let f1 = [rest[1][0] - rest[0][0], rest[1][1] - rest[0][1]];
         let f2 = [rest[2][0] - rest[0][0], rest[2][1] - rest[0][1]];
         // Barycentric derivatives: s along e1, t along e2.
-        let (ds_dx, ds_dy) = (e2[1] / det, -e2[0] / det);
-        let (dt_dx, dt_dy) = (-e1[1] / det, e1[0] / det);
+        let inv = 1.0 / det;
+        let (ds_dx, ds_dy) = (e2[1] * inv, -e2[0] * inv);
+        let (dt_dx, dt_dy) = (-e1[1] * inv, e1[0] * inv);
         let du = [f1[0] * ds_dx + f2[0] * dt_dx, f1[1] * ds_dx + f2[1] * dt_dx];
         let dv = [f1[0] * ds_dy + f2[0] * dt_dy, f1[1] * ds_dy + f2[1] * dt_dy];
         let map = Self {
@@ -161,10 +193,12 @@ impl AffineMap {
     }
 }
 
+/// A position in fixed point, clamped to `±COORD_LIMIT` pixels and rounded
+/// to nearest (half away from zero, without a libm call).
 fn snap(p: Vec2) -> [i64; 2] {
     let s = |v: f32| {
-        let v = f64::from(v).clamp(-COORD_LIMIT, COORD_LIMIT);
-        (v * ONE as f64).round() as i64
+        let scaled = f64::from(v).clamp(-COORD_LIMIT, COORD_LIMIT) * ONE as f64;
+        (scaled + 0.5f64.copysign(scaled)) as i64
     };
     [s(p.x), s(p.y)]
 }
@@ -182,12 +216,18 @@ fn pixel_range(lo: i64, hi: i64, size: u32) -> Option<(u32, u32)> {
 }
 
 impl TriangleSetup {
-    /// Prepares triangle `tri` of a validated mesh, or returns `None` when it
-    /// has zero area after snapping or misses the `width × height` output.
-    fn new(mesh: &WarpMesh, tri: [u32; 3], width: u32, height: u32) -> Option<Self> {
-        let [i0, i1, i2] = tri.map(|i| i as usize);
-        let mut ids = [i0, i1, i2];
-        let mut v = ids.map(|i| snap(mesh.deformed[i]));
+    /// Prepares triangle `tri` of a validated mesh whose deformed positions
+    /// snap to `snapped`, or returns `None` when it has zero area after
+    /// snapping or misses the `width × height` output.
+    fn new(
+        mesh: &WarpMesh,
+        snapped: &[[i64; 2]],
+        tri: [u32; 3],
+        width: u32,
+        height: u32,
+    ) -> Option<Self> {
+        let mut ids = tri.map(|i| i as usize);
+        let mut v = [snapped[ids[0]], snapped[ids[1]], snapped[ids[2]]];
         let cross =
             (v[1][0] - v[0][0]) * (v[2][1] - v[0][1]) - (v[1][1] - v[0][1]) * (v[2][0] - v[0][0]);
         if cross == 0 {
@@ -235,50 +275,71 @@ impl TriangleSetup {
         let mut lo = i64::from(self.x_min);
         let mut hi = i64::from(self.x_max);
         for edge in &self.edges {
-            let (l, h) = edge.columns(y_fixed);
-            lo = lo.max(l);
-            hi = hi.min(h);
+            (lo, hi) = edge.clip(y_fixed, lo, hi);
+            if lo > hi {
+                return 0..0;
+            }
         }
-        if lo > hi {
-            0..0
-        } else {
-            // lo and hi lie within x_min..=x_max, so both fit in u32.
-            lo as u32..hi as u32 + 1
-        }
+        // lo and hi lie within x_min..=x_max, so both fit in u32.
+        lo as u32..hi as u32 + 1
     }
 }
 
+/// Rows whose centres a triangle with snapped vertices `v` may cover,
+/// inclusive and clipped to `0..height`, or `None`.
+fn row_range(v: [[i64; 2]; 3], height: u32) -> Option<(u32, u32)> {
+    let min_y = v[0][1].min(v[1][1]).min(v[2][1]);
+    let max_y = v[0][1].max(v[1][1]).max(v[2][1]);
+    pixel_range(min_y, max_y, height)
+}
+
 /// A mesh prepared for scanning into a `width × height` output.
-pub(crate) struct Raster {
-    setups: Vec<TriangleSetup>,
+///
+/// Triangles are set up lazily, in the band that draws them (a triangle
+/// spanning several bands is set up once per band), which keeps memory small
+/// and the setup work parallel.
+pub(crate) struct Raster<'a> {
+    mesh: WarpMesh<'a>,
+    /// Deformed positions in fixed point.
+    snapped: Vec<[i64; 2]>,
     width: u32,
     height: u32,
 }
 
-impl Raster {
-    /// Sets up every drawable triangle of a **validated** mesh, in list order.
-    pub(crate) fn new(mesh: &WarpMesh, width: u32, height: u32) -> Self {
-        let setups = mesh
-            .triangles
-            .par_iter()
-            .with_min_len(1024)
-            .filter_map(|&tri| TriangleSetup::new(mesh, tri, width, height))
-            .collect();
+impl<'a> Raster<'a> {
+    /// Prepares a **validated** mesh.
+    pub(crate) fn new(mesh: &WarpMesh<'a>, width: u32, height: u32) -> Self {
+        let snapped = mesh.deformed.par_iter().map(|&p| snap(p)).collect();
         Self {
-            setups,
+            mesh: *mesh,
+            snapped,
             width,
             height,
         }
+    }
+
+    fn vertices(&self, tri: [u32; 3]) -> [[i64; 2]; 3] {
+        tri.map(|i| self.snapped[i as usize])
     }
 
     /// Triangle indices per band (compressed: band `b` owns
     /// `items[offsets[b]..offsets[b + 1]]`), each band in list order.
     fn bins(&self) -> (Vec<usize>, Vec<u32>) {
         let bands = self.height.div_ceil(BAND_ROWS) as usize;
+        let rows: Vec<Option<(u32, u32)>> = self
+            .mesh
+            .triangles
+            .par_iter()
+            .with_min_len(4096)
+            .map(|&tri| row_range(self.vertices(tri), self.height))
+            .collect();
+        let band_range = |&(y_min, y_max): &(u32, u32)| {
+            (y_min / BAND_ROWS) as usize..=(y_max / BAND_ROWS) as usize
+        };
         let mut offsets = vec![0usize; bands + 1];
-        for s in &self.setups {
-            for band in (s.y_min / BAND_ROWS)..=(s.y_max / BAND_ROWS) {
-                offsets[band as usize + 1] += 1;
+        for range in rows.iter().flatten() {
+            for band in band_range(range) {
+                offsets[band + 1] += 1;
             }
         }
         for b in 0..bands {
@@ -286,11 +347,12 @@ impl Raster {
         }
         let mut cursor = offsets.clone();
         let mut items = vec![0u32; offsets[bands]];
-        for (index, s) in self.setups.iter().enumerate() {
-            for band in (s.y_min / BAND_ROWS)..=(s.y_max / BAND_ROWS) {
-                let slot = &mut cursor[band as usize];
-                items[*slot] = index as u32;
-                *slot += 1;
+        for (index, range) in rows.iter().enumerate() {
+            if let Some(range) = range {
+                for band in band_range(range) {
+                    items[cursor[band]] = index as u32;
+                    cursor[band] += 1;
+                }
             }
         }
         (offsets, items)
@@ -322,7 +384,13 @@ impl Raster {
                 let rows_here = (chunk.len() / row_len) as u32;
                 let band_y1 = band_y0 + rows_here; // exclusive
                 for &index in &items[offsets[band]..offsets[band + 1]] {
-                    let setup = &self.setups[index as usize];
+                    let tri = self.mesh.triangles[index as usize];
+                    let Some(setup) =
+                        TriangleSetup::new(&self.mesh, &self.snapped, tri, self.width, self.height)
+                    else {
+                        continue;
+                    };
+                    let setup = &setup;
                     let y0 = setup.y_min.max(band_y0);
                     let y1 = (setup.y_max + 1).min(band_y1);
                     for y in y0..y1 {

@@ -4,8 +4,6 @@
 //! a span is an exact integer addition and splitting a position into texel
 //! index and fraction needs no floating-point rounding.
 
-use glam::Vec4;
-
 /// Sampling positions closer than this (in texels) to a texel centre are
 /// snapped onto it, so that an identity map reproduces texels exactly despite
 /// floating-point rounding.
@@ -29,6 +27,14 @@ pub(crate) const FIXED_RANGE: f64 = (1u64 << 30) as f64;
 #[inline]
 pub(crate) fn to_fixed(coordinate: f64) -> i64 {
     (coordinate.max(-FIXED_RANGE).min(FIXED_RANGE) * FIXED_ONE) as i64
+}
+
+/// Converts a per-pixel step in texels to fixed point, rounded to nearest
+/// (without a libm call), clamped like [`to_fixed`].
+#[inline]
+pub(crate) fn step_to_fixed(step: f64) -> i64 {
+    let scaled = step.max(-FIXED_RANGE).min(FIXED_RANGE) * FIXED_ONE;
+    (scaled + 0.5f64.copysign(scaled)) as i64
 }
 
 /// A borrowed RGBA8 texture with clamp-to-edge bilinear sampling.
@@ -72,50 +78,50 @@ impl<'a> Texture<'a> {
     ///
     /// Colours are premultiplied by alpha before filtering and divided by the
     /// filtered alpha afterwards, so a transparent neighbour contributes
-    /// coverage but no colour (no dark fringes on cut-outs).
+    /// coverage but no colour (no dark fringes on cut-outs). Filter weights
+    /// have 16 fractional bits and are accumulated exactly in integers.
     #[inline]
     pub(crate) fn sample_fixed(&self, u: i64, v: i64) -> [u8; 4] {
         let (x0, x1, fx) = axis(u, self.max_x);
         let (y0, y1, fy) = axis(v, self.max_y);
-        if fx == 0.0 && fy == 0.0 {
+        if fx == 0 && fy == 0 {
             return self.texel(x0, y0);
         }
+        let (gx, gy) = (WEIGHT_ONE - fx, WEIGHT_ONE - fy);
         blend(&[
-            (self.texel(x0, y0), (1.0 - fx) * (1.0 - fy)),
-            (self.texel(x1, y0), fx * (1.0 - fy)),
-            (self.texel(x0, y1), (1.0 - fx) * fy),
+            (self.texel(x0, y0), gx * gy),
+            (self.texel(x1, y0), fx * gy),
+            (self.texel(x0, y1), gx * fy),
             (self.texel(x1, y1), fx * fy),
         ])
     }
 }
 
+/// Fractional bits of a bilinear weight along one axis.
+const WEIGHT_BITS: u32 = 16;
+/// Weight one along one axis; the product of two axes' weights has
+/// `2 * WEIGHT_BITS` fractional bits.
+const WEIGHT_ONE: u64 = 1 << WEIGHT_BITS;
+
 /// Splits one fixed-point texture coordinate into the two texel indices to
-/// blend and the weight of the second, clamping to the texel centres
-/// `[0, max]` and snapping onto a texel centre within [`SNAP_TEXELS`].
+/// blend and the weight of the second (of [`WEIGHT_ONE`]), clamping to the
+/// texel centres `[0, max]` and snapping onto a texel centre within
+/// [`SNAP_TEXELS`].
 #[inline]
-fn axis(coordinate: i64, max: i64) -> (usize, usize, f32) {
+fn axis(coordinate: i64, max: i64) -> (usize, usize, u64) {
     let s = (coordinate - HALF_TEXEL).clamp(0, max);
     let i0 = (s >> FRAC_BITS) as usize;
     let frac = s & FRAC_MASK;
     if frac < SNAP_LO {
-        (i0, i0, 0.0)
+        (i0, i0, 0)
     } else if frac > SNAP_HI {
         // `i0 < s <= max` and `max` is whole, so `i0 + 1 <= max`.
-        (i0 + 1, i0 + 1, 0.0)
+        (i0 + 1, i0 + 1, 0)
     } else {
-        (i0, i0 + 1, frac as f32 * (1.0 / FIXED_ONE as f32))
+        // Strictly between 0 and WEIGHT_ONE thanks to the snapping margins.
+        let weight = (frac + (1 << (FRAC_BITS - WEIGHT_BITS - 1))) >> (FRAC_BITS - WEIGHT_BITS);
+        (i0, i0 + 1, weight as u64)
     }
-}
-
-/// The RGBA of a texel as floats, with alpha replaced by one.
-#[inline]
-fn colour(texel: [u8; 4]) -> Vec4 {
-    Vec4::new(
-        f32::from(texel[0]),
-        f32::from(texel[1]),
-        f32::from(texel[2]),
-        1.0,
-    )
 }
 
 /// Rounds a float channel to a byte (saturating; NaN becomes 0).
@@ -124,28 +130,36 @@ fn to_u8(v: f32) -> u8 {
     (v + 0.5) as u8
 }
 
-/// Weighted premultiplied average of texels; weights sum to one.
+/// Weighted premultiplied average of texels; the weights sum to
+/// `WEIGHT_ONE²`.
 #[inline]
-fn blend(taps: &[([u8; 4], f32); 4]) -> [u8; 4] {
-    // xyz: Σ w·a·rgb (premultiplied colour), w: Σ w·a (alpha).
-    let mut acc = Vec4::ZERO;
+fn blend(taps: &[([u8; 4], u64); 4]) -> [u8; 4] {
+    const SHIFT: u32 = 2 * WEIGHT_BITS;
+    const HALF: u64 = 1 << (SHIFT - 1);
+    // Σ w·a (≤ 2^40) and Σ w·a·c (≤ 2^48): exact in u64.
+    let mut alpha = 0u64;
+    let mut premultiplied = [0u64; 3];
     for &(texel, weight) in taps {
-        acc += colour(texel) * (weight * f32::from(texel[3]));
+        let wa = weight * u64::from(texel[3]);
+        alpha += wa;
+        for (sum, &c) in premultiplied.iter_mut().zip(&texel[..3]) {
+            *sum += wa * u64::from(c);
+        }
     }
-    if acc.w > 0.0 {
-        let straight = acc * acc.w.recip();
-        [
-            to_u8(straight.x),
-            to_u8(straight.y),
-            to_u8(straight.z),
-            to_u8(acc.w),
-        ]
+    if alpha > 0 {
+        let inv = 1.0 / alpha as f32;
+        let [r, g, b] = premultiplied.map(|c| to_u8(c as f32 * inv));
+        [r, g, b, ((alpha + HALF) >> SHIFT) as u8]
     } else {
         // Fully transparent: keep the (straight) filtered colour under it.
-        let straight = taps.iter().fold(Vec4::ZERO, |sum, &(texel, weight)| {
-            sum + colour(texel) * weight
-        });
-        [to_u8(straight.x), to_u8(straight.y), to_u8(straight.z), 0]
+        let mut straight = [0u64; 3];
+        for &(texel, weight) in taps {
+            for (sum, &c) in straight.iter_mut().zip(&texel[..3]) {
+                *sum += weight * u64::from(c);
+            }
+        }
+        let [r, g, b] = straight.map(|c| ((c + HALF) >> SHIFT) as u8);
+        [r, g, b, 0]
     }
 }
 

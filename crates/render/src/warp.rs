@@ -4,7 +4,7 @@ use image::RgbaImage;
 use rayon::iter::ParallelExtend;
 
 use crate::raster::Raster;
-use crate::sample::{FIXED_ONE, FIXED_RANGE, Texture, to_fixed};
+use crate::sample::{FIXED_RANGE, Texture, step_to_fixed, to_fixed};
 use crate::{RenderError, WarpMesh};
 
 /// Options for [`warp_cpu`].
@@ -124,8 +124,7 @@ pub fn warp_cpu(
                 // Step in exact fixed point along the span (rounding the step
                 // costs under 2^-33 texel per pixel).
                 let (mut u, mut v) = (to_fixed(first.0), to_fixed(first.1));
-                let du = (du_dx * FIXED_ONE).round() as i64;
-                let dv = (dv_dx * FIXED_ONE).round() as i64;
+                let (du, dv) = (step_to_fixed(du_dx), step_to_fixed(dv_dx));
                 for px in out.chunks_exact_mut(4) {
                     px.copy_from_slice(&texture.sample_fixed(u, v));
                     u += du;

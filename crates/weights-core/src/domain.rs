@@ -105,7 +105,7 @@ pub(crate) struct Grid {
 }
 
 impl Grid {
-    fn new(min: DVec2, max: DVec2, count: usize, per_cell: f64) -> (DVec2, f64, usize, usize) {
+    fn shape(min: DVec2, max: DVec2, count: usize, per_cell: f64) -> (DVec2, f64, usize, usize) {
         let size = (max - min).max(DVec2::splat(1e-9));
         let cells = (count as f64 / per_cell).max(1.0);
         let cell = (size.x * size.y / cells)
@@ -339,7 +339,7 @@ impl Domain {
 
     pub(crate) fn vertex_grid(&self) -> &Grid {
         self.vertex_grid.get_or_init(|| {
-            let shape = Grid::new(self.min, self.max, self.positions.len(), 8.0);
+            let shape = Grid::shape(self.min, self.max, self.positions.len(), 8.0);
             let probe = Grid::build(shape, 0, |_| (0, 0, 0, 0));
             Grid::build(shape, self.positions.len(), |i| {
                 let (x, y) = probe.cell_of(self.positions[i]);
@@ -350,7 +350,7 @@ impl Domain {
 
     fn triangle_grid(&self) -> &Grid {
         self.triangle_grid.get_or_init(|| {
-            let shape = Grid::new(self.min, self.max, self.triangles.len(), 4.0);
+            let shape = Grid::shape(self.min, self.max, self.triangles.len(), 4.0);
             let probe = Grid::build(shape, 0, |_| (0, 0, 0, 0));
             Grid::build(shape, self.triangles.len(), |i| {
                 let [a, b, c] = self.triangle_corners(i);

@@ -448,10 +448,8 @@ impl Rig {
             self.nodes.remove(k);
             map[k] = NONE;
         }
-        let mut next = 0;
-        for m in map.iter_mut().filter(|m| **m != NONE) {
-            *m = next;
-            next += 1;
+        for (next, m) in map.iter_mut().filter(|m| **m != NONE).enumerate() {
+            *m = next as u32;
         }
         // Add the new real nodes, then give every real node its (possibly renumbered)
         // kind from the target.

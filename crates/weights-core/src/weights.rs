@@ -236,7 +236,9 @@ impl Weights {
         dirty: &[u32],
     ) {
         let n = domain.len();
-        let results: Vec<(usize, Vec<(u32, f64)>, Vec<(u32, f32)>)> = changes
+        /// A changed node, the samples it reaches and its new support entries.
+        type Reach = (usize, Vec<(u32, f64)>, Vec<(u32, f32)>);
+        let results: Vec<Reach> = changes
             .par_iter()
             .map_init(
                 || {
@@ -292,10 +294,9 @@ impl Weights {
         let mut nodes = Vec::with_capacity(self.nodes.len() + self.nodes.len() / 8);
         let mut phi = Vec::with_capacity(nodes.capacity());
         let mut row: Vec<(u32, f32)> = Vec::new();
-        for v in 0..n {
+        for (v, &s) in slot.iter().enumerate() {
             offsets.push(nodes.len() as u32);
             let (a, b) = (self.offsets[v] as usize, self.offsets[v + 1] as usize);
-            let s = slot[v];
             if s == u32::MAX {
                 nodes.extend_from_slice(&self.nodes[a..b]);
                 phi.extend_from_slice(&self.phi[a..b]);
@@ -319,8 +320,8 @@ impl Weights {
         self.offsets = offsets;
         self.nodes = nodes;
         self.phi = phi;
-        for v in 0..n {
-            if slot[v] != u32::MAX {
+        for (v, &s) in slot.iter().enumerate() {
+            if s != u32::MAX {
                 self.sums[v] = self.row_sum(v);
             }
         }

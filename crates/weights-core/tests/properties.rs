@@ -24,7 +24,7 @@ fn check_invariants(rig: &Rig) -> Result<(), String> {
     for v in 0..n {
         let mut sum = 0.0;
         for (k, w) in rig.weights(v) {
-            if !(w >= 0.0) {
+            if w.is_nan() || w < 0.0 {
                 return Err(format!("negative weight {w} of node {k} at sample {v}"));
             }
             sum += w;
@@ -46,7 +46,7 @@ fn check_invariants(rig: &Rig) -> Result<(), String> {
     // r_d < r_h after virtual-handle insertion.
     for k in 0..nodes.len() {
         let r = rig.radii(k);
-        if !(r.r_d < r.r_h) {
+        if r.r_d.is_nan() || r.r_d >= r.r_h {
             return Err(format!("node {k}: r_d = {} ≥ r_h = {}", r.r_d, r.r_h));
         }
     }
@@ -308,7 +308,14 @@ fn degenerate_rigs_never_panic() {
     )
     .expect("valid");
     let nan = DVec2::new(f64::NAN, 1.0);
-    let cases: Vec<(&str, &Domain, Vec<Handle>, Option<fn(&RigError) -> bool>)> = vec![
+    /// Name, domain, handles, and the error expected (if any).
+    type Case<'a> = (
+        &'a str,
+        &'a Domain,
+        Vec<Handle>,
+        Option<fn(&RigError) -> bool>,
+    );
+    let cases: Vec<Case> = vec![
         ("no handles", &convex, vec![], None),
         (
             "one handle",

@@ -19,6 +19,13 @@ pub fn disc_with_hole_and_island() -> image::RgbaImage {
     image_from(200, 160, in_disc_with_hole_and_island)
 }
 
+/// [`disc_with_hole_and_island`] scaled up `k` times.
+pub fn disc_with_hole_and_island_scaled(k: u32) -> image::RgbaImage {
+    image_from(200 * k, 160 * k, |p| {
+        in_disc_with_hole_and_island(p / k as f64)
+    })
+}
+
 /// The shape of [`disc_with_hole_and_island`].
 pub fn in_disc_with_hole_and_island(p: DVec2) -> bool {
     let disc = p.distance(DVec2::new(80.0, 80.0)) < 60.0;
@@ -59,15 +66,28 @@ impl<'a> Locator<'a> {
         for t in 0..mesh.triangles.len() {
             let [a, b, c] = mesh.triangle_positions(t);
             let (tl, th) = (a.min(b).min(c), a.max(b).max(c));
-            let (x0, y0) = (((tl.x - lo.x) / cell) as usize, ((tl.y - lo.y) / cell) as usize);
-            let (x1, y1) = (((th.x - lo.x) / cell) as usize, ((th.y - lo.y) / cell) as usize);
+            let (x0, y0) = (
+                ((tl.x - lo.x) / cell) as usize,
+                ((tl.y - lo.y) / cell) as usize,
+            );
+            let (x1, y1) = (
+                ((th.x - lo.x) / cell) as usize,
+                ((th.y - lo.y) / cell) as usize,
+            );
             for y in y0..=y1.min(ny - 1) {
                 for x in x0..=x1.min(nx - 1) {
                     cells[y * nx + x].push(t);
                 }
             }
         }
-        Locator { mesh, lo, cell, nx, ny, cells }
+        Locator {
+            mesh,
+            lo,
+            cell,
+            nx,
+            ny,
+            cells,
+        }
     }
 
     /// Whether some triangle contains `p` (boundary included, tiny tolerance).

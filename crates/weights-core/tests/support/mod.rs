@@ -1,4 +1,5 @@
-//! Test domains: jittered grids, convex and with holes and notches.
+//! Test domains: jittered grids, convex and with holes and notches (shared by the
+//! benchmarks).
 #![allow(dead_code, missing_docs)]
 
 use glam::DVec2;

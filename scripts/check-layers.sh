@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# The numeric core knows no UI, GPU or dialog crates, and no images: fail if its
+# dependency tree says otherwise (see ARCHITECTURE.md).
+set -euo pipefail
+status=0
+for crate in weights-core; do
+  tree=$(cargo tree -p "$crate" -e normal --prefix none)
+  if echo "$tree" | grep -Eq '^(egui|eframe|wgpu|rfd|winit|image) '; then
+    echo "layering: $crate depends on: $(echo "$tree" | grep -Eo '^(egui|eframe|wgpu|rfd|winit|image) ' | sort -u | tr '\n' ' ')"
+    status=1
+  fi
+done
+for crate in mesh render project; do
+  tree=$(cargo tree -p "$crate" -e normal --prefix none)
+  if echo "$tree" | grep -Eq '^(egui|eframe|rfd|winit|weights-core) '; then
+    echo "layering: $crate depends on: $(echo "$tree" | grep -Eo '^(egui|eframe|rfd|winit|weights-core) ' | sort -u | tr '\n' ' ')"
+    status=1
+  fi
+done
+[ $status -eq 0 ] && echo "layering: ok"
+exit $status

@@ -1,0 +1,71 @@
+//! Helpers shared by the end-to-end tests: running the binary, comparing images.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// The workspace's `tests/data` folder.
+pub fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../tests/data")
+        .join(name)
+}
+
+/// Runs `c2warp` with the given arguments.
+pub fn c2warp(args: &[&std::ffi::OsStr]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_c2warp"))
+        .args(args)
+        .output()
+        .expect("the c2warp binary runs")
+}
+
+/// Runs `c2warp` and expects success.
+pub fn ok(args: &[&std::ffi::OsStr]) -> Output {
+    let out = c2warp(args);
+    assert!(
+        out.status.success(),
+        "c2warp {:?} failed: {}",
+        args,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// Runs `c2warp`, expects failure with one clear line on stderr (no panic), and
+/// returns that line.
+pub fn fails(args: &[&std::ffi::OsStr]) -> String {
+    let out = c2warp(args);
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(!out.status.success(), "c2warp {args:?} should fail");
+    assert!(
+        !stderr.contains("panicked"),
+        "c2warp {args:?} panicked: {stderr}"
+    );
+    let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "one line of error expected, got: {stderr}");
+    assert!(lines[0].starts_with("error: "), "{stderr}");
+    lines[0].to_string()
+}
+
+/// Per-channel differences between two images of the same size: (largest, share of
+/// channels differing by more than `tolerance`).
+pub fn difference(a: &image::RgbaImage, b: &image::RgbaImage, tolerance: u8) -> (u8, f64) {
+    assert_eq!(a.dimensions(), b.dimensions(), "image sizes differ");
+    let mut worst = 0u8;
+    let mut over = 0usize;
+    for (x, y) in a.as_raw().iter().zip(b.as_raw()) {
+        let d = x.abs_diff(*y);
+        worst = worst.max(d);
+        if d > tolerance {
+            over += 1;
+        }
+    }
+    (worst, over as f64 / a.as_raw().len() as f64)
+}
+
+/// Loads a PNG as RGBA.
+pub fn load(path: &Path) -> image::RgbaImage {
+    image::open(path)
+        .unwrap_or_else(|e| panic!("cannot open {}: {e}", path.display()))
+        .to_rgba8()
+}
