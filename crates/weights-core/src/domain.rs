@@ -25,7 +25,7 @@ pub(crate) struct Edge {
 
 /// Adjacency of the samples in compressed rows: the edges of vertex `v` are
 /// `edges[offsets[v]..offsets[v + 1]]`, sorted by target.
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub(crate) struct Graph {
     offsets: Vec<u32>,
     edges: Vec<Edge>,
@@ -94,7 +94,7 @@ impl Graph {
 
 /// A uniform grid over the domain's bounding box whose cells list items (vertex or
 /// triangle indices) in compressed rows.
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub(crate) struct Grid {
     origin: DVec2,
     cell: f64,
@@ -212,7 +212,7 @@ impl Grid {
 ///
 /// Samples are connected by the triangles' edges; that graph carries the intrinsic
 /// (inside-the-shape) distance when the metric is [`Metric::Intrinsic`].
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub struct Domain {
     positions: Vec<DVec2>,
     triangles: Vec<[u32; 3]>,
@@ -223,12 +223,6 @@ pub struct Domain {
     vertex_grid: OnceLock<Grid>,
     triangle_grid: OnceLock<Grid>,
     boundary: OnceLock<Vec<Vec<u32>>>,
-}
-
-impl Clone for Domain {
-    fn clone(&self) -> Self {
-        Self::new_unchecked(self.positions.clone(), self.triangles.clone(), self.metric)
-    }
 }
 
 impl Domain {

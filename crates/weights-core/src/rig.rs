@@ -157,6 +157,28 @@ pub struct BuildTimings {
     pub weights_ms: f64,
 }
 
+/// Wall-clock time of the phases of the last incremental update, in milliseconds.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct UpdateTimings {
+    /// Finding the nodes to add and remove, and the samples the removed ones reached.
+    pub plan_ms: f64,
+    /// Updating the partition (local Dijkstra) and the cells' radii.
+    pub partition_ms: f64,
+    /// Virtual handles inserted to restore r_d < r_h.
+    pub virtual_ms: f64,
+    /// Supports of the changed nodes and the rows of the samples they reach.
+    pub weights_ms: f64,
+    /// Dual graph, harmonic coordinates and node transforms.
+    pub transforms_ms: f64,
+}
+
+impl UpdateTimings {
+    /// Sum of the phases.
+    pub fn total_ms(&self) -> f64 {
+        self.plan_ms + self.partition_ms + self.virtual_ms + self.weights_ms + self.transforms_ms
+    }
+}
+
 impl BuildTimings {
     /// Sum of the phases.
     pub fn total_ms(&self) -> f64 {
@@ -227,6 +249,7 @@ pub struct Rig {
     affines: Vec<DAffine2>,
     resolution: f64,
     timings: BuildTimings,
+    update_timings: UpdateTimings,
 }
 
 impl Rig {
@@ -301,6 +324,7 @@ impl Rig {
             affines: Vec::new(),
             resolution,
             timings,
+            update_timings: UpdateTimings::default(),
         };
         rig.update_transforms();
         rig.timings.weights_ms = ms(clock);
@@ -355,10 +379,15 @@ impl Rig {
             self.update_affines();
             return Ok(());
         }
+        let clock = Instant::now();
         let target = real_nodes(&self.domain, &handles, &self.options, self.resolution)?;
+        self.update_timings = UpdateTimings::default();
+        self.update_timings.plan_ms = ms(clock);
         self.apply(target);
         self.handles = handles;
+        let clock = Instant::now();
         self.update_transforms();
+        self.update_timings.transforms_ms = ms(clock);
         Ok(())
     }
 
@@ -414,6 +443,7 @@ impl Rig {
     /// Moves the node set to `target` real nodes (virtual nodes kept unless a real node
     /// takes their sample), updating partition, virtual handles and weights locally.
     fn apply(&mut self, target: Vec<Node>) {
+        let clock = Instant::now();
         let target_vertices: std::collections::HashSet<u32> =
             target.iter().map(|n| n.vertex).collect();
         let doomed: Vec<usize> = (0..self.nodes.len())
@@ -430,18 +460,12 @@ impl Rig {
             .map(|k| (self.nodes[k].vertex, self.radii[k]))
             .collect();
         // Samples the doomed nodes reach: their rows must be redone.
-        let mut dirty = Vec::new();
-        let mut scratch = Scratch::new(self.domain.len());
-        for &k in &doomed {
-            let (b, _) = ball(
-                &self.domain,
-                &self.partition,
-                self.nodes[k].vertex,
-                self.radii[k],
-                &mut scratch,
-            );
-            dirty.extend(b.into_iter().map(|(v, _)| v));
-        }
+        let dirty: Vec<u32> = doomed
+            .iter()
+            .flat_map(|&k| self.weights.reached(k, self.radii[k]))
+            .collect();
+        self.update_timings.plan_ms += ms(clock);
+        let clock = Instant::now();
         let mut map: Vec<u32> = (0..self.nodes.len() as u32).collect();
         for &k in doomed.iter().rev() {
             self.partition.remove_node(&self.domain, k);
@@ -468,12 +492,16 @@ impl Rig {
                 }
             }
         }
+        self.update_timings.partition_ms = ms(clock);
+        let clock = Instant::now();
         for v in insert_virtual_handles(&self.domain, &mut self.partition) {
             self.nodes.push(Node {
                 vertex: v,
                 kind: NodeKind::Virtual,
             });
         }
+        self.update_timings.virtual_ms = ms(clock);
+        let clock = Instant::now();
         self.radii = support_radii(&self.partition, self.options.alpha);
         let changes: Vec<Change> = self
             .nodes
@@ -497,6 +525,7 @@ impl Rig {
             &changes,
             &dirty,
         );
+        self.update_timings.weights_ms = ms(clock);
     }
 
     /// Recomputes the dual graph, the virtual handles' harmonic coordinates and all
@@ -599,14 +628,12 @@ impl Rig {
     pub fn distances_from_node(&self, k: usize) -> Vec<f64> {
         let mut out = vec![f64::INFINITY; self.domain.len()];
         let mut scratch = Scratch::new(self.domain.len());
-        let (b, _) = ball(
+        for (v, d) in ball(
             &self.domain,
-            &self.partition,
             self.nodes[k].vertex,
             f64::INFINITY,
             &mut scratch,
-        );
-        for (v, d) in b {
+        ) {
             out[v as usize] = d;
         }
         out
@@ -699,6 +726,11 @@ impl Rig {
     /// Phase timings of the full build.
     pub fn timings(&self) -> BuildTimings {
         self.timings
+    }
+
+    /// Phase timings of the last insertion, removal or other change of handles.
+    pub fn update_timings(&self) -> UpdateTimings {
+        self.update_timings
     }
 
     /// Samples of the virtual handles, in node order (to save and rebuild exactly).

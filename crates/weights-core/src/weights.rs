@@ -35,17 +35,14 @@ impl Scratch {
 }
 
 /// The samples within `radius` of node sample `source` (and the source itself), with
-/// their distances, in order of distance; and `cut`, the distance of the nearest other
-/// node sample (∞ if none is within `radius`).
+/// their distances, in order of distance for the intrinsic metric.
 pub(crate) fn ball(
     domain: &Domain,
-    partition: &Partition,
     source: u32,
     radius: f64,
     scratch: &mut Scratch,
-) -> (Vec<(u32, f64)>, f64) {
+) -> Vec<(u32, f64)> {
     let mut out = Vec::new();
-    let mut cut = f64::INFINITY;
     match domain.metric() {
         Metric::Intrinsic => {
             let graph = domain.graph();
@@ -64,12 +61,6 @@ pub(crate) fn ball(
             while let Some(Entry { d, v, .. }) = heap.pop() {
                 if d > dist[v as usize] {
                     continue;
-                }
-                if d >= radius && v != source {
-                    break;
-                }
-                if v != source && cut.is_infinite() && partition.is_node(v) {
-                    cut = d;
                 }
                 out.push((v, d));
                 for e in graph.neighbors(v) {
@@ -116,24 +107,66 @@ pub(crate) fn ball(
             }
         }
     }
-    (out, cut)
+    out
 }
 
-/// Support entries of one node: samples strictly closer than both `radius` and `cut`
-/// (and the node's own sample), with φ(d / radius) as f32, zeros dropped.
-fn support(basis: &Basis, ball: &[(u32, f64)], radius: f64, cut: f64) -> Vec<(u32, f32)> {
-    let limit = radius.min(cut);
-    ball.iter()
-        .filter(|&&(_, d)| d == 0.0 || d < limit)
-        .filter_map(|&(v, d)| {
-            let phi = if d == 0.0 {
-                1.0
-            } else {
-                basis.eval(d / radius) as f32
-            };
-            (phi > 0.0).then_some((v, phi))
-        })
-        .collect()
+/// A node's distance field near it, kept so that a new support radius needs no new
+/// search: the samples closer than `radius` with their distances (rounded to f32; the
+/// weights are computed from these rounded values on every path, so rebuilds and
+/// updates agree bit for bit).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Ball {
+    /// How far the search went (negative: nothing cached).
+    radius: f64,
+    entries: Vec<(u32, f32)>,
+}
+
+impl Ball {
+    fn compute(domain: &Domain, source: u32, radius: f64, scratch: &mut Scratch) -> Self {
+        Self {
+            radius,
+            entries: ball(domain, source, radius, scratch)
+                .into_iter()
+                .map(|(v, d)| (v, d as f32))
+                .collect(),
+        }
+    }
+
+    fn covers(&self, radius: f64) -> bool {
+        self.radius >= radius
+    }
+
+    /// Support entries: samples strictly closer than `radius` and than the nearest other
+    /// node (and the node's own sample), with φ(d / radius), zeros dropped.
+    fn support(
+        &self,
+        basis: &Basis,
+        radius: f64,
+        partition: &Partition,
+        source: u32,
+    ) -> Vec<(u32, f32)> {
+        let cut = self
+            .entries
+            .iter()
+            .filter(|&&(v, _)| v != source && partition.is_node(v))
+            .map(|&(_, d)| f64::from(d))
+            .fold(f64::INFINITY, f64::min);
+        let limit = radius.min(cut);
+        self.entries
+            .iter()
+            .filter_map(|&(v, d)| {
+                let d = f64::from(d);
+                if v == source {
+                    return Some((v, 1.0));
+                }
+                if d >= limit {
+                    return None;
+                }
+                let phi = basis.eval(d / radius) as f32;
+                (phi > 0.0).then_some((v, phi))
+            })
+            .collect()
+    }
 }
 
 /// The sparse weights of every sample.
@@ -143,6 +176,8 @@ pub(crate) struct Weights {
     nodes: Vec<u32>,
     phi: Vec<f32>,
     sums: Vec<f64>,
+    /// Per node, its cached distance field.
+    balls: Vec<Ball>,
 }
 
 /// A per-node change for [`Weights::update`]: the node, its radius before the change
@@ -156,7 +191,7 @@ impl Weights {
     /// Weights from scratch.
     pub fn build(domain: &Domain, partition: &Partition, radii: &[f64], basis: &Basis) -> Self {
         let n = domain.len();
-        let supports: Vec<Vec<(u32, f32)>> = (0..partition.len())
+        let balls: Vec<Ball> = (0..partition.len())
             .into_par_iter()
             .map_init(
                 || {
@@ -166,12 +201,13 @@ impl Weights {
                         0
                     })
                 },
-                |scratch, k| {
-                    let r = radii[k];
-                    let (ball, cut) = ball(domain, partition, partition.node_vertex[k], r, scratch);
-                    support(basis, &ball, r, cut)
-                },
+                |scratch, k| Ball::compute(domain, partition.node_vertex[k], radii[k], scratch),
             )
+            .collect();
+        let supports: Vec<Vec<(u32, f32)>> = balls
+            .par_iter()
+            .enumerate()
+            .map(|(k, b)| b.support(basis, radii[k], partition, partition.node_vertex[k]))
             .collect();
         let mut order: Vec<usize> = (0..partition.len()).collect();
         order.sort_unstable_by_key(|&k| partition.node_vertex[k]);
@@ -204,6 +240,7 @@ impl Weights {
             nodes,
             phi,
             sums: Vec::new(),
+            balls,
         };
         w.sums = (0..n).map(|v| w.row_sum(v)).collect();
         w
@@ -214,6 +251,15 @@ impl Weights {
         self.phi[a..b].iter().map(|&f| f64::from(f)).sum()
     }
 
+    /// Samples node `k` reached within `radius`, from its cached distance field.
+    pub fn reached(&self, k: usize, radius: f64) -> impl Iterator<Item = u32> + '_ {
+        self.balls[k]
+            .entries
+            .iter()
+            .filter(move |&&(_, d)| f64::from(d) < radius || d == 0.0)
+            .map(|&(v, _)| v)
+    }
+
     /// Renumbers nodes after a removal: `map[old] = new` (or `NONE` for a removed node).
     pub fn renumber(&mut self, map: &[u32]) {
         self.nodes.par_iter_mut().for_each(|k| {
@@ -221,6 +267,13 @@ impl Weights {
                 *k = map[*k as usize];
             }
         });
+        let balls = std::mem::take(&mut self.balls);
+        self.balls = balls
+            .into_iter()
+            .zip(map)
+            .filter(|(_, m)| **m != NONE)
+            .map(|(b, _)| b)
+            .collect();
     }
 
     /// Brings the weights up to date after the nodes in `changes` got new radii (or
@@ -236,8 +289,14 @@ impl Weights {
         dirty: &[u32],
     ) {
         let n = domain.len();
-        /// A changed node, the samples it reaches and its new support entries.
-        type Reach = (usize, Vec<(u32, f64)>, Vec<(u32, f32)>);
+        self.balls.resize_with(partition.len(), || Ball {
+            radius: -1.0,
+            entries: Vec::new(),
+        });
+        /// A changed node, a fresh ball if the cached one was too small, the samples
+        /// whose rows it may change, and its new support entries.
+        type Reach = (usize, Option<Ball>, Vec<u32>, Vec<(u32, f32)>);
+        let balls = &self.balls;
         let results: Vec<Reach> = changes
             .par_iter()
             .map_init(
@@ -250,79 +309,127 @@ impl Weights {
                 },
                 |scratch, c| {
                     let r = radii[c.node];
+                    let source = partition.node_vertex[c.node];
+                    let fresh = (!balls[c.node].covers(r))
+                        .then(|| Ball::compute(domain, source, r, scratch));
+                    let ball = fresh.as_ref().unwrap_or(&balls[c.node]);
                     let reach = c.old_radius.map_or(r, |o| o.max(r));
-                    let (ball, cut) = ball(
-                        domain,
-                        partition,
-                        partition.node_vertex[c.node],
-                        reach,
-                        scratch,
-                    );
-                    let entries = support(basis, &ball, r, cut);
-                    (c.node, ball, entries)
+                    let touched = ball
+                        .entries
+                        .iter()
+                        .filter(|&&(_, d)| f64::from(d) < reach)
+                        .map(|&(v, _)| v)
+                        .chain(std::iter::once(source))
+                        .collect();
+                    let entries = ball.support(basis, r, partition, source);
+                    (c.node, fresh, touched, entries)
                 },
             )
             .collect();
+        if std::env::var_os("C2WARP_DEBUG").is_some() {
+            let total: usize = results.iter().map(|r| r.2.len()).sum();
+            let searched = results.iter().filter(|r| r.1.is_some()).count();
+            eprintln!(
+                "changes {} searched {} touched {} dirty {}",
+                changes.len(),
+                searched,
+                total,
+                dirty.len()
+            );
+        }
         let mut changed_node = vec![false; partition.len()];
         for c in changes {
             changed_node[c.node] = true;
         }
-        // Dirty samples and their new entries from changed nodes.
-        let mut slot = vec![u32::MAX; n];
-        let mut fresh: Vec<Vec<(u32, f32)>> = Vec::new();
-        let mark = |v: u32, slot: &mut Vec<u32>, fresh: &mut Vec<Vec<(u32, f32)>>| {
-            if slot[v as usize] == u32::MAX {
-                slot[v as usize] = fresh.len() as u32;
-                fresh.push(Vec::new());
-            }
-            slot[v as usize] as usize
-        };
-        for &v in dirty {
-            mark(v, &mut slot, &mut fresh);
+        // Dirty samples: every sample a changed or removed node reaches or reached.
+        let mut dirty_mark = vec![false; n];
+        for &v in dirty.iter().chain(results.iter().flat_map(|r| r.2.iter())) {
+            dirty_mark[v as usize] = true;
         }
-        for (node, ball, entries) in &results {
-            for &(v, _) in ball {
-                mark(v, &mut slot, &mut fresh);
+        // The changed nodes' new entries, bucketed by sample (counting sort).
+        let mut fresh_start = vec![0u32; n + 1];
+        for (_, _, _, entries) in &results {
+            for &(v, _) in entries {
+                fresh_start[v as usize + 1] += 1;
             }
+        }
+        for v in 0..n {
+            fresh_start[v + 1] += fresh_start[v];
+        }
+        let mut fill = fresh_start.clone();
+        let mut fresh = vec![(0u32, 0f32); fresh_start[n] as usize];
+        for (node, _, _, entries) in &results {
             for &(v, f) in entries {
-                let s = mark(v, &mut slot, &mut fresh);
-                fresh[s].push((*node as u32, f));
+                fresh[fill[v as usize] as usize] = (*node as u32, f);
+                fill[v as usize] += 1;
             }
         }
-        // Rebuild the rows: copy clean rows, merge dirty ones.
+        // Rebuild the rows in parallel chunks: copy clean rows, merge dirty ones.
+        const CHUNK: usize = 8192;
+        let this = &*self;
+        let parts: Vec<(Vec<u32>, Vec<u32>, Vec<f32>, Vec<(usize, f64)>)> = (0..n.div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                let (lo, hi) = (c * CHUNK, ((c + 1) * CHUNK).min(n));
+                let (a0, a1) = (this.offsets[lo] as usize, this.offsets[hi] as usize);
+                let mut lens = Vec::with_capacity(hi - lo);
+                let mut nodes = Vec::with_capacity(a1 - a0 + a1 / 16 - a0 / 16);
+                let mut phi = Vec::with_capacity(nodes.capacity());
+                let mut sums = Vec::new();
+                let mut row: Vec<(u32, f32)> = Vec::new();
+                for v in lo..hi {
+                    let (a, b) = (this.offsets[v] as usize, this.offsets[v + 1] as usize);
+                    if !dirty_mark[v] {
+                        nodes.extend_from_slice(&this.nodes[a..b]);
+                        phi.extend_from_slice(&this.phi[a..b]);
+                        lens.push((b - a) as u32);
+                        continue;
+                    }
+                    row.clear();
+                    row.extend(
+                        (a..b)
+                            .map(|i| (this.nodes[i], this.phi[i]))
+                            .filter(|&(k, _)| k != NONE && !changed_node[k as usize]),
+                    );
+                    row.extend_from_slice(
+                        &fresh[fresh_start[v] as usize..fresh_start[v + 1] as usize],
+                    );
+                    row.sort_unstable_by_key(|&(k, _)| partition.node_vertex[k as usize]);
+                    let mut sum = 0.0;
+                    for &(k, f) in &row {
+                        nodes.push(k);
+                        phi.push(f);
+                        sum += f64::from(f);
+                    }
+                    sums.push((v, sum));
+                    lens.push(row.len() as u32);
+                }
+                (lens, nodes, phi, sums)
+            })
+            .collect();
+        let total: usize = parts.iter().map(|p| p.1.len()).sum();
         let mut offsets = Vec::with_capacity(n + 1);
-        let mut nodes = Vec::with_capacity(self.nodes.len() + self.nodes.len() / 8);
-        let mut phi = Vec::with_capacity(nodes.capacity());
-        let mut row: Vec<(u32, f32)> = Vec::new();
-        for (v, &s) in slot.iter().enumerate() {
-            offsets.push(nodes.len() as u32);
-            let (a, b) = (self.offsets[v] as usize, self.offsets[v + 1] as usize);
-            if s == u32::MAX {
-                nodes.extend_from_slice(&self.nodes[a..b]);
-                phi.extend_from_slice(&self.phi[a..b]);
-                continue;
+        let mut nodes = Vec::with_capacity(total);
+        let mut phi = Vec::with_capacity(total);
+        let mut at = 0u32;
+        for (lens, part_nodes, part_phi, sums) in parts {
+            for len in lens {
+                offsets.push(at);
+                at += len;
             }
-            row.clear();
-            // Entries of changed and removed nodes are replaced by the fresh ones.
-            row.extend(
-                (a..b)
-                    .map(|i| (self.nodes[i], self.phi[i]))
-                    .filter(|&(k, _)| k != NONE && !changed_node[k as usize]),
-            );
-            row.extend_from_slice(&fresh[s as usize]);
-            row.sort_unstable_by_key(|&(k, _)| partition.node_vertex[k as usize]);
-            for &(k, f) in &row {
-                nodes.push(k);
-                phi.push(f);
+            nodes.extend_from_slice(&part_nodes);
+            phi.extend_from_slice(&part_phi);
+            for (v, s) in sums {
+                self.sums[v] = s;
             }
         }
-        offsets.push(nodes.len() as u32);
+        offsets.push(at);
         self.offsets = offsets;
         self.nodes = nodes;
         self.phi = phi;
-        for (v, &s) in slot.iter().enumerate() {
-            if s != u32::MAX {
-                self.sums[v] = self.row_sum(v);
+        for (node, ball, _, _) in results {
+            if let Some(ball) = ball {
+                self.balls[node] = ball;
             }
         }
     }
