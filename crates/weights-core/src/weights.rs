@@ -367,7 +367,9 @@ impl Weights {
         // Rebuild the rows in parallel chunks: copy clean rows, merge dirty ones.
         const CHUNK: usize = 8192;
         let this = &*self;
-        let parts: Vec<(Vec<u32>, Vec<u32>, Vec<f32>, Vec<(usize, f64)>)> = (0..n.div_ceil(CHUNK))
+        /// One chunk of rebuilt rows: lengths, nodes, φ, and new sums of dirty rows.
+        type Part = (Vec<u32>, Vec<u32>, Vec<f32>, Vec<(usize, f64)>);
+        let parts: Vec<Part> = (0..n.div_ceil(CHUNK))
             .into_par_iter()
             .map(|c| {
                 let (lo, hi) = (c * CHUNK, ((c + 1) * CHUNK).min(n));
