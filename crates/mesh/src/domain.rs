@@ -428,6 +428,7 @@ fn fill_small_holes(mask: &mut [bool], w: usize, h: usize, min_area: f64) {
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
 

@@ -20,6 +20,14 @@ pub enum MeshError {
         what: String,
     },
 
+    /// A coordinate is too large (above 1e50 in magnitude) or too close to zero (below
+    /// 1e-40, zero itself is fine) for the triangulator's exact predicates.
+    #[error("coordinate out of range in {what}: magnitudes must be 0 or within [1e-40, 1e50]")]
+    CoordinateOutOfRange {
+        /// Which input holds the bad coordinate, e.g. `"constraint point 3"`.
+        what: String,
+    },
+
     /// A constraint point lies outside the domain.
     #[error("constraint point {index} at ({x}, {y}) lies outside the shape")]
     PointOutsideDomain {

@@ -35,6 +35,35 @@ pub(crate) fn lerp(a: DVec2, b: DVec2, t: f64) -> DVec2 {
     a + (b - a) * t
 }
 
+/// `a - b` if it is exact in floating point (TwoDiff error term zero).
+fn exact_diff(a: f64, b: f64) -> Option<f64> {
+    let s = a - b;
+    let bv = a - s;
+    let av = s + bv;
+    let err = (a - av) + (bv - b);
+    (err == 0.0 && s.is_finite()).then_some(s)
+}
+
+/// Whether `p` lies exactly on the line through `a` and `b` (exact arithmetic; `false`
+/// when it cannot be decided exactly). The split points of a segment that pass this test
+/// create no sliver triangles against it.
+pub(crate) fn exactly_collinear(a: DVec2, b: DVec2, p: DVec2) -> bool {
+    let (Some(ux), Some(uy), Some(vx), Some(vy)) = (
+        exact_diff(b.x, a.x),
+        exact_diff(b.y, a.y),
+        exact_diff(p.x, a.x),
+        exact_diff(p.y, a.y),
+    ) else {
+        return false;
+    };
+    // ux * vy == uy * vx, each product as an exact two-term expansion.
+    let p1 = ux * vy;
+    let e1 = ux.mul_add(vy, -p1);
+    let p2 = uy * vx;
+    let e2 = uy.mul_add(vx, -p2);
+    p1.is_finite() && p2.is_finite() && p1 == p2 && e1 == e2
+}
+
 /// Squared distance from `p` to the segment `a b`.
 #[inline]
 pub(crate) fn dist2_point_segment(p: DVec2, a: DVec2, b: DVec2) -> f64 {
@@ -373,6 +402,7 @@ impl RingBands {
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
 
@@ -394,6 +424,19 @@ mod tests {
         bands.crossings(1.5, &mut xs);
         assert_eq!(xs, vec![0.0, 4.0]);
         assert!((ring_signed_area(&ring) - 16.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn exact_collinearity() {
+        let a = DVec2::new(3.0, 7.0);
+        let b = DVec2::new(103.0, 14.0);
+        assert!(exactly_collinear(a, b, lerp(a, b, 0.375)));
+        assert!(exactly_collinear(a, b, a));
+        assert!(!exactly_collinear(
+            a,
+            b,
+            lerp(a, b, 0.3) + DVec2::new(0.0, 1e-13)
+        ));
     }
 
     #[test]

@@ -10,6 +10,18 @@
 //! x to the right, y down; pixel `(x, y)` covers `[x, x+1] × [y, y+1]`. The crate knows
 //! nothing of UIs, GPUs or warping weights.
 //!
+//! # Design choices
+//! * **Outward tracing.** [`domain_from_image`] dilates the alpha mask by one pixel before
+//!   tracing, so the outline runs about a pixel outside the visible pixels: a warped
+//!   cut-out keeps its soft edge, and simplification (Douglas–Peucker, 0.75 px by
+//!   default) can never cut off a visible pixel.
+//! * **Connectivity.** Islands are 8-connected. The mask is then made well-composed
+//!   (diagonal-only contacts are filled in), so 4- and 8-connectivity agree and every
+//!   traced outline is a simple ring disjoint from the others; simplification keeps it so.
+//! * **Triangulation.** Interior vertices come from a hexagonal lattice sized to
+//!   [`MeshOptions::target_vertices`]; spade's Delaunay refinement then only repairs
+//!   the band along the boundary and the constraints. See [`triangulate`].
+//!
 //! # Example
 //! ```
 //! use glam::DVec2;

@@ -26,11 +26,11 @@ pub(crate) fn simplify_rings(rings: &[Vec<P>], tol: f64) -> Vec<Vec<P>> {
         }
         let mut progress = false;
         for (r, i, j) in conflicts {
-            if let Some(k) = farthest_between(&rings[r], i, j) {
-                if !keep[r][k] {
-                    keep[r][k] = true;
-                    progress = true;
-                }
+            if let Some(k) = farthest_between(&rings[r], i, j)
+                && !keep[r][k]
+            {
+                keep[r][k] = true;
+                progress = true;
             }
         }
         if !progress {
@@ -97,8 +97,8 @@ fn douglas_peucker(ring: &[P], tol: f64) -> Vec<bool> {
         let (a, b) = (to_f(ring[i]), to_f(ring[j % n]));
         let mut best = 0;
         let mut best_d = -1.0;
-        for k in i + 1..j {
-            let d = dist2_point_segment(to_f(ring[k]), a, b);
+        for (k, &p) in ring.iter().enumerate().take(j).skip(i + 1) {
+            let d = dist2_point_segment(to_f(p), a, b);
             if d > best_d {
                 best_d = d;
                 best = k;
@@ -218,6 +218,7 @@ fn dot(a: P, b: P, c: P, d: P) -> i128 {
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
 

@@ -90,6 +90,7 @@ pub(crate) fn trace(mask: &[bool], w: usize, h: usize) -> Vec<TracedRing> {
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
 

@@ -12,7 +12,8 @@ use spade::{
 };
 
 use crate::geometry::{
-    RingBands, SegmentGrid, dist2_point_segment, lerp, ring_signed_area, segment_hits,
+    RingBands, SegmentGrid, dist2_point_segment, exactly_collinear, lerp, ring_signed_area,
+    segment_hits,
 };
 use crate::{Domain, DomainOptions, Mesh, MeshError, domain_from_image};
 
@@ -112,22 +113,34 @@ pub fn mesh_image(
 /// edges are the domain's rings and the constraint polylines, keeping only triangles
 /// inside the domain.
 ///
-/// Method: interior vertices are seeded on a hexagonal lattice whose spacing gives about
-/// [`MeshOptions::target_vertices`] vertices, leaving a gap of half a spacing around
-/// the boundary and the constraints; boundary and polyline segments are split to the
-/// same spacing; then spade's Delaunay refinement fixes triangles below the angle limit
-/// or above twice the lattice triangle area. Vertices at constraint coordinates are
-/// never moved or removed. Inside and outside are told apart by parity of crossed
-/// boundary edges, so closed constraint polylines do not carve holes.
+/// Method:
+/// 1. Interior vertices are seeded on a hexagonal lattice whose spacing gives about
+///    [`MeshOptions::target_vertices`] vertices (calibrated once for the vertices the
+///    boundary and constraints take), leaving a gap of half a spacing around the
+///    boundary and the constraints. Ring and polyline segments are split to the same
+///    spacing (ring split points only where they fall exactly on the segment).
+/// 2. Everything is bulk-loaded into a spade CDT, inside a frame unless the domain is an
+///    axis-aligned convex polygon (the image rectangle), so no ring edge lies on the
+///    convex hull.
+/// 3. Spade's Delaunay refinement fixes triangles below the angle limit or above twice
+///    the lattice triangle area, ignoring faces outside the domain. This is light: it
+///    typically adds a few percent of the vertices, near the boundary.
+/// 4. Triangles are kept by parity of crossed ring edges (so closed constraint polylines
+///    do not carve holes; their inside is seeded but not refined), and the vertices in
+///    use are renumbered in spade's order.
 ///
-/// Every returned vertex is used by a triangle, triangles are non-degenerate and follow
-/// [`Mesh`]'s orientation. Points on the boundary are allowed.
+/// Constraint vertices are never moved or removed. A constraint point on the boundary
+/// (within 1e-9 px, relative to the coordinate magnitude) is made a ring vertex, so the
+/// boundary passes exactly through it. Every returned vertex is used by a triangle,
+/// triangles are non-degenerate and follow [`Mesh`]'s orientation.
 ///
 /// # Errors
 /// * [`MeshError::EmptyDomain`]: no polygon, or zero total area.
 /// * [`MeshError::InvalidDomain`]: a ring with fewer than 3 vertices or zero area, or
 ///   rings that cross.
 /// * [`MeshError::NonFinite`]: a NaN or infinite coordinate.
+/// * [`MeshError::CoordinateOutOfRange`]: a coordinate above 1e50 or below 1e-40 in
+///   magnitude (but not zero).
 /// * [`MeshError::PointOutsideDomain`], [`MeshError::PolylinePointOutsideDomain`],
 ///   [`MeshError::PolylineOutsideDomain`]: a constraint off the shape.
 /// * [`MeshError::Triangulation`]: an internal failure of the triangulator.
@@ -150,8 +163,8 @@ pub fn triangulate(
                     format!("hole {} of polygon {pi}", ri - 1)
                 }
             };
-            if ring.iter().any(|p| !p.is_finite()) {
-                return Err(MeshError::NonFinite { what: name() });
+            for &p in ring {
+                check_coords(p, name)?;
             }
             if ring.len() < 3 {
                 return Err(MeshError::InvalidDomain(format!(
@@ -172,7 +185,7 @@ pub fn triangulate(
         }
     }
     let area = domain.area();
-    if !(area > 0.0) {
+    if area.is_nan() || area <= 0.0 {
         return Err(MeshError::EmptyDomain);
     }
 
@@ -192,11 +205,7 @@ pub fn triangulate(
 
     // --- Validate constraints -----------------------------------------------------
     for (i, p) in constraints.points.iter().enumerate() {
-        if !p.is_finite() {
-            return Err(MeshError::NonFinite {
-                what: format!("constraint point {i}"),
-            });
-        }
+        check_coords(*p, || format!("constraint point {i}"))?;
         if !bands.contains(*p) {
             return Err(MeshError::PointOutsideDomain {
                 index: i,
@@ -212,11 +221,7 @@ pub fn triangulate(
         .collect();
     for (k, line) in constraints.polylines.iter().enumerate() {
         for (i, p) in line.iter().enumerate() {
-            if !p.is_finite() {
-                return Err(MeshError::NonFinite {
-                    what: format!("point {i} of polyline {k}"),
-                });
-            }
+            check_coords(*p, || format!("point {i} of polyline {k}"))?;
             if !bands.contains(*p) {
                 return Err(MeshError::PolylinePointOutsideDomain {
                     polyline: k,
@@ -261,7 +266,7 @@ pub fn triangulate(
 
     // --- Triangulate (spade), guarding against panics in the triangulator ---------
     let lattice_area = 3f64.sqrt() / 4.0 * s * s;
-    let max_extra = (opts.target_vertices.max(1000)).max(seeds.vertices.len());
+    let max_extra = (target as usize).max(1000).max(seeds.vertices.len());
     let result = catch_unwind(AssertUnwindSafe(|| {
         build_mesh(
             domain,
@@ -348,6 +353,24 @@ pub fn triangulate(
     })
 }
 
+/// Smallest non-zero coordinate magnitude accepted (spade rejects subnormal-range values).
+const MIN_COORDINATE: f64 = 1e-40;
+/// Largest coordinate magnitude accepted.
+const MAX_COORDINATE: f64 = 1e50;
+
+/// Checks that a coordinate pair is finite and in the range the triangulator handles.
+fn check_coords(p: DVec2, what: impl Fn() -> String) -> Result<(), MeshError> {
+    if !p.is_finite() {
+        return Err(MeshError::NonFinite { what: what() });
+    }
+    let ok = |v: f64| v == 0.0 || (MIN_COORDINATE..=MAX_COORDINATE).contains(&v.abs());
+    if ok(p.x) && ok(p.y) {
+        Ok(())
+    } else {
+        Err(MeshError::CoordinateOutOfRange { what: what() })
+    }
+}
+
 /// The vertices and constraint edges handed to spade.
 struct Seeds {
     vertices: Vec<Point2<f64>>,
@@ -388,21 +411,44 @@ impl Seeds {
                 (verts.len() - 1) as u32
             })
         };
-        // Pieces that lattice points keep clear of.
-        let mut clear: Vec<[DVec2; 2]> = Vec::new();
         let pieces = |len: f64| ((len / s).ceil().clamp(1.0, 1e7)) as usize;
 
-        // Constraint points on (or within a hair of) the boundary become ring vertices,
+        // Polylines split to the lattice spacing: (position, index of the polyline point
+        // it is, if any).
+        let samples: Vec<Vec<(DVec2, Option<usize>)>> = constraints
+            .polylines
+            .iter()
+            .map(|line| {
+                let mut out = Vec::new();
+                for (i, &p) in line.iter().enumerate() {
+                    if i > 0 {
+                        let a = line[i - 1];
+                        let m = pieces(a.distance(p));
+                        for j in 1..m {
+                            out.push((lerp(a, p, j as f64 / m as f64), None));
+                        }
+                    }
+                    out.push((p, Some(i)));
+                }
+                out
+            })
+            .collect();
+
+        // Constraint vertices on (or within a hair of) the boundary become ring vertices,
         // so the boundary passes exactly through them.
         let tol = 1e-9 * (1.0 + extent);
         let on_boundary: Vec<DVec2> = constraints
             .points
             .iter()
-            .chain(constraints.polylines.iter().flatten())
             .copied()
+            .chain(samples.iter().flatten().map(|&(p, _)| p))
             .filter(|&p| bands.near_boundary(p, tol))
             .collect();
+        // Pieces that lattice points keep clear of.
+        let mut clear: Vec<[DVec2; 2]> = Vec::new();
         let mut splits: Vec<(f64, DVec2)> = Vec::new();
+        // Ring segments that hold constraint vertices.
+        let mut busy_segments: Vec<[DVec2; 2]> = Vec::new();
         for ring in domain.rings() {
             let n = ring.len();
             let mut ids: Vec<u32> = Vec::new();
@@ -412,19 +458,36 @@ impl Seeds {
                 if len2 == 0.0 {
                     continue;
                 }
-                let m = pieces(len2.sqrt());
                 splits.clear();
                 for &p in &on_boundary {
-                    if p != a && p != b && dist2_point_segment(p, a, b) <= tol * tol {
-                        splits.push(((p - a).dot(b - a) / len2, p));
+                    if dist2_point_segment(p, a, b) <= tol * tol {
+                        if p != a && p != b {
+                            splits.push(((p - a).dot(b - a) / len2, p));
+                        }
+                        if busy_segments.last() != Some(&[a, b]) {
+                            busy_segments.push([a, b]);
+                        }
                     }
                 }
-                // Regular split points, except those crowding a constraint point.
+                // Regular split points, except those crowding a constraint vertex. Only
+                // points exactly on the segment are used: one rounded off the line would
+                // leave a sliver outside a convex-hull edge. A power-of-two count makes
+                // them exact for integer (traced) coordinates; spade's refinement splits
+                // whatever is left too long.
+                let m = pieces(len2.sqrt());
+                let exact = |m: usize| {
+                    (1..m).all(|j| exactly_collinear(a, b, lerp(a, b, j as f64 / m as f64)))
+                };
+                let m = if exact(m) { m } else { m.next_power_of_two() };
                 let step = 1.0 / m as f64;
                 for j in 0..m {
                     let t = j as f64 * step;
-                    if j == 0 || splits.iter().all(|&(u, _)| (u - t).abs() > 0.3 * step) {
-                        splits.push((t, lerp(a, b, t)));
+                    let p = lerp(a, b, t);
+                    if j == 0
+                        || (splits.iter().all(|&(u, _)| (u - t).abs() > 0.3 * step)
+                            && exactly_collinear(a, b, p))
+                    {
+                        splits.push((t, p));
                     }
                 }
                 splits.sort_by(|x, y| x.0.total_cmp(&y.0));
@@ -443,37 +506,36 @@ impl Seeds {
                 }
             }
         }
+        let on_same_segment = |p: DVec2, q: DVec2| {
+            busy_segments.iter().any(|&[a, b]| {
+                dist2_point_segment(p, a, b) <= tol * tol
+                    && dist2_point_segment(q, a, b) <= tol * tol
+            })
+        };
+
         for &p in constraints.points {
             seeds.point_ids.push(add(&mut seeds.vertices, p));
             clear.push([p, p]);
         }
-        for line in constraints.polylines {
-            let ids: Vec<u32> = line.iter().map(|&p| add(&mut seeds.vertices, p)).collect();
-            for (i, w) in line.windows(2).enumerate() {
-                let (a, b) = (w[0], w[1]);
-                if ids[i] == ids[i + 1] {
-                    continue;
+        for (line, samples) in constraints.polylines.iter().zip(&samples) {
+            let mut ids = vec![0u32; line.len()];
+            let mut prev: Option<(u32, DVec2)> = None;
+            for &(p, own) in samples {
+                let id = add(&mut seeds.vertices, p);
+                if let Some(i) = own {
+                    ids[i] = id;
                 }
-                let m = pieces(a.distance(b));
-                let mut prev = ids[i];
-                for j in 1..=m {
-                    let id = if j == m {
-                        ids[i + 1]
-                    } else {
-                        add(&mut seeds.vertices, lerp(a, b, j as f64 / m as f64))
-                    };
-                    if id != prev {
-                        seeds.polyline_edges.push([prev as usize, id as usize]);
+                match prev {
+                    Some((q, pq)) => {
+                        // Sub-edges lying on the boundary are constraint edges already.
+                        if q != id && !on_same_segment(pq, p) {
+                            seeds.polyline_edges.push([q as usize, id as usize]);
+                        }
+                        clear.push([pq, p]);
                     }
-                    prev = id;
-                    clear.push([
-                        lerp(a, b, (j - 1) as f64 / m as f64),
-                        lerp(a, b, j as f64 / m as f64),
-                    ]);
+                    None => clear.push([p, p]),
                 }
-            }
-            if line.len() == 1 {
-                clear.push([line[0], line[0]]);
+                prev = Some((id, p));
             }
             seeds.polyline_ids.push(ids);
         }
@@ -500,7 +562,7 @@ impl Seeds {
                     let (xa, xb) = (pair[0], pair[1]);
                     let k0 = ((xa - off) / s).ceil();
                     let k1 = ((xb - off) / s).floor();
-                    if !(k0 <= k1) {
+                    if k0.is_nan() || k1.is_nan() || k0 > k1 {
                         continue;
                     }
                     for k in (k0 as i64)..=(k1 as i64) {
@@ -539,12 +601,29 @@ fn build_mesh(
     min_angle: f64,
     max_extra: usize,
 ) -> Result<Built, MeshError> {
+    // Unless the domain is an axis-aligned convex polygon (the image rectangle), put a
+    // frame around it, so that no domain edge is on the convex hull. Refinement splits
+    // hull edges at points rounded off the line, which can leave sliver triangles outside
+    // a slanted hull edge that then get refined over and over.
+    let simple_rectangle = matches!(domain.polygons.as_slice(),
+        [p] if p.holes.is_empty() && is_convex(&p.outer) && is_axis_aligned(&p.outer));
+    let mut vertices = seeds.vertices.clone();
+    if !simple_rectangle {
+        let (lo, hi) = vertices.iter().fold(
+            (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+            |(lo, hi), p| (lo.min(DVec2::new(p.x, p.y)), hi.max(DVec2::new(p.x, p.y))),
+        );
+        let margin = 0.25 * (hi - lo).max_element() + 1.0;
+        let (lo, hi) = (lo - margin, hi + margin);
+        for p in [lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)] {
+            vertices.push(Point2::new(p.x, p.y));
+        }
+    }
     let mut conflicts = Vec::new();
-    let mut cdt =
-        Cdt::try_bulk_load_cdt(seeds.vertices.clone(), seeds.boundary_edges.clone(), |e| {
-            conflicts.push(e)
-        })
-        .map_err(|e| MeshError::Triangulation(format!("{e:?}")))?;
+    let mut cdt = Cdt::try_bulk_load_cdt(vertices.clone(), seeds.boundary_edges.clone(), |e| {
+        conflicts.push(e)
+    })
+    .map_err(|e| MeshError::Triangulation(format!("{e:?}")))?;
     if let Some([a, _]) = conflicts.first() {
         let p = seeds.vertices[*a];
         return Err(MeshError::InvalidDomain(format!(
@@ -552,7 +631,7 @@ fn build_mesh(
             p.x, p.y
         )));
     }
-    if cdt.num_vertices() != seeds.vertices.len() {
+    if cdt.num_vertices() != vertices.len() {
         return Err(MeshError::Triangulation(
             "vertices were merged unexpectedly".into(),
         ));
@@ -565,11 +644,8 @@ fn build_mesh(
         );
     }
 
-    // Outer faces exist unless the domain is one convex polygon without holes.
-    let convex =
-        matches!(domain.polygons.as_slice(), [p] if p.holes.is_empty() && is_convex(&p.outer));
     let mut params = RefinementParameters::<f64>::new()
-        .exclude_outer_faces(!convex)
+        .exclude_outer_faces(!simple_rectangle)
         .with_angle_limit(AngleLimit::from_deg(min_angle))
         .with_max_additional_vertices(max_extra);
     if lattice_area.is_finite() && lattice_area > 0.0 {
@@ -692,6 +768,15 @@ fn is_convex(ring: &[DVec2]) -> bool {
         neg |= o < 0.0;
     }
     !(pos && neg)
+}
+
+/// Whether every edge of a ring is horizontal or vertical.
+fn is_axis_aligned(ring: &[DVec2]) -> bool {
+    let n = ring.len();
+    (0..n).all(|i| {
+        let (a, b) = (ring[i], ring[(i + 1) % n]);
+        a.x == b.x || a.y == b.y
+    })
 }
 
 /// Follows constraint edges from vertex `from` straight towards vertex `to`.

@@ -1,5 +1,7 @@
 //! Constraint points and polylines become exact vertices and edges; insert_point.
 
+#![allow(clippy::unwrap_used)] // Tests unwrap freely.
+
 mod support;
 
 use glam::DVec2;

@@ -1,10 +1,15 @@
 //! Cut-out images: the mesh follows the alpha outline, covers every opaque pixel and
 //! respects holes.
 
+#![allow(clippy::unwrap_used)] // Tests unwrap freely.
+
 mod support;
 
 use glam::DVec2;
-use mesh::{Constraints, DomainOptions, MeshOptions, domain_from_image, mesh_image, triangulate};
+use mesh::{
+    Constraints, DomainOptions, MeshError, MeshOptions, domain_from_image, mesh_image, triangulate,
+};
+use proptest::prelude::*;
 use support::{
     Locator, disc_with_hole_and_island, disc_with_hole_and_island_scaled,
     in_disc_with_hole_and_island,
@@ -153,6 +158,77 @@ fn soft_edges_are_inside() {
             for (dx, dy) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0), (0.5, 0.5)] {
                 let q = DVec2::new(x as f64 + dx, y as f64 + dy);
                 assert!(loc.contains(q), "pixel ({x}, {y}) corner {q} uncovered");
+            }
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(40))]
+
+    /// Random blobs, holes and speckle: the mesh is valid, matches the domain and covers
+    /// every opaque pixel.
+    #[test]
+    fn random_images(
+        w in 1u32..200,
+        h in 1u32..160,
+        shapes in prop::collection::vec((0.0f64..1.0, 0.0f64..1.0, 0.5f64..30.0, any::<bool>()), 1..8),
+        noise in 0u32..4,
+        tol in 0.0f64..2.5,
+        min_area in 0.0f64..30.0,
+        target in 10usize..5000,
+        pts in prop::collection::vec((0.0f64..1.0, 0.0f64..1.0), 0..10),
+    ) {
+        let mut state = 0x9e37_79b9_u32 ^ w ^ (h << 8);
+        let img = image::RgbaImage::from_fn(w, h, |x, y| {
+            let p = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
+            let mut inside = false;
+            for &(cx, cy, r, add) in &shapes {
+                if p.distance(DVec2::new(cx * w as f64, cy * h as f64)) < r {
+                    inside = add;
+                }
+            }
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            if noise > 0 && state.is_multiple_of(40 / noise) {
+                inside = !inside;
+            }
+            image::Rgba([0, 0, 0, if inside { 200 } else { 3 }])
+        });
+        let dopts = DomainOptions {
+            simplify_tolerance: tol,
+            min_component_area: min_area,
+            ..Default::default()
+        };
+        let d = match domain_from_image(&img, &dopts) {
+            Ok(d) => d,
+            Err(MeshError::EmptyDomain) => {
+                prop_assert!(img.pixels().all(|p| p.0[3] <= 8));
+                return Ok(());
+            }
+            Err(e) => panic!("{e}"),
+        };
+        let points: Vec<DVec2> = pts
+            .iter()
+            .map(|&(x, y)| DVec2::new(x * w as f64, y * h as f64))
+            .filter(|&p| d.contains(p))
+            .collect();
+        let c = Constraints { points: &points, polylines: &[] };
+        let opts = MeshOptions { target_vertices: target, ..Default::default() };
+        let t = triangulate(&d, &c, &opts).unwrap();
+        t.mesh.sanity_check().unwrap();
+        prop_assert!((t.mesh.area() - d.area()).abs() < 1e-6 * d.area());
+        for (p, &v) in points.iter().zip(&t.point_vertices) {
+            prop_assert_eq!(t.mesh.vertices[v as usize], *p);
+        }
+        if min_area == 0.0 {
+            let loc = Locator::new(&t.mesh);
+            for (x, y, p) in img.enumerate_pixels() {
+                if p.0[3] > 8 {
+                    let centre = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
+                    prop_assert!(loc.contains(centre), "pixel ({x}, {y}) uncovered");
+                }
             }
         }
     }

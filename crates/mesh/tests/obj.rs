@@ -1,5 +1,7 @@
 //! Wavefront OBJ input and output.
 
+#![allow(clippy::unwrap_used)] // Tests unwrap freely.
+
 use glam::DVec2;
 use mesh::{Mesh, MeshError};
 
@@ -19,7 +21,7 @@ fn round_trip_is_exact() {
     let mesh = Mesh {
         vertices: vec![
             DVec2::new(0.1 + 0.2, -0.0),
-            DVec2::new(1e-300, 123456789.123456789),
+            DVec2::new(1e-300, 123_456_789.123_456_79),
             DVec2::new(1.0 / 3.0, 2.0f64.sqrt()),
             DVec2::new(5e300, f64::MIN_POSITIVE),
         ],

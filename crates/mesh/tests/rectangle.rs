@@ -1,5 +1,7 @@
 //! Opaque images mesh to the full rectangle; degenerate images have defined answers.
 
+#![allow(clippy::unwrap_used)] // Tests unwrap freely.
+
 mod support;
 
 use glam::DVec2;
