@@ -13,6 +13,9 @@ fn os(s: &str) -> &OsStr {
 }
 
 #[test]
+/// The expected image comes from this renderer; regenerate it (and look at it) when the
+/// mesher or the weights change on purpose:
+/// `c2warp render tests/data/dino.png --rig tests/data/dino-rig.json -o tests/data/dino-warped.png`.
 fn render_matches_the_golden_image() {
     let dir = tempfile::tempdir().expect("temp dir");
     let out = dir.path().join("dino-warped.png");
