@@ -195,6 +195,16 @@ impl Grid {
         d.length_squared()
     }
 
+    /// Squared distance from `p` to the farthest point of the box of cell `c`.
+    #[inline]
+    pub fn cell_far_distance_squared(&self, c: usize, p: DVec2) -> f64 {
+        let (x, y) = (c % self.nx, c / self.nx);
+        let lo = self.origin + DVec2::new(x as f64, y as f64) * self.cell;
+        let hi = lo + DVec2::splat(self.cell);
+        let d = (p - lo).abs().max((hi - p).abs());
+        d.length_squared()
+    }
+
     /// The inclusive range of cells overlapping the disc of radius `r` around `p`.
     pub fn cells_in_disc(&self, p: DVec2, r: f64) -> (usize, usize, usize, usize) {
         let (x0, y0) = self.cell_of(p - DVec2::splat(r));
@@ -223,6 +233,7 @@ pub struct Domain {
     vertex_grid: OnceLock<Grid>,
     triangle_grid: OnceLock<Grid>,
     boundary: OnceLock<Vec<Vec<u32>>>,
+    mean_edge: OnceLock<f64>,
 }
 
 impl Domain {
@@ -270,6 +281,7 @@ impl Domain {
             vertex_grid: OnceLock::new(),
             triangle_grid: OnceLock::new(),
             boundary: OnceLock::new(),
+            mean_edge: OnceLock::new(),
         }
     }
 
@@ -303,22 +315,26 @@ impl Domain {
         (self.min, self.max)
     }
 
-    /// Mean length of the graph's edges: the sampling resolution.
+    /// Mean length of the triangles' edges: the sampling resolution.
     pub fn mean_edge_length(&self) -> f64 {
-        let mut total = 0.0;
-        let mut count = 0usize;
-        for t in &self.triangles {
-            for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
-                total += (self.positions[a as usize] - self.positions[b as usize]).length();
-                count += 1;
-            }
-        }
-        total / count.max(1) as f64
+        *self.mean_edge.get_or_init(|| {
+            use rayon::prelude::*;
+            let total: f64 = self
+                .triangles
+                .par_iter()
+                .map(|t| {
+                    let [a, b, c] = t.map(|v| self.positions[v as usize]);
+                    (a - b).length() + (b - c).length() + (c - a).length()
+                })
+                .sum();
+            total / (3 * self.triangles.len()).max(1) as f64
+        })
     }
 
     /// Builds the lazily computed structures the chosen metric needs, so that later
     /// timings do not include them.
     pub fn prepare(&self) {
+        self.mean_edge_length();
         self.vertex_grid();
         self.triangle_grid();
         if self.metric == Metric::Intrinsic {

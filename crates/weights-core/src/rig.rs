@@ -462,7 +462,10 @@ impl Rig {
         // Samples the doomed nodes reach: their rows must be redone.
         let dirty: Vec<u32> = doomed
             .iter()
-            .flat_map(|&k| self.weights.reached(k, self.radii[k]))
+            .flat_map(|&k| {
+                self.weights
+                    .reached(&self.domain, k, self.nodes[k].vertex, self.radii[k])
+            })
             .collect();
         self.update_timings.plan_ms += ms(clock);
         let clock = Instant::now();
@@ -767,10 +770,22 @@ fn support_radii(partition: &Partition, alpha: f64) -> Vec<f64> {
             if s.r_h.is_infinite() {
                 f64::INFINITY
             } else {
-                ((1.0 - alpha) * s.r_d + alpha * s.r_h).min(s.r_h)
+                // Rounded up to an f32 value: distances are kept as f32, and a distance
+                // at or beyond a representable radius rounds to at or beyond it.
+                round_up_f32(((1.0 - alpha) * s.r_d + alpha * s.r_h).min(s.r_h))
             }
         })
         .collect()
+}
+
+/// The smallest f32 value at or above `x`, as f64.
+fn round_up_f32(x: f64) -> f64 {
+    let f = x as f32;
+    if f64::from(f) < x {
+        f64::from(f.next_up())
+    } else {
+        f64::from(f)
+    }
 }
 
 /// The virtual handle at `c`: the groups' rotations (unit complex numbers), scales and

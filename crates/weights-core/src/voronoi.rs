@@ -5,7 +5,6 @@
 //! Ties between nodes at equal distance go to the node on the lower sample index, so
 //! the partition depends on the set of nodes, not on the order they were added in.
 
-use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
 use glam::DVec2;
@@ -15,33 +14,34 @@ use crate::domain::{Domain, Metric};
 /// "No node": an unreachable sample, or a removed node.
 pub(crate) const NONE: u32 = u32::MAX;
 
-/// A heap entry: tentative distance, the tie-break key of its node, the sample.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Entry {
-    pub d: f64,
-    pub key: u32,
-    pub v: u32,
-}
+/// A heap entry: tentative distance, the tie-break key of its node, the sample, packed
+/// into one integer so that the heap compares them in one instruction. Distances are
+/// never negative, so their IEEE bit patterns order like the numbers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub(crate) struct Entry(std::cmp::Reverse<u128>);
 
-impl PartialEq for Entry {
-    fn eq(&self, other: &Self) -> bool {
-        self.cmp(other) == Ordering::Equal
+impl Entry {
+    #[inline]
+    pub fn new(d: f64, key: u32, v: u32) -> Self {
+        debug_assert!(d >= 0.0);
+        Self(std::cmp::Reverse(
+            (u128::from(d.to_bits()) << 64) | (u128::from(key) << 32) | u128::from(v),
+        ))
     }
-}
-impl Eq for Entry {}
-impl PartialOrd for Entry {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
+
+    #[inline]
+    pub fn d(&self) -> f64 {
+        f64::from_bits((self.0.0 >> 64) as u64)
     }
-}
-impl Ord for Entry {
-    /// Reversed, so that `BinaryHeap` pops the smallest (distance, key, sample).
-    fn cmp(&self, other: &Self) -> Ordering {
-        other
-            .d
-            .total_cmp(&self.d)
-            .then(other.key.cmp(&self.key))
-            .then(other.v.cmp(&self.v))
+
+    #[inline]
+    pub fn key(&self) -> u32 {
+        (self.0.0 >> 32) as u32
+    }
+
+    #[inline]
+    pub fn v(&self) -> u32 {
+        self.0.0 as u32
     }
 }
 
@@ -108,7 +108,7 @@ impl Partition {
                 p.members = vec![Vec::new(); p.node_vertex.len()];
                 let mut heap = BinaryHeap::new();
                 for (k, &v) in p.node_vertex.iter().enumerate() {
-                    let entry = Entry { d: 0.0, key: v, v };
+                    let entry = Entry::new(0.0, v, v);
                     if less((0.0, v), (p.dist[v as usize], p.key_of(v))) {
                         p.dist[v as usize] = 0.0;
                         p.owner[v as usize] = k as u32;
@@ -124,12 +124,7 @@ impl Partition {
                     }
                 }
             }
-            Metric::Euclidean => {
-                p.bin_max = vec![f64::INFINITY; domain.vertex_grid().cell_count()];
-                for v in node_vertex {
-                    p.add_node_euclidean(domain, v);
-                }
-            }
+            Metric::Euclidean => p.nearest_euclidean(domain, node_vertex),
         }
         p
     }
@@ -197,7 +192,8 @@ impl Partition {
         mut changed: Option<&mut Vec<(u32, u32)>>,
     ) {
         let graph = domain.graph();
-        while let Some(Entry { d, key, v }) = heap.pop() {
+        while let Some(entry) = heap.pop() {
+            let (d, key, v) = (entry.d(), entry.key(), entry.v());
             if d != self.dist[v as usize] || key != self.key_of(v) {
                 continue;
             }
@@ -216,11 +212,7 @@ impl Partition {
                     } else {
                         self.owner[w] = k;
                     }
-                    heap.push(Entry {
-                        d: nd,
-                        key,
-                        v: e.to,
-                    });
+                    heap.push(Entry::new(nd, key, e.to));
                 }
             }
         }
@@ -240,7 +232,7 @@ impl Partition {
                     changed.push((v, self.owner[v as usize]));
                     self.dist[v as usize] = 0.0;
                     self.set_owner(v, k as u32);
-                    heap.push(Entry { d: 0.0, key: v, v });
+                    heap.push(Entry::new(0.0, v, v));
                 }
                 self.propagate(domain, &mut heap, Some(&mut changed));
                 self.neighbour_cells(domain, &changed)
@@ -253,29 +245,142 @@ impl Partition {
             farthest: NONE,
             r_h: f64::INFINITY,
         });
-        if domain.metric() == Metric::Euclidean {
-            // r_h of any node may have dropped to its distance from the new node.
-            let p = domain.positions()[v as usize];
-            for j in 0..k {
-                let d = (domain.positions()[self.node_vertex[j] as usize] - p).length();
-                if d < self.stats[j].r_h {
-                    touched.push(j);
-                }
+        if domain.metric() == Metric::Intrinsic {
+            return self.refresh(domain, touched);
+        }
+        // Euclidean: exact shortcuts. A cell that lost samples keeps its r_d unless its
+        // farthest sample was taken (then it is rescanned); r_h can only drop, to the
+        // distance from the new node (a minimum over one more element).
+        self.stats[k] = self.cell_stats(domain, k);
+        let p = domain.positions()[v as usize];
+        for j in 0..k {
+            let d = (domain.positions()[self.node_vertex[j] as usize] - p).length();
+            if d < self.stats[j].r_h {
+                self.stats[j].r_h = d;
+                touched.push(j);
             }
         }
-        self.refresh(domain, touched)
+        touched.sort_unstable();
+        touched.dedup();
+        for &j in &touched {
+            let s = self.stats[j];
+            if j != k && s.farthest != NONE && self.owner[s.farthest as usize] != j as u32 {
+                let (r_d, farthest) = self.farthest(j);
+                self.stats[j].r_d = r_d;
+                self.stats[j].farthest = farthest;
+            }
+        }
+        touched
     }
 
+    /// Nearest node of every sample by straight-line distance, all nodes at once: each
+    /// vertex-grid cell keeps only the nodes that can be nearest somewhere in it.
+    fn nearest_euclidean(&mut self, domain: &Domain, node_vertex: Vec<u32>) {
+        use rayon::prelude::*;
+        let grid = domain.vertex_grid();
+        let positions = domain.positions();
+        let node_pos: Vec<DVec2> = node_vertex.iter().map(|&v| positions[v as usize]).collect();
+        let cells = grid.cell_count();
+        // Candidates per cell: nodes whose nearest point of the cell is no farther than
+        // the best farthest point (any node farther than that loses everywhere in it).
+        let candidates: Vec<Vec<u32>> = (0..cells)
+            .into_par_iter()
+            .map(|c| {
+                if grid.items_of_cell(c).is_empty() {
+                    return Vec::new();
+                }
+                let bound = node_pos
+                    .iter()
+                    .map(|&q| grid.cell_far_distance_squared(c, q))
+                    .fold(f64::INFINITY, f64::min);
+                (0..node_pos.len() as u32)
+                    .filter(|&k| grid.cell_distance_squared(c, node_pos[k as usize]) <= bound)
+                    .collect()
+            })
+            .collect();
+        let n = positions.len();
+        let nearest: Vec<(f64, u32)> = (0..n)
+            .into_par_iter()
+            .map(|v| {
+                let p = positions[v];
+                let (x, y) = grid.cell_of(p);
+                let mut best = (f64::INFINITY, NONE, NONE);
+                for &k in &candidates[y * grid.nx + x] {
+                    let d = (node_pos[k as usize] - p).length();
+                    let key = node_vertex[k as usize];
+                    if less((d, key), (best.0, best.1)) {
+                        best = (d, key, k);
+                    }
+                }
+                (best.0, best.2)
+            })
+            .collect();
+        self.members = vec![Vec::new(); node_vertex.len()];
+        for (v, &(d, k)) in nearest.iter().enumerate() {
+            self.dist[v] = d;
+            self.owner[v] = k;
+            if k != NONE {
+                self.slot[v] = self.members[k as usize].len() as u32;
+                self.members[k as usize].push(v as u32);
+            }
+        }
+        self.node_vertex = node_vertex;
+        self.bin_max = (0..cells)
+            .into_par_iter()
+            .map(|c| {
+                grid.items_of_cell(c)
+                    .iter()
+                    .map(|&w| self.dist[w as usize])
+                    .fold(0.0, f64::max)
+            })
+            .collect();
+    }
+
+    /// Adds a node by straight-line distance: floods the vertex-grid cells from the
+    /// node's own, entering a cell only if it may hold a sample closer to the new node
+    /// than to its current one. The new cell is convex and distance to the old nodes is
+    /// 1-Lipschitz, so every cell the new cell meets passes the test
+    /// `box distance < largest distance in the cell + cell diagonal`, and those cells are
+    /// connected.
     fn add_node_euclidean(&mut self, domain: &Domain, v: u32) -> Vec<usize> {
         let k = self.node_vertex.len() as u32;
         self.node_vertex.push(v);
         self.members.push(Vec::new());
         let grid = domain.vertex_grid();
         let p = domain.positions()[v as usize];
+        let diagonal = grid.cell_size() * std::f64::consts::SQRT_2;
         let mut touched = Vec::new();
-        for c in 0..grid.cell_count() {
-            let reach = self.bin_max[c];
-            if reach.is_finite() && grid.cell_distance_squared(c, p) >= reach * reach {
+        let mut seen = vec![false; grid.cell_count()];
+        let (sx, sy) = grid.cell_of(p);
+        let mut stack = vec![sy * grid.nx + sx];
+        seen[sy * grid.nx + sx] = true;
+        while let Some(c) = stack.pop() {
+            let items = grid.items_of_cell(c);
+            let near = grid.cell_distance_squared(c, p).sqrt();
+            if !items.is_empty() && near >= self.bin_max[c] + diagonal {
+                continue;
+            }
+            let (cx, cy) = (c % grid.nx, c / grid.nx);
+            for (dx, dy) in [
+                (-1i64, -1i64),
+                (0, -1),
+                (1, -1),
+                (-1, 0),
+                (1, 0),
+                (-1, 1),
+                (0, 1),
+                (1, 1),
+            ] {
+                let (x, y) = (cx as i64 + dx, cy as i64 + dy);
+                if x >= 0 && y >= 0 && (x as usize) < grid.nx && (y as usize) < grid.ny {
+                    let n = y as usize * grid.nx + x as usize;
+                    if !seen[n] {
+                        seen[n] = true;
+                        stack.push(n);
+                    }
+                }
+            }
+            if items.is_empty() || near >= self.bin_max[c] {
                 continue;
             }
             let mut max = 0.0f64;
@@ -284,7 +389,7 @@ impl Partition {
                 let wi = w as usize;
                 if less((d, v), (self.dist[wi], self.key_of(w))) {
                     let old = self.owner[wi];
-                    if old != NONE {
+                    if old != NONE && touched.last() != Some(&(old as usize)) {
                         touched.push(old as usize);
                     }
                     self.dist[wi] = d;
@@ -324,11 +429,11 @@ impl Partition {
                     for e in graph.neighbors(v) {
                         let o = self.owner[e.to as usize];
                         if o != NONE {
-                            heap.push(Entry {
-                                d: self.dist[e.to as usize],
-                                key: self.node_vertex[o as usize],
-                                v: e.to,
-                            });
+                            heap.push(Entry::new(
+                                self.dist[e.to as usize],
+                                self.node_vertex[o as usize],
+                                e.to,
+                            ));
                         }
                     }
                 }
@@ -409,8 +514,8 @@ impl Partition {
         cells
     }
 
-    /// r_d, the farthest sample and r_h of cell `k`, from scratch.
-    fn cell_stats(&self, domain: &Domain, k: usize) -> CellStats {
+    /// r_d and the farthest sample of cell `k` (ties to the lower sample index).
+    fn farthest(&self, k: usize) -> (f64, u32) {
         let mut r_d = 0.0;
         let mut farthest = NONE;
         for &v in &self.members[k] {
@@ -420,6 +525,12 @@ impl Partition {
                 farthest = v;
             }
         }
+        (r_d, farthest)
+    }
+
+    /// r_d, the farthest sample and r_h of cell `k`, from scratch.
+    fn cell_stats(&self, domain: &Domain, k: usize) -> CellStats {
+        let (r_d, farthest) = self.farthest(k);
         let r_h = match domain.metric() {
             Metric::Intrinsic => {
                 let graph = domain.graph();
@@ -520,12 +631,9 @@ mod tests {
         let mut dist = vec![f64::INFINITY; d.len()];
         let mut heap = BinaryHeap::new();
         dist[0] = 0.0;
-        heap.push(Entry {
-            d: 0.0,
-            key: 0,
-            v: 0,
-        });
-        while let Some(Entry { d: du, v, .. }) = heap.pop() {
+        heap.push(Entry::new(0.0, 0, 0));
+        while let Some(entry) = heap.pop() {
+            let (du, v) = (entry.d(), entry.v());
             if du > dist[v as usize] {
                 continue;
             }
@@ -533,11 +641,7 @@ mod tests {
                 let nd = du + f64::from(e.len);
                 if nd < dist[e.to as usize] {
                     dist[e.to as usize] = nd;
-                    heap.push(Entry {
-                        d: nd,
-                        key: 0,
-                        v: e.to,
-                    });
+                    heap.push(Entry::new(nd, 0, e.to));
                 }
             }
         }

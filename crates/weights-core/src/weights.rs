@@ -53,12 +53,9 @@ pub(crate) fn ball(
             } = scratch;
             dist[source as usize] = 0.0;
             touched.push(source);
-            heap.push(Entry {
-                d: 0.0,
-                key: 0,
-                v: source,
-            });
-            while let Some(Entry { d, v, .. }) = heap.pop() {
+            heap.push(Entry::new(0.0, 0, source));
+            while let Some(entry) = heap.pop() {
+                let (d, v) = (entry.d(), entry.v());
                 if d > dist[v as usize] {
                     continue;
                 }
@@ -71,11 +68,7 @@ pub(crate) fn ball(
                             touched.push(e.to);
                         }
                         dist[w] = nd;
-                        heap.push(Entry {
-                            d: nd,
-                            key: 0,
-                            v: e.to,
-                        });
+                        heap.push(Entry::new(nd, 0, e.to));
                     }
                 }
             }
@@ -136,8 +129,7 @@ impl Ball {
         self.radius >= radius
     }
 
-    /// Support entries: samples strictly closer than `radius` and than the nearest other
-    /// node (and the node's own sample), with φ(d / radius), zeros dropped.
+    /// Support entries from the cached field.
     fn support(
         &self,
         basis: &Basis,
@@ -145,28 +137,37 @@ impl Ball {
         partition: &Partition,
         source: u32,
     ) -> Vec<(u32, f32)> {
-        let cut = self
-            .entries
-            .iter()
-            .filter(|&&(v, _)| v != source && partition.is_node(v))
-            .map(|&(_, d)| f64::from(d))
-            .fold(f64::INFINITY, f64::min);
-        let limit = radius.min(cut);
         self.entries
             .iter()
             .filter_map(|&(v, d)| {
-                let d = f64::from(d);
-                if v == source {
-                    return Some((v, 1.0));
-                }
-                if d >= limit {
-                    return None;
-                }
-                let phi = basis.eval(d / radius) as f32;
-                (phi > 0.0).then_some((v, phi))
+                support_entry(basis, partition, source, v, d, radius).map(|f| (v, f))
             })
             .collect()
     }
+}
+
+/// The basis value node `source` gives sample `v` at (rounded) distance `d` with support
+/// `radius` (an f32-representable value), or `None`: 1 at its own sample, nothing at any
+/// other node's sample (so weights interpolate exactly), φ(d / radius) for d < radius.
+/// Every path that makes weights goes through here.
+#[inline]
+fn support_entry(
+    basis: &Basis,
+    partition: &Partition,
+    source: u32,
+    v: u32,
+    d: f32,
+    radius: f64,
+) -> Option<f32> {
+    if v == source {
+        return Some(1.0);
+    }
+    let d = f64::from(d);
+    if d >= radius || partition.is_node(v) {
+        return None;
+    }
+    let phi = basis.eval(d / radius) as f32;
+    (phi > 0.0).then_some(phi)
 }
 
 /// The sparse weights of every sample.
@@ -190,6 +191,9 @@ pub(crate) struct Change {
 impl Weights {
     /// Weights from scratch.
     pub fn build(domain: &Domain, partition: &Partition, radii: &[f64], basis: &Basis) -> Self {
+        if domain.metric() == Metric::Euclidean {
+            return Self::build_euclidean(domain, partition, radii, basis);
+        }
         let n = domain.len();
         let balls: Vec<Ball> = (0..partition.len())
             .into_par_iter()
@@ -246,18 +250,128 @@ impl Weights {
         w
     }
 
+    /// Euclidean weights row by row: each vertex-grid cell lists the nodes whose support
+    /// reaches it, and each sample evaluates only those. Node fields are left to be
+    /// cached on demand.
+    fn build_euclidean(
+        domain: &Domain,
+        partition: &Partition,
+        radii: &[f64],
+        basis: &Basis,
+    ) -> Self {
+        let n = domain.len();
+        let grid = domain.vertex_grid();
+        let positions = domain.positions();
+        // (cell, node) pairs: the node's support disc meets the cell, or its sample is in it.
+        let mut pairs: Vec<(u32, u32)> = (0..partition.len())
+            .into_par_iter()
+            .flat_map_iter(|k| {
+                let p = positions[partition.node_vertex[k] as usize];
+                let r = radii[k];
+                let reach = if r.is_finite() { r } else { f64::MAX / 4.0 };
+                let (x0, y0, x1, y1) = grid.cells_in_disc(p, reach);
+                let own = grid.cell_of(p);
+                (y0..=y1)
+                    .flat_map(move |y| (x0..=x1).map(move |x| (x, y)))
+                    .filter_map(move |(x, y)| {
+                        let c = y * grid.nx + x;
+                        let near = grid.cell_distance_squared(c, p) < reach * reach;
+                        (near || (x, y) == own).then_some((c as u32, k as u32))
+                    })
+            })
+            .collect();
+        pairs.par_sort_unstable_by_key(|&(c, k)| (c, partition.node_vertex[k as usize]));
+        let mut cell_start = vec![0u32; grid.cell_count() + 1];
+        for &(c, _) in &pairs {
+            cell_start[c as usize + 1] += 1;
+        }
+        for c in 0..grid.cell_count() {
+            cell_start[c + 1] += cell_start[c];
+        }
+        const CHUNK: usize = 16384;
+        /// One chunk of rows: lengths, nodes, φ and sums.
+        type Rows = (Vec<u32>, Vec<u32>, Vec<f32>, Vec<f64>);
+        let parts: Vec<Rows> = (0..n.div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|chunk| {
+                let (lo, hi) = (chunk * CHUNK, ((chunk + 1) * CHUNK).min(n));
+                let (mut lens, mut nodes, mut phi, mut sums) = (
+                    Vec::with_capacity(hi - lo),
+                    Vec::new(),
+                    Vec::new(),
+                    Vec::with_capacity(hi - lo),
+                );
+                for v in lo..hi {
+                    let p = positions[v];
+                    let (x, y) = grid.cell_of(p);
+                    let c = y * grid.nx + x;
+                    let before = nodes.len();
+                    let mut sum = 0.0;
+                    for &(_, k) in &pairs[cell_start[c] as usize..cell_start[c + 1] as usize] {
+                        let source = partition.node_vertex[k as usize];
+                        let d = (positions[source as usize] - p).length() as f32;
+                        if let Some(f) =
+                            support_entry(basis, partition, source, v as u32, d, radii[k as usize])
+                        {
+                            nodes.push(k);
+                            phi.push(f);
+                            sum += f64::from(f);
+                        }
+                    }
+                    lens.push((nodes.len() - before) as u32);
+                    sums.push(sum);
+                }
+                (lens, nodes, phi, sums)
+            })
+            .collect();
+        let total: usize = parts.iter().map(|p| p.1.len()).sum();
+        let mut w = Self {
+            offsets: Vec::with_capacity(n + 1),
+            nodes: Vec::with_capacity(total),
+            phi: Vec::with_capacity(total),
+            sums: Vec::with_capacity(n),
+            balls: vec![
+                Ball {
+                    radius: -1.0,
+                    entries: Vec::new()
+                };
+                partition.len()
+            ],
+        };
+        let mut at = 0u32;
+        for (lens, nodes, phi, sums) in parts {
+            for len in lens {
+                w.offsets.push(at);
+                at += len;
+            }
+            w.nodes.extend_from_slice(&nodes);
+            w.phi.extend_from_slice(&phi);
+            w.sums.extend_from_slice(&sums);
+        }
+        w.offsets.push(at);
+        w
+    }
+
     fn row_sum(&self, v: usize) -> f64 {
         let (a, b) = (self.offsets[v] as usize, self.offsets[v + 1] as usize);
         self.phi[a..b].iter().map(|&f| f64::from(f)).sum()
     }
 
-    /// Samples node `k` reached within `radius`, from its cached distance field.
-    pub fn reached(&self, k: usize, radius: f64) -> impl Iterator<Item = u32> + '_ {
-        self.balls[k]
-            .entries
+    /// Samples node `k` (on sample `source`) reached within `radius`, from its cached
+    /// distance field (searched now if none is cached).
+    pub fn reached(&self, domain: &Domain, k: usize, source: u32, radius: f64) -> Vec<u32> {
+        let fresh;
+        let ball = if self.balls[k].covers(radius) {
+            &self.balls[k]
+        } else {
+            fresh = Ball::compute(domain, source, radius, &mut Scratch::new(domain.len()));
+            &fresh
+        };
+        ball.entries
             .iter()
-            .filter(move |&&(_, d)| f64::from(d) < radius || d == 0.0)
+            .filter(|&&(_, d)| f64::from(d) < radius || d == 0.0)
             .map(|&(v, _)| v)
+            .collect()
     }
 
     /// Renumbers nodes after a removal: `map[old] = new` (or `NONE` for a removed node).
@@ -310,10 +424,10 @@ impl Weights {
                 |scratch, c| {
                     let r = radii[c.node];
                     let source = partition.node_vertex[c.node];
-                    let fresh = (!balls[c.node].covers(r))
-                        .then(|| Ball::compute(domain, source, r, scratch));
-                    let ball = fresh.as_ref().unwrap_or(&balls[c.node]);
                     let reach = c.old_radius.map_or(r, |o| o.max(r));
+                    let fresh = (!balls[c.node].covers(reach))
+                        .then(|| Ball::compute(domain, source, reach, scratch));
+                    let ball = fresh.as_ref().unwrap_or(&balls[c.node]);
                     let touched = ball
                         .entries
                         .iter()
@@ -326,17 +440,6 @@ impl Weights {
                 },
             )
             .collect();
-        if std::env::var_os("C2WARP_DEBUG").is_some() {
-            let total: usize = results.iter().map(|r| r.2.len()).sum();
-            let searched = results.iter().filter(|r| r.1.is_some()).count();
-            eprintln!(
-                "changes {} searched {} touched {} dirty {}",
-                changes.len(),
-                searched,
-                total,
-                dirty.len()
-            );
-        }
         let mut changed_node = vec![false; partition.len()];
         for c in changes {
             changed_node[c.node] = true;
