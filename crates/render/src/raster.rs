@@ -8,7 +8,8 @@
 //!
 //! Work is split into horizontal bands of [`BAND_ROWS`] rows. Triangles are
 //! binned into the bands their bounding boxes touch (in list order, so a later
-//! triangle overwrites an earlier one), and bands are drawn in parallel.
+//! triangle overwrites an earlier one), and bands are drawn in parallel, each
+//! setting up its triangles as it meets them.
 
 use std::ops::Range;
 
@@ -172,12 +173,19 @@ impl AffineMap {
     }
 
     fn is_finite(&self) -> bool {
-        self.du
-            .iter()
-            .chain(&self.dv)
-            .chain(&self.origin)
-            .chain(&self.anchor)
-            .all(|v| v.is_finite())
+        let [a, b] = self.du;
+        let [c, d] = self.dv;
+        let [e, f] = self.origin;
+        let [g, h] = self.anchor;
+        // A sum of finite numbers can overflow to infinity, so test each.
+        a.is_finite()
+            && b.is_finite()
+            && c.is_finite()
+            && d.is_finite()
+            && e.is_finite()
+            && f.is_finite()
+            && g.is_finite()
+            && h.is_finite()
     }
 
     /// Texture position at output `(0, y)` with `y` the row's centre, so that
@@ -324,7 +332,7 @@ impl<'a> Raster<'a> {
 
     /// Triangle indices per band (compressed: band `b` owns
     /// `items[offsets[b]..offsets[b + 1]]`), each band in list order.
-    fn bins(&self) -> (Vec<usize>, Vec<u32>) {
+    fn bins(&self) -> (Vec<usize>, Vec<usize>) {
         let bands = self.height.div_ceil(BAND_ROWS) as usize;
         let rows: Vec<Option<(u32, u32)>> = self
             .mesh
@@ -346,11 +354,11 @@ impl<'a> Raster<'a> {
             offsets[b + 1] += offsets[b];
         }
         let mut cursor = offsets.clone();
-        let mut items = vec![0u32; offsets[bands]];
+        let mut items = vec![0usize; offsets[bands]];
         for (index, range) in rows.iter().enumerate() {
             if let Some(range) = range {
                 for band in band_range(range) {
-                    items[cursor[band]] = index as u32;
+                    items[cursor[band]] = index;
                     cursor[band] += 1;
                 }
             }
@@ -384,7 +392,7 @@ impl<'a> Raster<'a> {
                 let rows_here = (chunk.len() / row_len) as u32;
                 let band_y1 = band_y0 + rows_here; // exclusive
                 for &index in &items[offsets[band]..offsets[band + 1]] {
-                    let tri = self.mesh.triangles[index as usize];
+                    let tri = self.mesh.triangles[index];
                     let Some(setup) =
                         TriangleSetup::new(&self.mesh, &self.snapped, tri, self.width, self.height)
                     else {

@@ -23,18 +23,24 @@ const SNAP_HI: i64 = (1 << FRAC_BITS) - SNAP_LO;
 pub(crate) const FIXED_RANGE: f64 = (1u64 << 30) as f64;
 
 /// Converts a texture coordinate to fixed point, clamping far-away values
-/// (and mapping NaN to 0).
+/// (NaN becomes 0, as `as` casts do).
 #[inline]
 pub(crate) fn to_fixed(coordinate: f64) -> i64 {
-    (coordinate.max(-FIXED_RANGE).min(FIXED_RANGE) * FIXED_ONE) as i64
+    (coordinate.clamp(-FIXED_RANGE, FIXED_RANGE) * FIXED_ONE) as i64
 }
 
 /// Converts a per-pixel step in texels to fixed point, rounded to nearest
 /// (without a libm call), clamped like [`to_fixed`].
 #[inline]
 pub(crate) fn step_to_fixed(step: f64) -> i64 {
-    let scaled = step.max(-FIXED_RANGE).min(FIXED_RANGE) * FIXED_ONE;
+    let scaled = step.clamp(-FIXED_RANGE, FIXED_RANGE) * FIXED_ONE;
     (scaled + 0.5f64.copysign(scaled)) as i64
+}
+
+/// The position of the last texel centre along an axis of `size` texels,
+/// relative to the first, in fixed point (texels past 2^30 are unreachable).
+fn last_centre(size: u32) -> i64 {
+    i64::from(size.saturating_sub(1)).min(1 << 30) << FRAC_BITS
 }
 
 /// A borrowed RGBA8 texture with clamp-to-edge bilinear sampling.
@@ -52,8 +58,8 @@ impl<'a> Texture<'a> {
         Self {
             data,
             width: width as usize,
-            max_x: i64::from(width.saturating_sub(1)) << FRAC_BITS,
-            max_y: i64::from(height.saturating_sub(1)) << FRAC_BITS,
+            max_x: last_centre(width),
+            max_y: last_centre(height),
         }
     }
 
@@ -80,7 +86,7 @@ impl<'a> Texture<'a> {
     /// filtered alpha afterwards, so a transparent neighbour contributes
     /// coverage but no colour (no dark fringes on cut-outs). Filter weights
     /// have 16 fractional bits and are accumulated exactly in integers.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn sample_fixed(&self, u: i64, v: i64) -> [u8; 4] {
         let (x0, x1, fx) = axis(u, self.max_x);
         let (y0, y1, fy) = axis(v, self.max_y);
@@ -109,7 +115,7 @@ const WEIGHT_ONE: u64 = 1 << WEIGHT_BITS;
 /// [`SNAP_TEXELS`].
 #[inline]
 fn axis(coordinate: i64, max: i64) -> (usize, usize, u64) {
-    let s = (coordinate - HALF_TEXEL).clamp(0, max);
+    let s = (coordinate - HALF_TEXEL).max(0).min(max);
     let i0 = (s >> FRAC_BITS) as usize;
     let frac = s & FRAC_MASK;
     if frac < SNAP_LO {
@@ -136,6 +142,21 @@ fn to_u8(v: f32) -> u8 {
 fn blend(taps: &[([u8; 4], u64); 4]) -> [u8; 4] {
     const SHIFT: u32 = 2 * WEIGHT_BITS;
     const HALF: u64 = 1 << (SHIFT - 1);
+    // Straight weighted average (≤ 2^40 per channel), rounded.
+    let straight = || {
+        let mut sums = [0u64; 3];
+        for &(texel, weight) in taps {
+            for (sum, &c) in sums.iter_mut().zip(&texel[..3]) {
+                *sum += weight * u64::from(c);
+            }
+        }
+        sums.map(|c| ((c + HALF) >> SHIFT) as u8)
+    };
+    if taps.iter().all(|(texel, _)| texel[3] == 255) {
+        // Opaque (the common case): premultiplying changes nothing.
+        let [r, g, b] = straight();
+        return [r, g, b, 255];
+    }
     // Σ w·a (≤ 2^40) and Σ w·a·c (≤ 2^48): exact in u64.
     let mut alpha = 0u64;
     let mut premultiplied = [0u64; 3];
@@ -147,18 +168,13 @@ fn blend(taps: &[([u8; 4], u64); 4]) -> [u8; 4] {
         }
     }
     if alpha > 0 {
-        let inv = 1.0 / alpha as f32;
-        let [r, g, b] = premultiplied.map(|c| to_u8(c as f32 * inv));
+        // The sums fit in i64, whose conversion to f32 is one instruction.
+        let inv = 1.0 / alpha as i64 as f32;
+        let [r, g, b] = premultiplied.map(|c| to_u8(c as i64 as f32 * inv));
         [r, g, b, ((alpha + HALF) >> SHIFT) as u8]
     } else {
         // Fully transparent: keep the (straight) filtered colour under it.
-        let mut straight = [0u64; 3];
-        for &(texel, weight) in taps {
-            for (sum, &c) in straight.iter_mut().zip(&texel[..3]) {
-                *sum += weight * u64::from(c);
-            }
-        }
-        let [r, g, b] = straight.map(|c| ((c + HALF) >> SHIFT) as u8);
+        let [r, g, b] = straight();
         [r, g, b, 0]
     }
 }

@@ -55,7 +55,8 @@ fn alloc<T: Clone + Default + Send>(
 /// * Fold-overs (triangles whose deformed winding is flipped) are drawn like
 ///   any other triangle.
 /// * Where triangles overlap, **the later triangle in `mesh.triangles` wins**.
-/// * Triangles of zero area after snapping are skipped.
+/// * Triangles of zero area after snapping are skipped, as are (absurd)
+///   triangles whose texture mapping overflows `f64`.
 /// * Pixels no triangle covers get `opts.background`.
 ///
 /// Work is split into bands of rows drawn in parallel on the rayon pool.
@@ -122,13 +123,15 @@ pub fn warp_cpu(
             let in_range = |(u, v): (f64, f64)| u.abs() < FIXED_RANGE && v.abs() < FIXED_RANGE;
             if in_range(first) && in_range(last) {
                 // Step in exact fixed point along the span (rounding the step
-                // costs under 2^-33 texel per pixel).
+                // costs under 2^-33 texel per pixel). Every sampled position
+                // lies between `first` and `last`; only the unused step after
+                // the last pixel may overflow, hence the wrapping adds.
                 let (mut u, mut v) = (to_fixed(first.0), to_fixed(first.1));
                 let (du, dv) = (step_to_fixed(du_dx), step_to_fixed(dv_dx));
                 for px in out.chunks_exact_mut(4) {
                     px.copy_from_slice(&texture.sample_fixed(u, v));
-                    u += du;
-                    v += dv;
+                    u = u.wrapping_add(du);
+                    v = v.wrapping_add(dv);
                 }
             } else {
                 for (px, x) in out.chunks_exact_mut(4).zip(columns) {

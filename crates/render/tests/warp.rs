@@ -466,3 +466,39 @@ fn fill_rule_holds_on_many_random_grids() {
     }
     assert!(tested > 30, "only {tested} grids were valid");
 }
+
+#[test]
+fn wild_but_valid_meshes_never_panic() {
+    let mut rng = support::Rng::new(7);
+    let texture = random_image(5, 3, 8);
+    let scales = [1e-30f32, 1e-3, 1.0, 10.0, 1e4, 1e7, 1e20, 3e38];
+    let value = |rng: &mut support::Rng| {
+        let scale = scales[(rng.next_u64() % scales.len() as u64) as usize];
+        rng.range(-1.0, 1.0) * scale + rng.range(0.0, 12.0)
+    };
+    for round in 0..300 {
+        let n = 3 + (rng.next_u64() % 6) as usize;
+        let rest: Vec<Vec2> = (0..n)
+            .map(|_| Vec2::new(value(&mut rng), value(&mut rng)))
+            .collect();
+        let deformed: Vec<Vec2> = (0..n)
+            .map(|_| Vec2::new(value(&mut rng), value(&mut rng)))
+            .collect();
+        let triangles: Vec<[u32; 3]> = (0..4)
+            .map(|_| [0, 1, 2].map(|_| (rng.next_u64() % n as u64) as u32))
+            .collect();
+        let mesh = WarpMesh {
+            rest: &rest,
+            deformed: &deformed,
+            triangles: &triangles,
+        };
+        let (w, h) = (
+            1 + (rng.next_u64() % 12) as u32,
+            1 + (rng.next_u64() % 12) as u32,
+        );
+        let out = warp_cpu(&texture, &mesh, w, h, &RasterOptions::default());
+        assert!(out.is_ok(), "round {round}: {:?}", out.err());
+        let counts = coverage_counts(&mesh, w, h).expect("coverage");
+        assert_eq!(counts.len(), (w * h) as usize);
+    }
+}

@@ -163,3 +163,29 @@ pub fn encode_png(image: &RgbaImage) -> Vec<u8> {
         .expect("encoding a PNG in memory");
     bytes.into_inner()
 }
+
+/// Swirls `positions` about the centre of a `size × size` square: a rotation
+/// by up to 1.2 rad at the centre, fading to none at radius `size / 2`.
+pub fn swirl(positions: &[Vec2], size: f32) -> Vec<Vec2> {
+    let centre = Vec2::splat(size / 2.0);
+    positions
+        .iter()
+        .map(|&p| {
+            let d = p - centre;
+            let t = (1.0 - d.length() / (size / 2.0)).max(0.0);
+            centre + Vec2::from_angle(1.2 * t * t).rotate(d)
+        })
+        .collect()
+}
+
+/// A `size × size` texture with smooth gradients and blocks of transparency.
+pub fn gradient_texture(size: u32) -> RgbaImage {
+    RgbaImage::from_fn(size, size, |x, y| {
+        image::Rgba([
+            (x * 255 / size) as u8,
+            (y * 255 / size) as u8,
+            ((x ^ y) & 0xff) as u8,
+            if (x / 64 + y / 64) % 3 == 0 { 0 } else { 255 },
+        ])
+    })
+}
