@@ -7,13 +7,15 @@
 //! none (the farthest sample of a cell with r_d > 0), so the loop ends after at most as
 //! many insertions as there are samples.
 
-use glam::DVec2;
-
 use crate::domain::{Domain, Metric};
 use crate::voronoi::Partition;
 
-/// Relative tolerance under which two violation ratios count as tied.
+/// Relative tolerance under which two violation ratios count as tied. Tied violators
+/// (and tied farthest samples of one cell) are fixed together, so that a
+/// mirror-symmetric rig keeps its symmetry.
 const TIE: f64 = 1e-9;
+/// At most this many tied farthest samples of one cell get a virtual handle at once.
+const MAX_TIED_PER_CELL: usize = 4;
 
 /// Inserts virtual nodes into `partition` until the r_d < r_h condition holds for every
 /// node, and every sample is reached by some node. Returns the new nodes' samples in
@@ -33,7 +35,6 @@ pub(crate) fn insert_virtual_handles(domain: &Domain, partition: &mut Partition)
             }
         }
     }
-    let positions = domain.positions();
     loop {
         let mut violators: Vec<(f64, usize)> = partition
             .stats
@@ -48,23 +49,26 @@ pub(crate) fn insert_virtual_handles(domain: &Domain, partition: &mut Partition)
         let key = |k: usize| partition.node_vertex[k];
         violators.sort_by(|a, b| b.0.total_cmp(&a.0).then(key(a.1).cmp(&key(b.1))));
         let top = violators[0].0;
-        // Tied violators far apart from each other are fixed together, so that mirror
-        // images of a symmetric rig get mirror-image virtual handles.
-        let mut batch: Vec<(u32, DVec2, f64)> = Vec::new();
+        // Tied violators are fixed together, so that mirror images of a symmetric rig
+        // get mirror-image virtual handles; a cell whose farthest samples tie (a
+        // symmetric cell) gets all of them, up to a few (perfectly regular grids can tie
+        // many).
+        let mut batch: Vec<u32> = Vec::new();
         for &(ratio, k) in &violators {
             if ratio < top - TIE * top.abs().max(TIE) {
                 break;
             }
-            let s = partition.stats[k];
-            let at = positions[s.farthest as usize];
-            let clear = batch
-                .iter()
-                .all(|&(_, q, r)| (q - at).length() >= r.max(s.r_d));
-            if clear {
-                batch.push((s.farthest, at, s.r_d));
+            for far in partition
+                .farthest_samples(domain, k)
+                .into_iter()
+                .take(MAX_TIED_PER_CELL)
+            {
+                if !batch.contains(&far) {
+                    batch.push(far);
+                }
             }
         }
-        for (v, _, _) in batch {
+        for v in batch {
             partition.add_node(domain, v);
             added.push(v);
         }
@@ -76,6 +80,7 @@ pub(crate) fn insert_virtual_handles(domain: &Domain, partition: &mut Partition)
 mod tests {
     use super::*;
     use crate::domain::tests::grid_mesh;
+    use glam::DVec2;
 
     #[test]
     fn two_handles_one_sample_apart_terminate() {

@@ -529,8 +529,12 @@ impl Partition {
     }
 
     /// r_d, the farthest sample and r_h of cell `k`, from scratch.
+    ///
+    /// With the intrinsic metric, a sample of a neighbouring cell that this node reaches
+    /// at exactly its distance (a tie the tie-break gave away) counts toward r_d too:
+    /// cells are closed, so mirror-image nodes get mirror-image radii.
     fn cell_stats(&self, domain: &Domain, k: usize) -> CellStats {
-        let (r_d, farthest) = self.farthest(k);
+        let (mut r_d, mut farthest) = self.farthest(k);
         let r_h = match domain.metric() {
             Metric::Intrinsic => {
                 let graph = domain.graph();
@@ -541,7 +545,13 @@ impl Partition {
                     for e in graph.neighbors(u) {
                         let o = self.owner[e.to as usize];
                         if o != k32 && o != NONE {
-                            best = best.min(du + f64::from(e.len) + self.dist[e.to as usize]);
+                            let dw = self.dist[e.to as usize];
+                            let reach = du + f64::from(e.len);
+                            best = best.min(reach + dw);
+                            if reach == dw && (dw > r_d || (dw == r_d && e.to < farthest)) {
+                                r_d = dw;
+                                farthest = e.to;
+                            }
                         }
                     }
                 }
@@ -559,6 +569,32 @@ impl Partition {
             }
         };
         CellStats { r_d, farthest, r_h }
+    }
+
+    /// Every sample of the closed cell `k` at distance exactly r_d (its farthest samples,
+    /// ties included), lowest index first.
+    pub fn farthest_samples(&self, domain: &Domain, k: usize) -> Vec<u32> {
+        let r_d = self.stats[k].r_d;
+        let mut out: Vec<u32> = self.members[k]
+            .iter()
+            .copied()
+            .filter(|&v| self.dist[v as usize] == r_d)
+            .collect();
+        if domain.metric() == Metric::Intrinsic {
+            let graph = domain.graph();
+            for &u in &self.members[k] {
+                let du = self.dist[u as usize];
+                for e in graph.neighbors(u) {
+                    let (o, dw) = (self.owner[e.to as usize], self.dist[e.to as usize]);
+                    if o != k as u32 && o != NONE && dw == r_d && du + f64::from(e.len) == dw {
+                        out.push(e.to);
+                    }
+                }
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
     }
 
     /// Samples no node reaches (other components of the graph), lowest first.
