@@ -5,33 +5,78 @@
 use glam::DVec2;
 use rayon::prelude::*;
 
-use crate::domain::Domain;
+use crate::domain::{Domain, Metric};
 use crate::voronoi::{NONE, Partition};
 
-/// The dual graph: pairs of nodes whose cells share a mesh edge, each pair once with
-/// the lower node index first, sorted.
+/// The dual graph: pairs of nodes whose closed cells share a mesh edge, each pair once
+/// with the lower node index first, sorted.
+///
+/// A sample at exactly equal distance from two nodes belongs to one cell by the
+/// tie-break but to both closed cells, so it also links the other node to the cells
+/// around it; this keeps the graph of a mirror-symmetric rig symmetric.
 pub(crate) fn dual_edges(domain: &Domain, partition: &Partition) -> Vec<(u32, u32)> {
     let owner = &partition.owner;
-    let mut pairs: Vec<(u32, u32)> = domain
+    let dist = &partition.dist;
+    let positions = domain.positions();
+    // Whether sample `w` is as close to node `k` (owner of its neighbour `u`) as to its own.
+    let tied = |w: u32, u: u32, k: u32| -> bool {
+        let dw = dist[w as usize];
+        match domain.metric() {
+            Metric::Euclidean => {
+                (positions[w as usize] - positions[partition.node_vertex[k as usize] as usize])
+                    .length()
+                    == dw
+            }
+            Metric::Intrinsic => {
+                let len = (positions[w as usize] - positions[u as usize]).length() as f32;
+                dist[u as usize] + f64::from(len) == dw
+            }
+        }
+    };
+    let (mut pairs, ties) = domain
         .triangles()
         .par_chunks(4096)
-        .fold(Vec::new, |mut acc, chunk| {
-            for t in chunk {
-                for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
-                    let (oa, ob) = (owner[a as usize], owner[b as usize]);
-                    if oa != ob && oa != NONE && ob != NONE {
-                        acc.push((oa.min(ob), oa.max(ob)));
+        .fold(
+            || (Vec::new(), Vec::new()),
+            |(mut acc, mut ties), chunk| {
+                for t in chunk {
+                    for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+                        let (oa, ob) = (owner[a as usize], owner[b as usize]);
+                        if oa != ob && oa != NONE && ob != NONE {
+                            acc.push((oa.min(ob), oa.max(ob)));
+                            if tied(a, b, ob) {
+                                ties.push((a, ob));
+                            }
+                            if tied(b, a, oa) {
+                                ties.push((b, oa));
+                            }
+                        }
                     }
                 }
+                acc.sort_unstable();
+                acc.dedup();
+                (acc, ties)
+            },
+        )
+        .reduce(
+            || (Vec::new(), Vec::new()),
+            |(mut a, mut ta), (b, tb)| {
+                a.extend(b);
+                ta.extend(tb);
+                (a, ta)
+            },
+        );
+    if !ties.is_empty() {
+        let graph = domain.graph();
+        for (w, k) in ties {
+            for e in graph.neighbors(w) {
+                let o = owner[e.to as usize];
+                if o != k && o != NONE {
+                    pairs.push((o.min(k), o.max(k)));
+                }
             }
-            acc.sort_unstable();
-            acc.dedup();
-            acc
-        })
-        .reduce(Vec::new, |mut a, b| {
-            a.extend(b);
-            a
-        });
+        }
+    }
     pairs.sort_unstable();
     pairs.dedup();
     pairs

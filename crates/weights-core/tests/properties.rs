@@ -214,7 +214,7 @@ proptest! {
 /// A mirror-symmetric grid domain (mirror line x = nx / 2, nx even), jittered by
 /// multiples of 1/256 so that mirrored coordinates are exact, with a centred hole and two
 /// mirrored notches when `holed`.
-fn symmetric_domain(nx: usize, ny: usize, holed: bool) -> Domain {
+fn symmetric_domain(nx: usize, ny: usize, holed: bool, metric: Metric) -> Domain {
     let mut rng = Rng(5);
     let mut jitter = std::collections::HashMap::new();
     let mut positions = Vec::new();
@@ -266,13 +266,17 @@ fn symmetric_domain(nx: usize, ny: usize, holed: bool) -> Domain {
             }
         }
     }
-    support::compact(positions, triangles, Metric::Intrinsic)
+    support::compact(positions, triangles, metric)
 }
 
 #[test]
 fn mirror_symmetric_rigs_give_mirror_symmetric_weights_and_warps() {
-    for holed in [false, true] {
-        let domain = symmetric_domain(40, 30, holed);
+    for (holed, metric) in [
+        (false, Metric::Euclidean),
+        (false, Metric::Intrinsic),
+        (true, Metric::Intrinsic),
+    ] {
+        let domain = symmetric_domain(40, 30, holed, metric);
         let width = 40.0;
         let mirror = |p: DVec2| DVec2::new(width - p.x, p.y);
         let positions = domain.positions();
@@ -313,17 +317,10 @@ fn mirror_symmetric_rigs_give_mirror_symmetric_weights_and_warps() {
             .map(|(k, n)| (n.vertex, k))
             .collect();
         for (k, n) in rig.nodes().iter().enumerate() {
-            let r = rig.radii(k);
-            eprintln!(
-                "{k} {:?} at {} r_d {} r_h {}",
-                n.kind, positions[n.vertex as usize], r.r_d, r.r_h
-            );
-        }
-        for (k, n) in rig.nodes().iter().enumerate() {
             let m = find(mirror(positions[n.vertex as usize])) as u32;
             assert!(
                 node_at.contains_key(&m),
-                "holed {holed}: node {k} ({:?}) has no mirror image",
+                "{metric:?}, holed {holed}: node {k} ({:?}) has no mirror image",
                 n.kind
             );
         }
