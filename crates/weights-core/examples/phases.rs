@@ -49,7 +49,7 @@ fn main() {
     }
     let handles: Vec<Handle> = pts.into_iter().map(Handle::point).collect();
     let t = Instant::now();
-    let mut rig = Rig::new(d.clone(), handles, RigOptions::default()).expect("valid");
+    let rig = Rig::new(d.clone(), handles, RigOptions::default()).expect("valid");
     println!(
         "Rig::new: {:.1} ms  {:?}",
         t.elapsed().as_secs_f64() * 1e3,
@@ -62,20 +62,31 @@ fn main() {
         rig.deform_into(&mut out);
         println!("deform: {:.2} ms", t.elapsed().as_secs_f64() * 1e3);
     }
-    for _ in 0..5 {
+    let base = rig.clone();
+    let mut totals = Vec::new();
+    let repeats: usize = std::env::var("INSERTS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(12);
+    for _ in 0..repeats {
+        let mut rig = base.clone();
         let p = d.positions()[rng.below(d.len())];
+        let before = rig.stats().virtual_nodes;
         let t = Instant::now();
         let Ok(i) = rig.insert_handle(Handle::point(p)) else {
             continue;
         };
         let ins = t.elapsed().as_secs_f64() * 1e3;
-        let t = Instant::now();
+        totals.push(ins);
         let timings = rig.update_timings();
+        let added = rig.stats().virtual_nodes - before;
+        let t = Instant::now();
         rig.remove_handle(i).expect("exists");
         println!(
-            "insert {ins:.2} ms {timings:?}\n  remove {:.2} ms {:?}",
-            t.elapsed().as_secs_f64() * 1e3,
-            rig.update_timings()
+            "insert {ins:.2} ms (+{added} virtual) {timings:?}\n  remove {:.2} ms",
+            t.elapsed().as_secs_f64() * 1e3
         );
     }
+    totals.sort_by(f64::total_cmp);
+    println!("median insert {:.2} ms", totals[totals.len() / 2]);
 }

@@ -481,23 +481,23 @@ impl Partition {
         self.refresh(domain, touched)
     }
 
-    /// Owners (before and after) of the changed samples and of their neighbours.
+    /// Owners (before and after) of the changed samples and of their neighbours, each
+    /// once.
     fn neighbour_cells(&self, domain: &Domain, changed: &[(u32, u32)]) -> Vec<usize> {
         let graph = domain.graph();
+        let mut seen = vec![false; self.node_vertex.len()];
         let mut cells = Vec::new();
-        for &(v, old) in changed {
-            if old != NONE {
-                cells.push(old as usize);
-            }
-            for e in graph.neighbors(v) {
-                let o = self.owner[e.to as usize];
-                if o != NONE {
-                    cells.push(o as usize);
-                }
-            }
-            let o = self.owner[v as usize];
-            if o != NONE {
+        let mut note = |o: u32, cells: &mut Vec<usize>| {
+            if o != NONE && !seen[o as usize] {
+                seen[o as usize] = true;
                 cells.push(o as usize);
+            }
+        };
+        for &(v, old) in changed {
+            note(old, &mut cells);
+            note(self.owner[v as usize], &mut cells);
+            for e in graph.neighbors(v) {
+                note(self.owner[e.to as usize], &mut cells);
             }
         }
         cells
