@@ -67,12 +67,26 @@ pub(crate) fn dual_edges(domain: &Domain, partition: &Partition) -> Vec<(u32, u3
             },
         );
     if !ties.is_empty() {
-        let graph = domain.graph();
+        // Link each tied sample's other node to every cell around the sample.
+        let mut tied_with: std::collections::HashMap<u32, Vec<u32>> =
+            std::collections::HashMap::new();
+        let mut is_tied = vec![false; owner.len()];
         for (w, k) in ties {
-            for e in graph.neighbors(w) {
-                let o = owner[e.to as usize];
-                if o != k && o != NONE {
-                    pairs.push((o.min(k), o.max(k)));
+            is_tied[w as usize] = true;
+            tied_with.entry(w).or_default().push(k);
+        }
+        for t in domain.triangles() {
+            for (i, &w) in t.iter().enumerate() {
+                if !is_tied[w as usize] {
+                    continue;
+                }
+                for &k in &tied_with[&w] {
+                    for &u in [t[(i + 1) % 3], t[(i + 2) % 3]].iter() {
+                        let o = owner[u as usize];
+                        if o != k && o != NONE {
+                            pairs.push((o.min(k), o.max(k)));
+                        }
+                    }
                 }
             }
         }
