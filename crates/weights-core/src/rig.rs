@@ -446,12 +446,37 @@ impl Rig {
         let clock = Instant::now();
         let target_vertices: std::collections::HashSet<u32> =
             target.iter().map(|n| n.vertex).collect();
+        // New real nodes replace the virtual nodes they crowd: any virtual node a new one
+        // is closer to than its current nearest neighbour. Left in place, a node beside a
+        // virtual one would make Algorithm 1 refine the whole neighbourhood down to their
+        // spacing (at one edge apart, every sample would become a node); removed, it is
+        // re-placed where the new node needs it.
+        let present: std::collections::HashSet<u32> = self.nodes.iter().map(|n| n.vertex).collect();
+        let positions = self.domain.positions();
+        let arrivals: Vec<DVec2> = target
+            .iter()
+            .filter(|n| !present.contains(&n.vertex))
+            .map(|n| positions[n.vertex as usize])
+            .collect();
+        let replaced: std::collections::HashSet<u32> = self
+            .nodes
+            .iter()
+            .enumerate()
+            .filter(|(_, n)| n.kind == NodeKind::Virtual)
+            .filter(|&(k, n)| {
+                let p = positions[n.vertex as usize];
+                let r_h = self.partition.stats[k].r_h;
+                arrivals.iter().any(|q| (*q - p).length() < r_h)
+            })
+            .map(|(_, n)| n.vertex)
+            .collect();
         let doomed: Vec<usize> = (0..self.nodes.len())
             .filter(|&k| {
                 let n = self.nodes[k];
                 let is_real = n.kind != NodeKind::Virtual;
                 (is_real && !target_vertices.contains(&n.vertex))
-                    || (!is_real && target_vertices.contains(&n.vertex))
+                    || (!is_real
+                        && (target_vertices.contains(&n.vertex) || replaced.contains(&n.vertex)))
             })
             .collect();
         // Radii of the surviving nodes, by sample (node numbers change below).

@@ -51,23 +51,58 @@ pub(crate) fn insert_virtual_handles(domain: &Domain, partition: &mut Partition)
         let top = violators[0].0;
         // Tied violators are fixed together, so that mirror images of a symmetric rig
         // get mirror-image virtual handles; a cell whose farthest samples tie (a
-        // symmetric cell) gets all of them, up to a few (perfectly regular grids can tie
-        // many).
-        let mut batch: Vec<u32> = Vec::new();
+        // symmetric cell) offers all of them, up to a few (perfectly regular grids can
+        // tie many). Candidates closer together than the violator's r_h are merged into
+        // one handle at the sample nearest their centroid: two new nodes that close would
+        // lower the rig's smallest r_h (the plain greedy never does), and Algorithm 1
+        // would then refine everything around them to that spacing. A mirror pair merges
+        // onto the mirror line, which keeps the symmetry.
+        let positions = domain.positions();
+        let mut groups: Vec<(Vec<u32>, f64)> = Vec::new();
         for &(ratio, k) in &violators {
             if ratio < top - TIE * top.abs().max(TIE) {
                 break;
             }
+            let r_h = partition.stats[k].r_h;
             for far in partition
                 .farthest_samples(domain, k)
                 .into_iter()
                 .take(MAX_TIED_PER_CELL)
             {
-                if !batch.contains(&far) {
-                    batch.push(far);
+                let p = positions[far as usize];
+                let near = groups.iter_mut().find(|(members, reach)| {
+                    members
+                        .iter()
+                        .any(|&b| (positions[b as usize] - p).length() < r_h.max(*reach))
+                });
+                match near {
+                    Some((members, _)) => {
+                        if !members.contains(&far) {
+                            members.push(far);
+                        }
+                    }
+                    None => groups.push((vec![far], r_h)),
                 }
             }
         }
+        let batch: Vec<u32> = groups
+            .into_iter()
+            .map(|(members, r_h)| {
+                if members.len() == 1 {
+                    return members[0];
+                }
+                let centroid = members
+                    .iter()
+                    .map(|&b| positions[b as usize])
+                    .sum::<glam::DVec2>()
+                    / members.len() as f64;
+                // The merged handle must not crowd an existing node either.
+                match domain.nearest_vertex(centroid) {
+                    Some(v) if partition.dist[v as usize] >= r_h => v,
+                    _ => members[0],
+                }
+            })
+            .collect();
         for v in batch {
             partition.add_node(domain, v);
             added.push(v);

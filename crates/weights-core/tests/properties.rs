@@ -545,3 +545,39 @@ fn bars_are_sampled_and_follow_their_pose() {
         }
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 12, .. ProptestConfig::default() })]
+
+    /// A handle dropped right beside a virtual handle replaces it instead of making
+    /// Algorithm 1 refine the neighbourhood down to one edge (which, on a discrete
+    /// mesh, turns nearly every sample into a handle).
+    #[test]
+    fn inserting_beside_a_virtual_handle_stays_local(seed in any::<u64>(), convex in any::<bool>()) {
+        let domain = grid_domain(40, 30, 1.0, 0.3, shape_of(convex), seed);
+        let mut rng = Rng(seed);
+        let handles = random_handles(&domain, &mut rng, 4, 1);
+        let mut rig = Rig::new(domain.clone(), handles, RigOptions::default()).expect("valid");
+        let virtuals: Vec<u32> = rig.virtual_vertices();
+        prop_assume!(!virtuals.is_empty());
+        let v = virtuals[rng.below(virtuals.len())];
+        // The sample next to it.
+        let p = domain.positions()[v as usize];
+        let beside = (0..domain.len())
+            .filter(|&u| u != v as usize)
+            .min_by(|&a, &b| {
+                (domain.positions()[a] - p)
+                    .length()
+                    .total_cmp(&(domain.positions()[b] - p).length())
+            })
+            .expect("another sample");
+        let before = rig.stats().virtual_nodes;
+        if rig.insert_handle(Handle::point(domain.positions()[beside])).is_ok() {
+            let after = rig.stats().virtual_nodes;
+            prop_assert!(after < before + domain.len() / 20, "{} virtual handles became {}", before, after);
+            if let Err(e) = check_invariants(&rig) {
+                prop_assert!(false, "{}", e);
+            }
+        }
+    }
+}
