@@ -79,7 +79,7 @@ fn main() {
         let ins = t.elapsed().as_secs_f64() * 1e3;
         totals.push(ins);
         let timings = rig.update_timings();
-        let added = rig.stats().virtual_nodes - before;
+        let added = rig.stats().virtual_nodes as i64 - before as i64;
         let t = Instant::now();
         rig.remove_handle(i).expect("exists");
         println!(
