@@ -581,3 +581,84 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn points_between_samples_follow_the_mesh_and_samples_follow_their_weights() {
+    let domain = grid_domain(20, 16, 1.0, 0.25, Shape::Holed, 9);
+    let mut rng = Rng(9);
+    let handles = random_handles(&domain, &mut rng, 3, 1);
+    let mut rig = Rig::new(domain.clone(), handles, RigOptions::default()).expect("valid");
+    rig.set_point_transform(
+        0,
+        Similarity {
+            translation: DVec2::new(2.0, -1.0),
+            rotation: 0.3,
+            scale: 1.2,
+        },
+    )
+    .expect("point handle");
+    let moved = rig.deform();
+    // A sample moves to the weighted blend of its nodes' transforms.
+    for v in (0..domain.len()).step_by(7) {
+        let p = domain.positions()[v];
+        let blend: DVec2 = rig
+            .weights(v)
+            .map(|(k, w)| w * rig.node_transform(k).transform_point2(p))
+            .sum();
+        assert!((blend - moved[v]).length() < 1e-9, "sample {v}");
+        // At a sample, the point deformation is the sample's own.
+        let at = rig.deform_point(&moved, p).expect("inside");
+        assert!((at - moved[v]).length() < 1e-9);
+    }
+    // Between samples: the barycentric blend of the triangle's corners.
+    let t = domain.triangles()[5];
+    let corners = t.map(|v| domain.positions()[v as usize]);
+    let p = (corners[0] + corners[1] + corners[2]) / 3.0;
+    let expected = t.iter().map(|&v| moved[v as usize]).sum::<DVec2>() / 3.0;
+    let got = rig.deform_point(&moved, p).expect("inside");
+    assert!((got - expected).length() < 1e-9);
+    // Off the shape there is no answer.
+    assert!(rig.deform_point(&moved, DVec2::new(10.0, 8.0)).is_none());
+}
+
+#[test]
+fn a_fixed_boundary_stays_put() {
+    for shape in [Shape::Rectangle, Shape::Holed] {
+        let domain = grid_domain(24, 18, 1.0, 0.2, shape, 4);
+        let mut rng = Rng(4);
+        let handles = random_handles(&domain, &mut rng, 3, 0);
+        let options = RigOptions {
+            fixed_boundary: true,
+            ..RigOptions::default()
+        };
+        let mut rig = Rig::new(domain.clone(), handles, options).expect("valid");
+        let pinned: Vec<u32> = rig
+            .nodes()
+            .iter()
+            .filter(|n| n.kind == NodeKind::Boundary)
+            .map(|n| n.vertex)
+            .collect();
+        assert!(!pinned.is_empty(), "{shape:?}: no border pins");
+        for i in 0..3 {
+            rig.set_point_transform(i, Similarity::translate(DVec2::new(3.0, 2.0)))
+                .expect("point handle");
+        }
+        let moved = rig.deform();
+        for v in pinned {
+            assert_eq!(
+                moved[v as usize],
+                domain.positions()[v as usize],
+                "{shape:?}"
+            );
+        }
+        // The handles themselves still move.
+        for n in rig
+            .nodes()
+            .iter()
+            .filter(|n| matches!(n.kind, NodeKind::Point { .. }))
+        {
+            let p = domain.positions()[n.vertex as usize];
+            assert!((moved[n.vertex as usize] - p - DVec2::new(3.0, 2.0)).length() < 1e-9);
+        }
+    }
+}
