@@ -262,31 +262,46 @@ impl Weights {
         let n = domain.len();
         let grid = domain.vertex_grid();
         let positions = domain.positions();
-        // (cell, node) pairs: the node's support disc meets the cell, or its sample is in it.
-        let mut pairs: Vec<(u32, u32)> = (0..partition.len())
-            .into_par_iter()
-            .flat_map_iter(|k| {
-                let p = positions[partition.node_vertex[k] as usize];
-                let r = radii[k];
+        // Per cell, the nodes whose support disc meets it (or whose sample is in it), in
+        // order of the nodes' samples: nodes visited in that order, bucketed by cell.
+        let mut order: Vec<u32> = (0..partition.len() as u32).collect();
+        order.sort_unstable_by_key(|&k| partition.node_vertex[k as usize]);
+        let reached: Vec<Vec<u32>> = order
+            .par_iter()
+            .map(|&k| {
+                let p = positions[partition.node_vertex[k as usize] as usize];
+                let r = radii[k as usize];
                 let reach = if r.is_finite() { r } else { f64::MAX / 4.0 };
                 let (x0, y0, x1, y1) = grid.cells_in_disc(p, reach);
                 let own = grid.cell_of(p);
-                (y0..=y1)
-                    .flat_map(move |y| (x0..=x1).map(move |x| (x, y)))
-                    .filter_map(move |(x, y)| {
+                let mut cells = Vec::new();
+                for y in y0..=y1 {
+                    for x in x0..=x1 {
                         let c = y * grid.nx + x;
-                        let near = grid.cell_distance_squared(c, p) < reach * reach;
-                        (near || (x, y) == own).then_some((c as u32, k as u32))
-                    })
+                        if grid.cell_distance_squared(c, p) < reach * reach || (x, y) == own {
+                            cells.push(c as u32);
+                        }
+                    }
+                }
+                cells
             })
             .collect();
-        pairs.par_sort_unstable_by_key(|&(c, k)| (c, partition.node_vertex[k as usize]));
         let mut cell_start = vec![0u32; grid.cell_count() + 1];
-        for &(c, _) in &pairs {
-            cell_start[c as usize + 1] += 1;
+        for cells in &reached {
+            for &c in cells {
+                cell_start[c as usize + 1] += 1;
+            }
         }
         for c in 0..grid.cell_count() {
             cell_start[c + 1] += cell_start[c];
+        }
+        let mut fill = cell_start.clone();
+        let mut by_cell = vec![0u32; cell_start[grid.cell_count()] as usize];
+        for (&k, cells) in order.iter().zip(&reached) {
+            for &c in cells {
+                by_cell[fill[c as usize] as usize] = k;
+                fill[c as usize] += 1;
+            }
         }
         const CHUNK: usize = 16384;
         /// One chunk of rows: lengths, nodes, φ and sums.
@@ -307,7 +322,7 @@ impl Weights {
                     let c = y * grid.nx + x;
                     let before = nodes.len();
                     let mut sum = 0.0;
-                    for &(_, k) in &pairs[cell_start[c] as usize..cell_start[c + 1] as usize] {
+                    for &k in &by_cell[cell_start[c] as usize..cell_start[c + 1] as usize] {
                         let source = partition.node_vertex[k as usize];
                         let d = (positions[source as usize] - p).length() as f32;
                         if let Some(f) =
