@@ -400,23 +400,16 @@ impl Rig {
         index: usize,
         transform: Similarity,
     ) -> Result<(), RigError> {
-        match self.handles.get(index) {
-            Some(Handle::Point { rest, .. }) => {
-                let h = Handle::Point {
-                    rest: *rest,
-                    transform,
-                };
-                check_handle(index, &h)?;
-                self.handles[index] = h;
-                self.update_affines();
-                Ok(())
-            }
-            Some(_) => Err(RigError::WrongKind {
+        self.set_pose(index, |h| match *h {
+            Handle::Point { rest, .. } => Some(Handle::Point { rest, transform }),
+            Handle::Bar { .. } => None,
+        })
+        .map_err(|e| {
+            e.unwrap_or(RigError::WrongKind {
                 handle: index,
                 expected: "bar",
-            }),
-            None => Err(RigError::NoSuchHandle { handle: index }),
-        }
+            })
+        })
     }
 
     /// Sets the posed end points of bar handle `index`.
@@ -424,20 +417,34 @@ impl Rig {
     /// # Errors
     /// No such handle, not a bar, or non-finite end points.
     pub fn set_bar_pose(&mut self, index: usize, pose: [DVec2; 2]) -> Result<(), RigError> {
-        match self.handles.get(index) {
-            Some(Handle::Bar { rest, .. }) => {
-                let h = Handle::Bar { rest: *rest, pose };
-                check_handle(index, &h)?;
-                self.handles[index] = h;
-                self.update_affines();
-                Ok(())
-            }
-            Some(_) => Err(RigError::WrongKind {
+        self.set_pose(index, |h| match *h {
+            Handle::Bar { rest, .. } => Some(Handle::Bar { rest, pose }),
+            Handle::Point { .. } => None,
+        })
+        .map_err(|e| {
+            e.unwrap_or(RigError::WrongKind {
                 handle: index,
                 expected: "point",
-            }),
-            None => Err(RigError::NoSuchHandle { handle: index }),
-        }
+            })
+        })
+    }
+
+    /// Replaces handle `index` by `posed(handle)` (same rest geometry, new pose) and
+    /// updates the node transforms. `Err(None)` when `posed` refuses the handle's kind.
+    fn set_pose(
+        &mut self,
+        index: usize,
+        posed: impl FnOnce(&Handle) -> Option<Handle>,
+    ) -> Result<(), Option<RigError>> {
+        let current = self
+            .handles
+            .get(index)
+            .ok_or(Some(RigError::NoSuchHandle { handle: index }))?;
+        let h = posed(current).ok_or(None)?;
+        check_handle(index, &h).map_err(Some)?;
+        self.handles[index] = h;
+        self.update_affines();
+        Ok(())
     }
 
     /// Moves the node set to `target` real nodes (virtual nodes kept unless a real node

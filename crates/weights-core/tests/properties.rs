@@ -249,23 +249,7 @@ fn symmetric_domain(nx: usize, ny: usize, holed: bool, metric: Metric) -> Domain
         let notch = mx >= nx / 8 && mx < nx / 8 + 2 && y < ny / 2;
         !hole && !notch
     };
-    let id = |x: usize, y: usize| (y * (nx + 1) + x) as u32;
-    let mut triangles = Vec::new();
-    for y in 0..ny {
-        for x in 0..nx {
-            if !keep(x, y) {
-                continue;
-            }
-            let (a, b, c, d) = (id(x, y), id(x + 1, y), id(x + 1, y + 1), id(x, y + 1));
-            if 2 * x < nx {
-                triangles.push([a, b, c]);
-                triangles.push([a, c, d]);
-            } else {
-                triangles.push([a, b, d]);
-                triangles.push([b, c, d]);
-            }
-        }
-    }
+    let triangles = support::grid_triangles(nx, ny, keep);
     support::compact(positions, triangles, metric)
 }
 

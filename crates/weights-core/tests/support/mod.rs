@@ -56,6 +56,20 @@ pub fn grid_domain(nx: usize, ny: usize, h: f64, jitter: f64, shape: Shape, seed
             !in_hole && !in_notch
         }
     };
+    let triangles = grid_triangles(nx, ny, keep);
+    compact(
+        positions,
+        triangles,
+        match shape {
+            Shape::Rectangle => Metric::Euclidean,
+            Shape::Holed => Metric::Intrinsic,
+        },
+    )
+}
+
+/// Two triangles for every kept cell of an `nx × ny` grid of `(nx + 1) × (ny + 1)`
+/// vertices (row-major), with diagonals mirrored about the vertical centre line.
+pub fn grid_triangles(nx: usize, ny: usize, keep: impl Fn(usize, usize) -> bool) -> Vec<[u32; 3]> {
     let id = |x: usize, y: usize| (y * (nx + 1) + x) as u32;
     let mut triangles = Vec::new();
     for y in 0..ny {
@@ -73,14 +87,7 @@ pub fn grid_domain(nx: usize, ny: usize, h: f64, jitter: f64, shape: Shape, seed
             }
         }
     }
-    compact(
-        positions,
-        triangles,
-        match shape {
-            Shape::Rectangle => Metric::Euclidean,
-            Shape::Holed => Metric::Intrinsic,
-        },
-    )
+    triangles
 }
 
 /// Drops unused vertices and renumbers.
