@@ -133,32 +133,36 @@ fn load_image(path: &Path) -> Result<image::RgbaImage> {
 }
 
 fn render(image: &Path, rig: &Path, output: &Path, density: Option<usize>) -> Result<()> {
-    let progress = progress::Steps::new(4);
-    progress.step("reading");
     let project = load_project(rig)?;
     let picture = load_image(image)?;
+    warp_and_save(&picture, &project, density, output)?;
+    Ok(())
+}
+
+/// Meshes, weights, warps and writes `picture` by `project`, with a progress counter;
+/// returns the rig.
+fn warp_and_save(
+    picture: &image::RgbaImage,
+    project: &Project,
+    density: Option<usize>,
+    output: &Path,
+) -> Result<weights_core::Rig> {
+    let progress = progress::Steps::new(3);
     progress.step("meshing and weighting");
-    let prepared = pipeline::prepare(&picture, &project, density)?;
+    let prepared = pipeline::prepare(picture, project, density)?;
     progress.step("rendering");
-    let warped = pipeline::warp(&picture, &prepared.rig)?;
+    let warped = pipeline::warp(picture, &prepared.rig)?;
     progress.step("writing");
     render::save_png_atomic(output, &warped)?;
     progress.finish();
-    Ok(())
+    Ok(prepared.rig)
 }
 
 fn demo(output: &Path) -> Result<()> {
     let picture = render::decode_image(DEFAULT_IMAGE, &render::ImageLimits::default())?;
     let project = Project::from_json(DEFAULT_RIG).context("built-in rig")?;
-    let progress = progress::Steps::new(3);
-    progress.step("meshing and weighting");
-    let prepared = pipeline::prepare(&picture, &project, None)?;
-    progress.step("rendering");
-    let warped = pipeline::warp(&picture, &prepared.rig)?;
-    progress.step("writing");
-    render::save_png_atomic(output, &warped)?;
-    progress.finish();
-    let stats = prepared.rig.stats();
+    let rig = warp_and_save(&picture, &project, None, output)?;
+    let stats = rig.stats();
     println!(
         "Warped the built-in lizard ({} × {} px, {} mesh vertices, {} handles + {} virtual) into {}",
         picture.width(),
