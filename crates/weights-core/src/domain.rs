@@ -465,6 +465,9 @@ impl Domain {
                 pos = true;
             } else if cross < -tol {
                 neg = true;
+            } else if (b - a).dot(c - b) < 0.0 {
+                // The boundary doubles back on itself: a cut.
+                return false;
             }
         }
         !(pos && neg)

@@ -646,3 +646,129 @@ fn a_fixed_boundary_stays_put() {
         }
     }
 }
+
+#[test]
+fn a_cut_separates_its_two_sides() {
+    // A 20 × 20 square with a vertical slit from the top edge down to y = 14 at x = 10:
+    // the vertices on the slit are doubled, one copy for each side.
+    let n = 20usize;
+    let mut positions: Vec<DVec2> = Vec::new();
+    for y in 0..=n {
+        for x in 0..=n {
+            positions.push(DVec2::new(x as f64, y as f64));
+        }
+    }
+    let id = |x: usize, y: usize| (y * (n + 1) + x) as u32;
+    let mut twin = std::collections::HashMap::new();
+    for y in 0..14 {
+        twin.insert(id(10, y), positions.len() as u32);
+        positions.push(DVec2::new(10.0, y as f64));
+    }
+    let mut triangles = Vec::new();
+    for y in 0..n {
+        for x in 0..n {
+            // Cells right of the slit use the twin copies of its vertices.
+            let v = |xx: usize, yy: usize| {
+                let i = id(xx, yy);
+                if x == 10 && xx == 10 {
+                    twin.get(&i).copied().unwrap_or(i)
+                } else {
+                    i
+                }
+            };
+            let (a, b, c, d) = (v(x, y), v(x + 1, y), v(x + 1, y + 1), v(x, y + 1));
+            triangles.push([a, b, c]);
+            triangles.push([a, c, d]);
+        }
+    }
+    let domain = Domain::new(positions, triangles, Metric::Intrinsic).expect("valid");
+    assert!(!domain.is_convex(), "a slit makes the boundary non-convex");
+    let handles = vec![
+        Handle::point(DVec2::new(8.0, 2.0)),
+        Handle::point(DVec2::new(12.0, 2.0)),
+    ];
+    let rig = Rig::new(domain.clone(), handles, RigOptions::default()).expect("valid");
+    check_invariants(&rig).expect("invariants");
+    // The handles are 4 px apart in the plane but must go around the slit's end.
+    let d = rig.distances_from_node(0);
+    let other = rig.nodes()[1].vertex as usize;
+    assert!(
+        d[other] > 2.0 * 12.0,
+        "distance across the slit {} should go around it",
+        d[other]
+    );
+    // Across the slit the left handle weighs far less than straight-line distance
+    // (which ignores the cut) would make it.
+    let right = domain
+        .positions()
+        .iter()
+        .position(|p| *p == DVec2::new(11.0, 2.0))
+        .expect("sample");
+    let weight_of_left = |rig: &Rig| {
+        rig.weights(right)
+            .find(|&(k, _)| k == 0)
+            .map_or(0.0, |(_, w)| w)
+    };
+    let straight = Domain::new(
+        domain.positions().to_vec(),
+        domain.triangles().to_vec(),
+        Metric::Euclidean,
+    )
+    .expect("valid");
+    let handles = rig.handles().to_vec();
+    let euclidean = Rig::new(straight, handles, RigOptions::default()).expect("valid");
+    let (through, around) = (weight_of_left(&euclidean), weight_of_left(&rig));
+    assert!(through > 0.01, "straight-line weight {through}");
+    assert!(
+        around < through / 10.0,
+        "weight around the slit {around} vs straight {through}"
+    );
+}
+
+#[test]
+fn the_warp_does_not_depend_on_where_the_origin_is() {
+    let domain = grid_domain(24, 18, 1.0, 0.25, Shape::Holed, 12);
+    let shift = DVec2::new(1000.0, -250.0);
+    let moved_domain = Domain::new(
+        domain.positions().iter().map(|p| *p + shift).collect(),
+        domain.triangles().to_vec(),
+        Metric::Intrinsic,
+    )
+    .expect("valid");
+    let mut rng = Rng(12);
+    let handles = random_handles(&domain, &mut rng, 3, 1);
+    let posed = |h: &Handle, offset: DVec2| match *h {
+        Handle::Point { rest, .. } => Handle::Point {
+            rest: rest + offset,
+            transform: Similarity {
+                translation: DVec2::new(1.5, -2.0),
+                rotation: 0.4,
+                scale: 0.9,
+            },
+        },
+        Handle::Bar { rest, .. } => Handle::Bar {
+            rest: rest.map(|p| p + offset),
+            pose: [
+                rest[0] + offset + DVec2::new(1.0, 1.0),
+                rest[1] + offset + DVec2::new(-2.0, 0.5),
+            ],
+        },
+    };
+    let a = Rig::new(
+        domain,
+        handles.iter().map(|h| posed(h, DVec2::ZERO)).collect(),
+        RigOptions::default(),
+    )
+    .expect("valid")
+    .deform();
+    let b = Rig::new(
+        moved_domain,
+        handles.iter().map(|h| posed(h, shift)).collect(),
+        RigOptions::default(),
+    )
+    .expect("valid")
+    .deform();
+    for (p, q) in a.iter().zip(&b) {
+        assert!((*p + shift - *q).length() < 1e-6, "{p} + shift != {q}");
+    }
+}
