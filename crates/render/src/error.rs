@@ -154,4 +154,12 @@ pub enum RenderError {
         /// Requested height in pixels.
         height: u32,
     },
+
+    /// No GPU adapter or device could be opened (not even a software one).
+    #[error("no GPU adapter: {0} (install a Vulkan driver such as Mesa's lavapipe)")]
+    NoAdapter(String),
+
+    /// The GPU failed while drawing or reading back.
+    #[error("GPU error: {0}")]
+    Gpu(String),
 }

@@ -1,0 +1,104 @@
+//! The GPU path (wgpu, on a software adapter where there is no GPU) draws what the CPU
+//! path draws. Needs a wgpu adapter: `scripts/setup.sh` installs Mesa's lavapipe.
+
+mod support;
+
+use glam::Vec2;
+use render::{GpuContext, RasterOptions, WarpMesh, warp_cpu};
+use support::{Grid, gradient_texture, swirl};
+
+/// Share of premultiplied channels that differ by more than `tolerance`, and the
+/// largest difference (the colour under a fully transparent pixel does not count).
+fn compare(a: &image::RgbaImage, b: &image::RgbaImage, tolerance: u8) -> (f64, u8) {
+    let premultiplied = |p: &image::Rgba<u8>| {
+        let m = |c: u8| ((u16::from(c) * u16::from(p[3]) + 127) / 255) as u8;
+        [m(p[0]), m(p[1]), m(p[2]), p[3]]
+    };
+    let mut over = 0usize;
+    let mut worst = 0u8;
+    for (x, y) in a.pixels().zip(b.pixels()) {
+        for (u, v) in premultiplied(x).into_iter().zip(premultiplied(y)) {
+            let d = u.abs_diff(v);
+            worst = worst.max(d);
+            if d > tolerance {
+                over += 1;
+            }
+        }
+    }
+    (over as f64 / a.as_raw().len() as f64, worst)
+}
+
+#[test]
+fn gpu_and_cpu_draw_the_same_warp() {
+    let gpu = GpuContext::new().expect("a wgpu adapter (run scripts/setup.sh for lavapipe)");
+    eprintln!("adapter: {:?}", gpu.adapter_info());
+    let size = 256u32;
+    let texture = gradient_texture(size);
+    let grid = Grid::new(size as f32, size as f32, 24, 24);
+    let cases: [(&str, Vec<Vec2>); 2] = [
+        ("identity", grid.positions.clone()),
+        ("swirl", swirl(&grid.positions, size as f32)),
+    ];
+    for (name, deformed) in cases {
+        let mesh = WarpMesh {
+            rest: &grid.positions,
+            deformed: &deformed,
+            triangles: &grid.triangles,
+        };
+        let cpu = warp_cpu(&texture, &mesh, size, size, &RasterOptions::default()).expect("cpu");
+        let out = gpu.warp(&texture, &mesh, size, size).expect("gpu");
+        // Rasterisation rules are the same; filtering precision differs a little
+        // (8-bit premultiplied texels and the GPU's sub-texel precision).
+        let (share, worst) = compare(&cpu, &out, 3);
+        assert!(
+            share < 0.01,
+            "{name}: {:.3}% of channels differ by more than 3 (largest {worst})",
+            share * 100.0
+        );
+    }
+}
+
+#[test]
+fn gpu_identity_of_an_opaque_image_is_exact() {
+    let gpu = GpuContext::new().expect("a wgpu adapter (run scripts/setup.sh for lavapipe)");
+    let size = 128u32;
+    let texture = image::RgbaImage::from_fn(size, size, |x, y| {
+        image::Rgba([(x * 2) as u8, (y * 2) as u8, ((x * y) % 251) as u8, 255])
+    });
+    let grid = Grid::new(size as f32, size as f32, 9, 7);
+    let mesh = WarpMesh {
+        rest: &grid.positions,
+        deformed: &grid.positions,
+        triangles: &grid.triangles,
+    };
+    let out = gpu.warp(&texture, &mesh, size, size).expect("gpu");
+    let (share, worst) = compare(&texture, &out, 0);
+    assert_eq!(share, 0.0, "largest difference {worst}");
+}
+
+#[test]
+fn gpu_refuses_bad_input() {
+    let gpu = GpuContext::new().expect("a wgpu adapter (run scripts/setup.sh for lavapipe)");
+    let texture = gradient_texture(16);
+    let rest = [Vec2::ZERO, Vec2::X, Vec2::Y];
+    let bad = [Vec2::ZERO, Vec2::new(f32::NAN, 0.0), Vec2::Y];
+    let mesh = WarpMesh {
+        rest: &rest,
+        deformed: &bad,
+        triangles: &[[0, 1, 2]],
+    };
+    assert!(gpu.warp(&texture, &mesh, 16, 16).is_err());
+    let mesh = WarpMesh {
+        rest: &rest,
+        deformed: &rest,
+        triangles: &[[0, 1, 5]],
+    };
+    assert!(gpu.warp(&texture, &mesh, 16, 16).is_err());
+    let mesh = WarpMesh {
+        rest: &rest,
+        deformed: &rest,
+        triangles: &[[0, 1, 2]],
+    };
+    assert!(gpu.warp(&texture, &mesh, 0, 16).is_err());
+    assert!(gpu.warp(&texture, &mesh, 1 << 20, 16).is_err());
+}
