@@ -41,6 +41,33 @@ fn render_matches_the_golden_image() {
 }
 
 #[test]
+fn the_gpu_draws_what_the_cpu_draws() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let (cpu, gpu) = (dir.path().join("cpu.png"), dir.path().join("gpu.png"));
+    let (image, rig) = (data("dino.png"), data("dino-rig.json"));
+    for (out, flag) in [(&cpu, None), (&gpu, Some("--gpu"))] {
+        let mut args = vec![
+            os("render"),
+            image.as_os_str(),
+            os("--rig"),
+            rig.as_os_str(),
+            os("-o"),
+            out.as_os_str(),
+        ];
+        args.extend(flag.map(os));
+        ok(&args);
+    }
+    // Same rasterisation rules; the GPU blends transforms in f32 and filters with
+    // 8-bit texels, so edges may land a pixel apart here and there.
+    let (worst, share) = difference(&load(&cpu), &load(&gpu), 8);
+    assert!(
+        share < 0.01,
+        "{:.3}% of channels differ by more than 8 (largest {worst})",
+        share * 100.0
+    );
+}
+
+#[test]
 fn identity_rig_gives_back_the_input() {
     let dir = tempfile::tempdir().expect("temp dir");
     let out = dir.path().join("same.png");

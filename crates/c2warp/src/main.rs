@@ -43,6 +43,10 @@ enum Command {
         /// Target number of mesh vertices (overrides the rig's `density`).
         #[arg(long)]
         density: Option<usize>,
+        /// Draw with the GPU (a software Vulkan driver works too), blending the handle
+        /// transforms in the vertex shader, instead of on the CPU.
+        #[arg(long)]
+        gpu: bool,
     },
     /// Write the nodes actually used and every mesh vertex's non-zero weights as JSON.
     Weights {
@@ -99,7 +103,8 @@ fn main() -> ExitCode {
             rig,
             output,
             density,
-        } => render(&image, &rig, &output, density),
+            gpu,
+        } => render(&image, &rig, &output, density, gpu),
         Command::Weights {
             source,
             rig,
@@ -132,10 +137,16 @@ fn load_image(path: &Path) -> Result<image::RgbaImage> {
     Ok(render::load_image(path, &render::ImageLimits::default())?)
 }
 
-fn render(image: &Path, rig: &Path, output: &Path, density: Option<usize>) -> Result<()> {
+fn render(
+    image: &Path,
+    rig: &Path,
+    output: &Path,
+    density: Option<usize>,
+    gpu: bool,
+) -> Result<()> {
     let project = load_project(rig)?;
     let picture = load_image(image)?;
-    warp_and_save(&picture, &project, density, output)?;
+    warp_and_save(&picture, &project, density, output, gpu)?;
     Ok(())
 }
 
@@ -146,12 +157,17 @@ fn warp_and_save(
     project: &Project,
     density: Option<usize>,
     output: &Path,
+    gpu: bool,
 ) -> Result<weights_core::Rig> {
     let progress = progress::Steps::new(3);
     progress.step("meshing and weighting");
     let prepared = pipeline::prepare(picture, project, density)?;
     progress.step("rendering");
-    let warped = pipeline::warp(picture, &prepared.rig)?;
+    let warped = if gpu {
+        pipeline::warp_gpu(picture, &prepared.rig)?
+    } else {
+        pipeline::warp(picture, &prepared.rig)?
+    };
     progress.step("writing");
     render::save_png_atomic(output, &warped)?;
     progress.finish();
@@ -161,7 +177,7 @@ fn warp_and_save(
 fn demo(output: &Path) -> Result<()> {
     let picture = render::decode_image(DEFAULT_IMAGE, &render::ImageLimits::default())?;
     let project = Project::from_json(DEFAULT_RIG).context("built-in rig")?;
-    let rig = warp_and_save(&picture, &project, None, output)?;
+    let rig = warp_and_save(&picture, &project, None, output, false)?;
     let stats = rig.stats();
     println!(
         "Warped the built-in lizard ({} × {} px, {} mesh vertices, {} handles + {} virtual) into {}",

@@ -129,6 +129,31 @@ pub fn prepare(image: &RgbaImage, project: &Project, density: Option<usize>) -> 
     Ok(Prepared { rig })
 }
 
+/// The image warped by the rig's current pose on the GPU (or a software adapter): the
+/// vertex shader blends the node transforms with the sparse weights.
+///
+/// # Errors
+/// No adapter, or a GPU failure.
+pub fn warp_gpu(image: &RgbaImage, rig: &Rig) -> Result<RgbaImage> {
+    let gpu = render::GpuContext::new()?;
+    let (rows, nodes, weights) = rig.weight_table();
+    let rest: Vec<Vec2> = rig
+        .domain()
+        .positions()
+        .iter()
+        .map(|p| p.as_vec2())
+        .collect();
+    let mesh = render::SkinnedMesh {
+        rest: &rest,
+        rows: &rows,
+        nodes: &nodes,
+        weights: &weights,
+        triangles: rig.domain().triangles(),
+    };
+    let (w, h) = image.dimensions();
+    Ok(gpu.warp_skinned(image, &mesh, &rig.node_affines(), w, h)?)
+}
+
 /// The image warped by the rig's current pose, at the image's full resolution.
 ///
 /// # Errors

@@ -15,7 +15,9 @@ pub struct GpuContext {
     queue: wgpu::Queue,
     info: wgpu::AdapterInfo,
     pipeline: wgpu::RenderPipeline,
+    skinned: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
+    skin_layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
 }
 
@@ -57,6 +59,60 @@ fn fs(in: Out) -> @location(0) vec4<f32> {
     return textureSample(source, linear, in.uv);
 }
 ";
+
+/// The skinned variant: each vertex blends its nodes' affine transforms (linear blend
+/// skinning) from storage buffers, so a new pose uploads only the transforms.
+const SKINNED_SHADER: &str = r"
+struct Sizes { output: vec2<f32>, texture: vec2<f32> };
+@group(0) @binding(0) var<uniform> sizes: Sizes;
+@group(0) @binding(1) var source: texture_2d<f32>;
+@group(0) @binding(2) var linear: sampler;
+@group(1) @binding(0) var<storage, read> rows: array<u32>;
+@group(1) @binding(1) var<storage, read> entries: array<vec2<u32>>;
+@group(1) @binding(2) var<storage, read> transforms: array<vec4<f32>>;
+
+struct Out { @builtin(position) clip: vec4<f32>, @location(0) uv: vec2<f32> };
+
+@vertex
+fn vs(@builtin(vertex_index) index: u32, @location(0) rest: vec2<f32>) -> Out {
+    var position = vec2<f32>(0.0, 0.0);
+    for (var i = rows[index]; i < rows[index + 1u]; i = i + 1u) {
+        let entry = entries[i];
+        let w = bitcast<f32>(entry.y);
+        let linear_part = transforms[2u * entry.x];
+        let shift = transforms[2u * entry.x + 1u];
+        position += w * (linear_part.xy * rest.x + linear_part.zw * rest.y + shift.xy);
+    }
+    var out: Out;
+    let ndc = position / sizes.output * 2.0 - vec2<f32>(1.0, 1.0);
+    out.clip = vec4<f32>(ndc.x, -ndc.y, 0.0, 1.0);
+    out.uv = rest / sizes.texture;
+    return out;
+}
+
+@fragment
+fn fs(in: Out) -> @location(0) vec4<f32> {
+    return textureSample(source, linear, in.uv);
+}
+";
+
+/// A mesh whose vertices are moved by blending node transforms on the GPU.
+pub struct SkinnedMesh<'a> {
+    /// Rest positions in source pixels (also the texture coordinates).
+    pub rest: &'a [Vec2],
+    /// Row `v` of the weights is `nodes[rows[v]..rows[v + 1]]` (length: vertices + 1).
+    pub rows: &'a [u32],
+    /// Node index of each weight.
+    pub nodes: &'a [u32],
+    /// The weights (each row sums to one).
+    pub weights: &'a [f32],
+    /// Triangles as vertex index triples.
+    pub triangles: &'a [[u32; 3]],
+}
+
+/// An affine transform of pixel coordinates, `x ↦ A x + t`, as
+/// `[a₀₀, a₁₀, a₀₁, a₁₁, t₀, t₁]` (the columns of `A`, then `t`).
+pub type Affine = [f32; 6];
 
 const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
@@ -118,40 +174,36 @@ impl GpuContext {
                 },
             ],
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("warp"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("warp"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs"),
-                compilation_options: Default::default(),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: std::mem::size_of::<Vertex>() as u64,
-                    step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &wgpu::vertex_attr_array![0 => Float32x2, 1 => Float32x2],
-                })],
+        let storage = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::VERTEX,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: true },
+                has_dynamic_offset: false,
+                min_binding_size: None,
             },
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: None,
-            multisample: wgpu::MultisampleState::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: FORMAT,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
+            count: None,
+        };
+        let skin_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("skin"),
+            entries: &[storage(0), storage(1), storage(2)],
         });
+        let pipeline = make_pipeline(
+            &device,
+            &module,
+            &[Some(&layout)],
+            &[wgpu::VertexFormat::Float32x2, wgpu::VertexFormat::Float32x2],
+        );
+        let skinned_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("skinned warp"),
+            source: wgpu::ShaderSource::Wgsl(SKINNED_SHADER.into()),
+        });
+        let skinned = make_pipeline(
+            &device,
+            &skinned_module,
+            &[Some(&layout), Some(&skin_layout)],
+            &[wgpu::VertexFormat::Float32x2],
+        );
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("warp"),
             mag_filter: wgpu::FilterMode::Linear,
@@ -163,7 +215,9 @@ impl GpuContext {
             queue,
             info: adapter.get_info(),
             pipeline,
+            skinned,
             layout,
+            skin_layout,
             sampler,
         })
     }
@@ -187,6 +241,145 @@ impl GpuContext {
         height: u32,
     ) -> Result<RgbaImage, RenderError> {
         mesh.validate()?;
+        let vertices: Vec<Vertex> = mesh
+            .triangles
+            .iter()
+            .flat_map(|t| t.map(|v| v as usize))
+            .map(|v| Vertex {
+                position: clamp(mesh.deformed[v]),
+                rest: mesh.rest[v].to_array(),
+            })
+            .collect();
+        let vertex_buffer = self.buffer(
+            "vertices",
+            bytemuck::cast_slice(&vertices),
+            wgpu::BufferUsages::VERTEX,
+        );
+        self.draw(texture, width, height, |pass| {
+            pass.set_pipeline(&self.pipeline);
+            pass.set_vertex_buffer(0, vertex_buffer.slice(..));
+            pass.draw(0..vertices.len() as u32, 0..1);
+        })
+    }
+
+    /// Draws `mesh` with every vertex moved by the blend of its nodes' `transforms`
+    /// (computed in the vertex shader), textured with `texture`: the same picture as
+    /// [`GpuContext::warp`] of the blended positions.
+    ///
+    /// # Errors
+    /// Rows or triangles that refer to missing vertices, nodes or weights; non-finite
+    /// transforms or weights; an empty texture; a size the device cannot hold.
+    pub fn warp_skinned(
+        &self,
+        texture: &RgbaImage,
+        mesh: &SkinnedMesh,
+        transforms: &[Affine],
+        width: u32,
+        height: u32,
+    ) -> Result<RgbaImage, RenderError> {
+        let n = mesh.rest.len();
+        let bad = |what: &str| RenderError::Gpu(format!("invalid skinned mesh: {what}"));
+        if mesh.rows.len() != n + 1 || mesh.nodes.len() != mesh.weights.len() {
+            return Err(bad("row table lengths"));
+        }
+        if mesh.rows.windows(2).any(|w| w[0] > w[1]) || mesh.rows[n] as usize != mesh.nodes.len() {
+            return Err(bad("row offsets"));
+        }
+        if mesh.nodes.iter().any(|&k| k as usize >= transforms.len()) {
+            return Err(bad("a node without a transform"));
+        }
+        if mesh.triangles.iter().flatten().any(|&v| v as usize >= n) {
+            return Err(bad("a triangle index out of range"));
+        }
+        if !transforms
+            .iter()
+            .flatten()
+            .chain(mesh.weights)
+            .all(|x| x.is_finite())
+            || !mesh.rest.iter().all(|p| p.is_finite())
+        {
+            return Err(bad("non-finite values"));
+        }
+        let entries: Vec<[u32; 2]> = mesh
+            .nodes
+            .iter()
+            .zip(mesh.weights)
+            .map(|(&k, &w)| [k, w.to_bits()])
+            .collect();
+        let packed: Vec<[f32; 4]> = transforms
+            .iter()
+            .flat_map(|t| [[t[0], t[1], t[2], t[3]], [t[4], t[5], 0.0, 0.0]])
+            .collect();
+        let storage = wgpu::BufferUsages::STORAGE;
+        // Storage buffers may not be empty.
+        let rows = self.buffer("rows", bytemuck::cast_slice(mesh.rows), storage);
+        let entries = self.buffer(
+            "entries",
+            bytemuck::cast_slice(&nonempty(entries, [0, 0])),
+            storage,
+        );
+        let packed = self.buffer(
+            "transforms",
+            bytemuck::cast_slice(&nonempty(packed, [0.0; 4])),
+            storage,
+        );
+        let skin = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("skin"),
+            layout: &self.skin_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: rows.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: entries.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: packed.as_entire_binding(),
+                },
+            ],
+        });
+        let rest: Vec<[f32; 2]> = mesh.rest.iter().map(|p| p.to_array()).collect();
+        let vertex_buffer = self.buffer(
+            "rest",
+            bytemuck::cast_slice(&rest),
+            wgpu::BufferUsages::VERTEX,
+        );
+        let indices: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
+        let index_buffer = self.buffer(
+            "indices",
+            bytemuck::cast_slice(&indices),
+            wgpu::BufferUsages::INDEX,
+        );
+        self.draw(texture, width, height, |pass| {
+            pass.set_pipeline(&self.skinned);
+            pass.set_bind_group(1, &skin, &[]);
+            pass.set_vertex_buffer(0, vertex_buffer.slice(..));
+            pass.set_index_buffer(index_buffer.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..indices.len() as u32, 0, 0..1);
+        })
+    }
+
+    fn buffer(&self, label: &str, contents: &[u8], usage: wgpu::BufferUsages) -> wgpu::Buffer {
+        self.device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage,
+            })
+    }
+
+    /// Uploads the texture, runs `record` in a render pass into a `width × height`
+    /// target cleared to transparent, and reads the target back, unpremultiplied.
+    fn draw(
+        &self,
+        texture: &RgbaImage,
+        width: u32,
+        height: u32,
+        record: impl FnOnce(&mut wgpu::RenderPass<'_>),
+    ) -> Result<RgbaImage, RenderError> {
         if texture.width() == 0 || texture.height() == 0 {
             return Err(RenderError::EmptyTexture {
                 width: texture.width(),
@@ -241,33 +434,15 @@ impl GpuContext {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
         });
-        let vertices: Vec<Vertex> = mesh
-            .triangles
-            .iter()
-            .flat_map(|t| t.map(|v| v as usize))
-            .map(|v| Vertex {
-                position: clamp(mesh.deformed[v]),
-                rest: mesh.rest[v].to_array(),
-            })
-            .collect();
-        let vertex_buffer = self
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("vertices"),
-                contents: bytemuck::cast_slice(&vertices),
-                usage: wgpu::BufferUsages::VERTEX,
-            });
         let sizes = Sizes {
             output: [width as f32, height as f32],
             texture: [texture.width() as f32, texture.height() as f32],
         };
-        let uniform = self
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("sizes"),
-                contents: bytemuck::bytes_of(&sizes),
-                usage: wgpu::BufferUsages::UNIFORM,
-            });
+        let uniform = self.buffer(
+            "sizes",
+            bytemuck::bytes_of(&sizes),
+            wgpu::BufferUsages::UNIFORM,
+        );
         let view = source.create_view(&Default::default());
         let bind_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("warp"),
@@ -315,10 +490,8 @@ impl GpuContext {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &bind_group, &[]);
-            pass.set_vertex_buffer(0, vertex_buffer.slice(..));
-            pass.draw(0..vertices.len() as u32, 0..1);
+            record(&mut pass);
         }
         encoder.copy_texture_to_buffer(
             wgpu::TexelCopyTextureInfo {
@@ -368,6 +541,72 @@ impl GpuContext {
         }
         Ok(out)
     }
+}
+
+/// A render pipeline drawing into an RGBA8 target with no blending, vertex attributes
+/// `attributes` in one interleaved buffer.
+fn make_pipeline(
+    device: &wgpu::Device,
+    module: &wgpu::ShaderModule,
+    layouts: &[Option<&wgpu::BindGroupLayout>],
+    attributes: &[wgpu::VertexFormat],
+) -> wgpu::RenderPipeline {
+    let mut offset = 0;
+    let attributes: Vec<wgpu::VertexAttribute> = attributes
+        .iter()
+        .enumerate()
+        .map(|(i, &format)| {
+            let a = wgpu::VertexAttribute {
+                format,
+                offset,
+                shader_location: i as u32,
+            };
+            offset += format.size();
+            a
+        })
+        .collect();
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("warp"),
+        bind_group_layouts: layouts,
+        immediate_size: 0,
+    });
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("warp"),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs"),
+            compilation_options: Default::default(),
+            buffers: &[Some(wgpu::VertexBufferLayout {
+                array_stride: offset,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &attributes,
+            })],
+        },
+        primitive: wgpu::PrimitiveState::default(),
+        depth_stencil: None,
+        multisample: wgpu::MultisampleState::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some("fs"),
+            compilation_options: Default::default(),
+            targets: &[Some(wgpu::ColorTargetState {
+                format: FORMAT,
+                blend: None,
+                write_mask: wgpu::ColorWrites::ALL,
+            })],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// `v`, or one `filler` element if `v` is empty.
+fn nonempty<T: Copy>(mut v: Vec<T>, filler: T) -> Vec<T> {
+    if v.is_empty() {
+        v.push(filler);
+    }
+    v
 }
 
 /// Keeps far-away positions finite for the rasteriser.

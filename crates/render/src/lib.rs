@@ -29,7 +29,7 @@ mod warp;
 
 pub use atomic::{save_png_atomic, write_atomic};
 pub use error::RenderError;
-pub use gpu::GpuContext;
+pub use gpu::{Affine, GpuContext, SkinnedMesh};
 pub use image_io::{ImageLimits, decode_image, load_image};
 pub use mesh::WarpMesh;
 pub use warp::{RasterOptions, coverage_counts, warp_cpu};

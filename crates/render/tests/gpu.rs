@@ -102,3 +102,103 @@ fn gpu_refuses_bad_input() {
     assert!(gpu.warp(&texture, &mesh, 0, 16).is_err());
     assert!(gpu.warp(&texture, &mesh, 1 << 20, 16).is_err());
 }
+
+/// Rows of weights over `centres`: each vertex weighs its three nearest centres by
+/// inverse distance, normalised.
+fn weight_rows(positions: &[Vec2], centres: &[Vec2]) -> (Vec<u32>, Vec<u32>, Vec<f32>) {
+    let (mut rows, mut nodes, mut weights) = (vec![0u32], Vec::new(), Vec::new());
+    for p in positions {
+        let mut near: Vec<(f32, u32)> = centres
+            .iter()
+            .enumerate()
+            .map(|(k, c)| ((*c - *p).length(), k as u32))
+            .collect();
+        near.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let raw: Vec<f32> = near[..3].iter().map(|(d, _)| 1.0 / (d + 1.0)).collect();
+        let sum: f32 = raw.iter().sum();
+        for (i, (_, k)) in near[..3].iter().enumerate() {
+            nodes.push(*k);
+            weights.push(raw[i] / sum);
+        }
+        rows.push(nodes.len() as u32);
+    }
+    (rows, nodes, weights)
+}
+
+#[test]
+fn vertex_shader_skinning_matches_blending_on_the_cpu() {
+    let gpu = GpuContext::new().expect("a wgpu adapter (run scripts/setup.sh for lavapipe)");
+    let size = 256u32;
+    let texture = gradient_texture(size);
+    let grid = Grid::new(size as f32, size as f32, 20, 20);
+    let centres = [
+        Vec2::new(40.0, 40.0),
+        Vec2::new(200.0, 60.0),
+        Vec2::new(128.0, 128.0),
+        Vec2::new(60.0, 210.0),
+        Vec2::new(220.0, 220.0),
+    ];
+    // Small rotations, scales and shifts about each centre.
+    let transforms: Vec<[f32; 6]> = centres
+        .iter()
+        .enumerate()
+        .map(|(i, c)| {
+            let angle = 0.08 * (i as f32 - 2.0);
+            let scale = 1.0 + 0.03 * i as f32;
+            let a = glam::Mat2::from_angle(angle) * scale;
+            let shift = Vec2::new(6.0 - 3.0 * i as f32, 2.0 * i as f32 - 4.0);
+            let t = *c + shift - a * *c;
+            [a.x_axis.x, a.x_axis.y, a.y_axis.x, a.y_axis.y, t.x, t.y]
+        })
+        .collect();
+    let (rows, nodes, weights) = weight_rows(&grid.positions, &centres);
+    let blended: Vec<Vec2> = grid
+        .positions
+        .iter()
+        .enumerate()
+        .map(|(v, p)| {
+            (rows[v] as usize..rows[v + 1] as usize)
+                .map(|i| {
+                    let t = transforms[nodes[i] as usize];
+                    let q = Vec2::new(t[0], t[1]) * p.x
+                        + Vec2::new(t[2], t[3]) * p.y
+                        + Vec2::new(t[4], t[5]);
+                    weights[i] * q
+                })
+                .sum()
+        })
+        .collect();
+    let cpu = warp_cpu(
+        &texture,
+        &WarpMesh {
+            rest: &grid.positions,
+            deformed: &blended,
+            triangles: &grid.triangles,
+        },
+        size,
+        size,
+        &RasterOptions::default(),
+    )
+    .expect("cpu");
+    let skinned = render::SkinnedMesh {
+        rest: &grid.positions,
+        rows: &rows,
+        nodes: &nodes,
+        weights: &weights,
+        triangles: &grid.triangles,
+    };
+    let out = gpu
+        .warp_skinned(&texture, &skinned, &transforms, size, size)
+        .expect("gpu");
+    let (share, worst) = compare(&cpu, &out, 3);
+    assert!(
+        share < 0.01,
+        "{:.3}% of channels differ by more than 3 (largest {worst})",
+        share * 100.0
+    );
+    // The same rows with a node missing its transform are refused.
+    assert!(
+        gpu.warp_skinned(&texture, &skinned, &transforms[..2], size, size)
+            .is_err()
+    );
+}

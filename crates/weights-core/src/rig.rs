@@ -658,6 +658,38 @@ impl Rig {
         self.weights.row(v, &self.partition.owner)
     }
 
+    /// The normalised weights of every sample as compressed rows for a GPU to blend:
+    /// row `v` is `nodes[rows[v]..rows[v + 1]]` with `weights[…]` (f32; each row sums
+    /// to one up to f32 rounding).
+    pub fn weight_table(&self) -> (Vec<u32>, Vec<u32>, Vec<f32>) {
+        let n = self.domain.len();
+        let mut rows = Vec::with_capacity(n + 1);
+        let mut nodes = Vec::with_capacity(self.weights.nonzeros() + n / 64);
+        let mut weights = Vec::with_capacity(nodes.capacity());
+        rows.push(0);
+        for v in 0..n {
+            for (k, w) in self.weights(v) {
+                nodes.push(k as u32);
+                weights.push(w as f32);
+            }
+            rows.push(nodes.len() as u32);
+        }
+        (rows, nodes, weights)
+    }
+
+    /// Every node's transform as `[a₀₀, a₁₀, a₀₁, a₁₁, t₀, t₁]` (columns of the linear
+    /// part, then the translation) in f32: what a GPU needs per pose.
+    pub fn node_affines(&self) -> Vec<[f32; 6]> {
+        self.affines
+            .iter()
+            .map(|a| {
+                let m = a.matrix2;
+                let t = a.translation;
+                [m.x_axis.x, m.x_axis.y, m.y_axis.x, m.y_axis.y, t.x, t.y].map(|x| x as f32)
+            })
+            .collect()
+    }
+
     /// Distances from node `k` to every sample (∞ where unreachable), in the rig's
     /// metric: for heat maps, isolines and tests.
     pub fn distances_from_node(&self, k: usize) -> Vec<f64> {
