@@ -14,7 +14,7 @@ use crate::harmonic::{dual_edges, harmonic_coordinates};
 use crate::transform::Similarity;
 use crate::virtual_handles::insert_virtual_handles;
 use crate::voronoi::{NONE, Partition};
-use crate::weights::{Change, Scratch, Weights, ball};
+use crate::weights::{Change, Weights, ball};
 
 /// A handle the user places.
 #[derive(Clone, Debug, PartialEq)]
@@ -694,13 +694,7 @@ impl Rig {
     /// metric: for heat maps, isolines and tests.
     pub fn distances_from_node(&self, k: usize) -> Vec<f64> {
         let mut out = vec![f64::INFINITY; self.domain.len()];
-        let mut scratch = Scratch::new(self.domain.len());
-        for (v, d) in ball(
-            &self.domain,
-            self.nodes[k].vertex,
-            f64::INFINITY,
-            &mut scratch,
-        ) {
+        for (v, d) in ball(&self.domain, self.nodes[k].vertex, f64::INFINITY) {
             out[v as usize] = d;
         }
         out

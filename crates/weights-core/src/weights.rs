@@ -17,40 +17,40 @@ use crate::basis::Basis;
 use crate::domain::{Domain, Metric};
 use crate::voronoi::{Entry, NONE, Partition};
 
-/// Reusable per-thread buffers for bounded Dijkstra searches.
-pub(crate) struct Scratch {
+/// Reusable buffers for bounded Dijkstra searches, one set per thread. `dist` is all
+/// infinite between searches (each search resets what it touched).
+struct Scratch {
     dist: Vec<f64>,
     touched: Vec<u32>,
     heap: BinaryHeap<Entry>,
 }
 
-impl Scratch {
-    pub fn new(n: usize) -> Self {
-        Self {
-            dist: vec![f64::INFINITY; n],
+thread_local! {
+    static SCRATCH: std::cell::RefCell<Scratch> = const {
+        std::cell::RefCell::new(Scratch {
+            dist: Vec::new(),
             touched: Vec::new(),
             heap: BinaryHeap::new(),
-        }
-    }
+        })
+    };
 }
 
 /// The samples within `radius` of node sample `source` (and the source itself), with
 /// their distances, in order of distance for the intrinsic metric.
-pub(crate) fn ball(
-    domain: &Domain,
-    source: u32,
-    radius: f64,
-    scratch: &mut Scratch,
-) -> Vec<(u32, f64)> {
+pub(crate) fn ball(domain: &Domain, source: u32, radius: f64) -> Vec<(u32, f64)> {
     let mut out = Vec::new();
     match domain.metric() {
-        Metric::Intrinsic => {
-            let graph = domain.graph();
+        Metric::Intrinsic => SCRATCH.with(|scratch| {
+            let mut scratch = scratch.borrow_mut();
             let Scratch {
                 dist,
                 touched,
                 heap,
-            } = scratch;
+            } = &mut *scratch;
+            if dist.len() != domain.len() {
+                *dist = vec![f64::INFINITY; domain.len()];
+            }
+            let graph = domain.graph();
             dist[source as usize] = 0.0;
             touched.push(source);
             heap.push(Entry::new(0.0, 0, source));
@@ -77,7 +77,7 @@ pub(crate) fn ball(
                 dist[v as usize] = f64::INFINITY;
             }
             touched.clear();
-        }
+        }),
         Metric::Euclidean => {
             let grid = domain.vertex_grid();
             let positions = domain.positions();
@@ -115,10 +115,10 @@ pub(crate) struct Ball {
 }
 
 impl Ball {
-    fn compute(domain: &Domain, source: u32, radius: f64, scratch: &mut Scratch) -> Self {
+    fn compute(domain: &Domain, source: u32, radius: f64) -> Self {
         Self {
             radius,
-            entries: ball(domain, source, radius, scratch)
+            entries: ball(domain, source, radius)
                 .into_iter()
                 .map(|(v, d)| (v, d as f32))
                 .collect(),
@@ -197,16 +197,7 @@ impl Weights {
         let n = domain.len();
         let balls: Vec<Ball> = (0..partition.len())
             .into_par_iter()
-            .map_init(
-                || {
-                    Scratch::new(if domain.metric() == Metric::Intrinsic {
-                        n
-                    } else {
-                        0
-                    })
-                },
-                |scratch, k| Ball::compute(domain, partition.node_vertex[k], radii[k], scratch),
-            )
+            .map(|k| Ball::compute(domain, partition.node_vertex[k], radii[k]))
             .collect();
         let supports: Vec<Vec<(u32, f32)>> = balls
             .par_iter()
@@ -379,7 +370,7 @@ impl Weights {
         let ball = if self.balls[k].covers(radius) {
             &self.balls[k]
         } else {
-            fresh = Ball::compute(domain, source, radius, &mut Scratch::new(domain.len()));
+            fresh = Ball::compute(domain, source, radius);
             &fresh
         };
         ball.entries
@@ -428,32 +419,23 @@ impl Weights {
         let balls = &self.balls;
         let results: Vec<Reach> = changes
             .par_iter()
-            .map_init(
-                || {
-                    Scratch::new(if domain.metric() == Metric::Intrinsic {
-                        n
-                    } else {
-                        0
-                    })
-                },
-                |scratch, c| {
-                    let r = radii[c.node];
-                    let source = partition.node_vertex[c.node];
-                    let reach = c.old_radius.map_or(r, |o| o.max(r));
-                    let fresh = (!balls[c.node].covers(reach))
-                        .then(|| Ball::compute(domain, source, reach, scratch));
-                    let ball = fresh.as_ref().unwrap_or(&balls[c.node]);
-                    let touched = ball
-                        .entries
-                        .iter()
-                        .filter(|&&(_, d)| f64::from(d) < reach)
-                        .map(|&(v, _)| v)
-                        .chain(std::iter::once(source))
-                        .collect();
-                    let entries = ball.support(basis, r, partition, source);
-                    (c.node, fresh, touched, entries)
-                },
-            )
+            .map(|c| {
+                let r = radii[c.node];
+                let source = partition.node_vertex[c.node];
+                let reach = c.old_radius.map_or(r, |o| o.max(r));
+                let fresh =
+                    (!balls[c.node].covers(reach)).then(|| Ball::compute(domain, source, reach));
+                let ball = fresh.as_ref().unwrap_or(&balls[c.node]);
+                let touched = ball
+                    .entries
+                    .iter()
+                    .filter(|&&(_, d)| f64::from(d) < reach)
+                    .map(|&(v, _)| v)
+                    .chain(std::iter::once(source))
+                    .collect();
+                let entries = ball.support(basis, r, partition, source);
+                (c.node, fresh, touched, entries)
+            })
             .collect();
         let mut changed_node = vec![false; partition.len()];
         for c in changes {
