@@ -6,7 +6,7 @@ mod support;
 use std::ffi::OsStr;
 use std::fs;
 
-use support::{c2warp, data, difference, fails, load, ok};
+use support::{c2warp, data, difference, fails, load, ok, render_args};
 
 fn os(s: &str) -> &OsStr {
     OsStr::new(s)
@@ -19,14 +19,12 @@ fn os(s: &str) -> &OsStr {
 fn render_matches_the_golden_image() {
     let dir = tempfile::tempdir().expect("temp dir");
     let out = dir.path().join("dino-warped.png");
-    ok(&[
-        os("render"),
-        data("dino.png").as_os_str(),
-        os("--rig"),
-        data("dino-rig.json").as_os_str(),
-        os("-o"),
-        out.as_os_str(),
-    ]);
+    ok(&render_args(
+        &data("dino.png"),
+        &data("dino-rig.json"),
+        &out,
+        &[],
+    ));
     let got = load(&out);
     let expected = load(&data("dino-warped.png"));
     let (worst, share) = difference(&got, &expected, 8);
@@ -46,16 +44,7 @@ fn the_gpu_draws_what_the_cpu_draws() {
     let (cpu, gpu) = (dir.path().join("cpu.png"), dir.path().join("gpu.png"));
     let (image, rig) = (data("dino.png"), data("dino-rig.json"));
     for (out, flag) in [(&cpu, None), (&gpu, Some("--gpu"))] {
-        let mut args = vec![
-            os("render"),
-            image.as_os_str(),
-            os("--rig"),
-            rig.as_os_str(),
-            os("-o"),
-            out.as_os_str(),
-        ];
-        args.extend(flag.map(os));
-        ok(&args);
+        ok(&render_args(&image, &rig, out, flag.as_slice()));
     }
     // Same rasterisation rules; the GPU blends transforms in f32 and filters with
     // 8-bit texels, so edges may land a pixel apart here and there.
@@ -71,14 +60,12 @@ fn the_gpu_draws_what_the_cpu_draws() {
 fn identity_rig_gives_back_the_input() {
     let dir = tempfile::tempdir().expect("temp dir");
     let out = dir.path().join("same.png");
-    ok(&[
-        os("render"),
-        data("opaque.png").as_os_str(),
-        os("--rig"),
-        data("opaque-identity-rig.json").as_os_str(),
-        os("-o"),
-        out.as_os_str(),
-    ]);
+    ok(&render_args(
+        &data("opaque.png"),
+        &data("opaque-identity-rig.json"),
+        &out,
+        &[],
+    ));
     assert_eq!(load(&out), load(&data("opaque.png")));
 }
 
@@ -92,14 +79,7 @@ fn a_cut_out_at_rest_keeps_its_pixels() {
     )
     .expect("write rig");
     let out = dir.path().join("same.png");
-    ok(&[
-        os("render"),
-        data("dino.png").as_os_str(),
-        os("--rig"),
-        rig.as_os_str(),
-        os("-o"),
-        out.as_os_str(),
-    ]);
+    ok(&render_args(&data("dino.png"), &rig, &out, &[]));
     let (worst, share) = difference(&load(&out), &load(&data("dino.png")), 0);
     assert_eq!(share, 0.0, "largest difference {worst}");
 }
@@ -334,14 +314,7 @@ fn bad_input_gives_one_clear_line_and_keeps_the_old_output() {
         ),
     ];
     for (image, rig, expected) in cases {
-        let line = fails(&[
-            os("render"),
-            image.as_os_str(),
-            os("--rig"),
-            rig.as_os_str(),
-            os("-o"),
-            out.as_os_str(),
-        ]);
+        let line = fails(&render_args(&image, &rig, &out, &[]));
         assert!(line.contains(expected), "{}: {line}", rig.display());
         assert_eq!(
             fs::read(&out).expect("read"),

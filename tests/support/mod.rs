@@ -47,6 +47,25 @@ pub fn fails(args: &[&std::ffi::OsStr]) -> String {
     lines[0].to_string()
 }
 
+/// The arguments of `c2warp render IMAGE --rig RIG -o OUT` followed by `extra`.
+pub fn render_args<'a>(
+    image: &'a Path,
+    rig: &'a Path,
+    out: &'a Path,
+    extra: &[&'a str],
+) -> Vec<&'a std::ffi::OsStr> {
+    let mut args: Vec<&std::ffi::OsStr> = vec![
+        "render".as_ref(),
+        image.as_os_str(),
+        "--rig".as_ref(),
+        rig.as_os_str(),
+        "-o".as_ref(),
+        out.as_os_str(),
+    ];
+    args.extend(extra.iter().map(|e| std::ffi::OsStr::new(*e)));
+    args
+}
+
 /// Per-channel differences between two images of the same size: (largest, share of
 /// channels differing by more than `tolerance`).
 pub fn difference(a: &image::RgbaImage, b: &image::RgbaImage, tolerance: u8) -> (u8, f64) {

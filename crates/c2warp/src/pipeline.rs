@@ -129,6 +129,15 @@ pub fn prepare(image: &RgbaImage, project: &Project, density: Option<usize>) -> 
     Ok(Prepared { rig })
 }
 
+/// The rig's samples at rest in f32: the texture coordinates of the mesh.
+fn rest_positions(rig: &Rig) -> Vec<Vec2> {
+    rig.domain()
+        .positions()
+        .iter()
+        .map(|p| p.as_vec2())
+        .collect()
+}
+
 /// The image warped by the rig's current pose on the GPU (or a software adapter): the
 /// vertex shader blends the node transforms with the sparse weights.
 ///
@@ -137,12 +146,7 @@ pub fn prepare(image: &RgbaImage, project: &Project, density: Option<usize>) -> 
 pub fn warp_gpu(image: &RgbaImage, rig: &Rig) -> Result<RgbaImage> {
     let gpu = render::GpuContext::new()?;
     let (rows, nodes, weights) = rig.weight_table();
-    let rest: Vec<Vec2> = rig
-        .domain()
-        .positions()
-        .iter()
-        .map(|p| p.as_vec2())
-        .collect();
+    let rest = rest_positions(rig);
     let mesh = render::SkinnedMesh {
         rest: &rest,
         rows: &rows,
@@ -163,12 +167,7 @@ pub fn warp(image: &RgbaImage, rig: &Rig) -> Result<RgbaImage> {
     if deformed.iter().any(|p| !p.is_finite()) {
         bail!("the deformation produced non-finite positions");
     }
-    let rest: Vec<Vec2> = rig
-        .domain()
-        .positions()
-        .iter()
-        .map(|p| p.as_vec2())
-        .collect();
+    let rest = rest_positions(rig);
     let deformed: Vec<Vec2> = deformed.iter().map(|p| p.as_vec2()).collect();
     let mesh = render::WarpMesh {
         rest: &rest,

@@ -37,7 +37,9 @@ struct Sizes {
     texture: [f32; 2],
 }
 
-const SHADER: &str = r"
+/// What both shaders share: the bindings of group 0, placing a vertex given in output
+/// pixels with its rest position as texture coordinates, and sampling the texture.
+const COMMON_WGSL: &str = r"
 struct Sizes { output: vec2<f32>, texture: vec2<f32> };
 @group(0) @binding(0) var<uniform> sizes: Sizes;
 @group(0) @binding(1) var source: texture_2d<f32>;
@@ -45,8 +47,7 @@ struct Sizes { output: vec2<f32>, texture: vec2<f32> };
 
 struct Out { @builtin(position) clip: vec4<f32>, @location(0) uv: vec2<f32> };
 
-@vertex
-fn vs(@location(0) position: vec2<f32>, @location(1) rest: vec2<f32>) -> Out {
+fn place(position: vec2<f32>, rest: vec2<f32>) -> Out {
     var out: Out;
     let ndc = position / sizes.output * 2.0 - vec2<f32>(1.0, 1.0);
     out.clip = vec4<f32>(ndc.x, -ndc.y, 0.0, 1.0);
@@ -60,18 +61,20 @@ fn fs(in: Out) -> @location(0) vec4<f32> {
 }
 ";
 
-/// The skinned variant: each vertex blends its nodes' affine transforms (linear blend
-/// skinning) from storage buffers, so a new pose uploads only the transforms.
-const SKINNED_SHADER: &str = r"
-struct Sizes { output: vec2<f32>, texture: vec2<f32> };
-@group(0) @binding(0) var<uniform> sizes: Sizes;
-@group(0) @binding(1) var source: texture_2d<f32>;
-@group(0) @binding(2) var linear: sampler;
+/// Vertices arrive already deformed.
+const PLAIN_VERTEX_WGSL: &str = r"
+@vertex
+fn vs(@location(0) position: vec2<f32>, @location(1) rest: vec2<f32>) -> Out {
+    return place(position, rest);
+}
+";
+
+/// Each vertex blends its nodes' affine transforms (linear blend skinning) read from
+/// storage buffers, so a new pose uploads only the transforms.
+const SKINNED_VERTEX_WGSL: &str = r"
 @group(1) @binding(0) var<storage, read> rows: array<u32>;
 @group(1) @binding(1) var<storage, read> entries: array<vec2<u32>>;
 @group(1) @binding(2) var<storage, read> transforms: array<vec4<f32>>;
-
-struct Out { @builtin(position) clip: vec4<f32>, @location(0) uv: vec2<f32> };
 
 @vertex
 fn vs(@builtin(vertex_index) index: u32, @location(0) rest: vec2<f32>) -> Out {
@@ -83,16 +86,7 @@ fn vs(@builtin(vertex_index) index: u32, @location(0) rest: vec2<f32>) -> Out {
         let shift = transforms[2u * entry.x + 1u];
         position += w * (linear_part.xy * rest.x + linear_part.zw * rest.y + shift.xy);
     }
-    var out: Out;
-    let ndc = position / sizes.output * 2.0 - vec2<f32>(1.0, 1.0);
-    out.clip = vec4<f32>(ndc.x, -ndc.y, 0.0, 1.0);
-    out.uv = rest / sizes.texture;
-    return out;
-}
-
-@fragment
-fn fs(in: Out) -> @location(0) vec4<f32> {
-    return textureSample(source, linear, in.uv);
+    return place(position, rest);
 }
 ";
 
@@ -141,7 +135,7 @@ impl GpuContext {
         .map_err(|e| RenderError::NoAdapter(e.to_string()))?;
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("warp"),
-            source: wgpu::ShaderSource::Wgsl(SHADER.into()),
+            source: wgpu::ShaderSource::Wgsl(format!("{COMMON_WGSL}{PLAIN_VERTEX_WGSL}").into()),
         });
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("warp"),
@@ -196,7 +190,7 @@ impl GpuContext {
         );
         let skinned_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("skinned warp"),
-            source: wgpu::ShaderSource::Wgsl(SKINNED_SHADER.into()),
+            source: wgpu::ShaderSource::Wgsl(format!("{COMMON_WGSL}{SKINNED_VERTEX_WGSL}").into()),
         });
         let skinned = make_pipeline(
             &device,
