@@ -443,6 +443,39 @@ impl Domain {
             .get_or_init(|| boundary_loops(&self.triangles))
     }
 
+    /// Whether the segment from `a` to `b` lies in the domain: both ends inside and no
+    /// boundary edge crossed (touching the boundary is allowed).
+    pub fn contains_segment(&self, a: DVec2, b: DVec2) -> bool {
+        if self.locate(a).is_none() || self.locate(b).is_none() {
+            return false;
+        }
+        let scale = (self.max - self.min).length().max(1e-12);
+        let tol = 1e-12 * scale * scale;
+        let side = |p: DVec2, q: DVec2, r: DVec2| {
+            let c = (q - p).perp_dot(r - p);
+            if c > tol {
+                1
+            } else if c < -tol {
+                -1
+            } else {
+                0
+            }
+        };
+        let crosses = |p: DVec2, q: DVec2| {
+            let (s1, s2) = (side(a, b, p), side(a, b, q));
+            let (s3, s4) = (side(p, q, a), side(p, q, b));
+            s1 * s2 < 0 && s3 * s4 < 0
+        };
+        let positions = &self.positions;
+        !self.boundary_loops().iter().any(|ring| {
+            (0..ring.len()).any(|i| {
+                let p = positions[ring[i] as usize];
+                let q = positions[ring[(i + 1) % ring.len()] as usize];
+                crosses(p, q)
+            })
+        }) && self.locate((a + b) * 0.5).is_some()
+    }
+
     /// Whether the domain is one region bounded by a single convex loop (collinear
     /// boundary vertices allowed): then [`Metric::Euclidean`] is exact.
     pub fn is_convex(&self) -> bool {
@@ -590,6 +623,28 @@ pub(crate) mod tests {
             .collect();
         let d = Domain::new(p, l, Metric::Intrinsic).expect("valid");
         assert!(!d.is_convex());
+    }
+
+    #[test]
+    fn segments_that_cut_a_corner_of_a_hole_are_outside() {
+        // A 6 × 6 grid without the cell [2, 3] × [2, 3].
+        let (p, t) = grid_mesh(6, 6, 1.0);
+        let kept: Vec<_> = t
+            .iter()
+            .copied()
+            .filter(|tri| {
+                let c = tri.iter().map(|&v| p[v as usize]).sum::<DVec2>() / 3.0;
+                !(c.x > 2.0 && c.x < 3.0 && c.y > 2.0 && c.y < 3.0)
+            })
+            .collect();
+        let d = Domain::new(p, kept, Metric::Intrinsic).expect("valid");
+        // Its ends and every point a coarse walk would test are inside; it clips the
+        // hole's corner at (2, 2).
+        assert!(!d.contains_segment(DVec2::new(1.5, 2.7), DVec2::new(2.7, 1.5)));
+        assert!(d.contains_segment(DVec2::new(1.5, 2.4), DVec2::new(2.4, 1.5)));
+        // Along the hole's edge is allowed.
+        assert!(d.contains_segment(DVec2::new(2.0, 1.0), DVec2::new(2.0, 4.0)));
+        assert!(!d.contains_segment(DVec2::new(1.0, 2.5), DVec2::new(4.0, 2.5)));
     }
 
     #[test]

@@ -1035,16 +1035,17 @@ fn real_nodes(
             }),
             Handle::Bar { rest, .. } => {
                 // The whole bar must lie on the shape, not only its samples.
-                let steps = ((rest[1] - rest[0]).length() / resolution).ceil() as usize;
-                for s in 0..=steps.min(1 << 16) {
-                    let p = rest[0].lerp(rest[1], s as f64 / steps.max(1) as f64);
-                    if domain.locate(p).is_none() {
-                        return Err(RigError::OutsideDomain {
-                            handle: i,
-                            x: p.x,
-                            y: p.y,
-                        });
-                    }
+                if !domain.contains_segment(rest[0], rest[1]) {
+                    let p = if domain.locate(rest[0]).is_none() {
+                        rest[0]
+                    } else {
+                        rest[1]
+                    };
+                    return Err(RigError::OutsideDomain {
+                        handle: i,
+                        x: p.x,
+                        y: p.y,
+                    });
                 }
                 for (t, p) in bar_samples(rest, spacing) {
                     let v = snap(i, p)?;
