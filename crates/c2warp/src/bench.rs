@@ -7,7 +7,8 @@ use anyhow::Result;
 use serde::Serialize;
 use weights_core::Handle;
 
-use crate::{Source, export, load_project};
+use crate::{Source, export};
+use pipeline::load_project;
 
 #[derive(Serialize)]
 struct Phases {

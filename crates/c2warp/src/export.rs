@@ -9,7 +9,8 @@ use project::Project;
 use serde::Serialize;
 use weights_core::{Domain, Handle, NodeKind, Rig};
 
-use crate::{Source, load_image, load_project, pipeline};
+use crate::Source;
+use pipeline::{load_image, load_project};
 
 /// A rig built from a `--mesh` or `--image` source.
 pub struct Built {

@@ -2,7 +2,6 @@
 
 mod bench;
 mod export;
-mod pipeline;
 mod progress;
 
 use std::path::{Path, PathBuf};
@@ -10,26 +9,32 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
+use pipeline::{DEFAULT_IMAGE, DEFAULT_RIG, load_image, load_project};
 use project::Project;
-
-/// The image the demo warps (public domain, see assets/LICENSES.md).
-pub const DEFAULT_IMAGE: &[u8] = include_bytes!("../../../assets/lizard.png");
-/// The rig the demo applies to it.
-pub const DEFAULT_RIG: &str = include_str!("../../../assets/lizard-rig.json");
 
 #[derive(Parser)]
 #[command(
     name = "c2warp",
     version,
-    about = "Handle-driven image warping with closed-form C² weights"
+    about = "Handle-driven image warping with closed-form C² weights",
+    long_about = "Handle-driven image warping with closed-form C² weights.\n\n\
+        With no command, opens the editor (on FILE, or on the built-in picture).",
+    args_conflicts_with_subcommands = true
 )]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
+    /// A picture (PNG, JPEG) or a project (.json) to open in the editor.
+    file: Option<PathBuf>,
 }
 
 #[derive(Subcommand)]
 enum Command {
+    /// Open the editor on a picture (PNG, JPEG) or a project (.json).
+    Open {
+        /// The file to open.
+        file: PathBuf,
+    },
     /// Warp an image by a rig and write a PNG of the same size (alpha kept).
     Render {
         /// The image (PNG or JPEG).
@@ -95,9 +100,22 @@ struct Source {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let result = match cli.command.unwrap_or(Command::Demo {
-        output: PathBuf::from("c2warp-demo.png"),
-    }) {
+    let result = match cli.command {
+        None => editor::run(cli.file),
+        Some(command) => run(command),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(command: Command) -> Result<()> {
+    match command {
+        Command::Open { file } => editor::run(Some(file)),
         Command::Render {
             image,
             rig,
@@ -116,25 +134,7 @@ fn main() -> ExitCode {
             positions,
         } => bench::run(&source, &rig, positions),
         Command::Demo { output } => demo(&output),
-    };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            ExitCode::FAILURE
-        }
     }
-}
-
-/// Reads and parses a rig file.
-fn load_project(path: &Path) -> Result<Project> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read rig file {}", path.display()))?;
-    Project::from_json(&text).with_context(|| format!("rig file {}", path.display()))
-}
-
-fn load_image(path: &Path) -> Result<image::RgbaImage> {
-    Ok(render::load_image(path, &render::ImageLimits::default())?)
 }
 
 fn render(

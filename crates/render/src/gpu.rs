@@ -69,15 +69,15 @@ fn vs(@location(0) position: vec2<f32>, @location(1) rest: vec2<f32>) -> Out {
 }
 ";
 
-/// Each vertex blends its nodes' affine transforms (linear blend skinning) read from
-/// storage buffers, so a new pose uploads only the transforms.
-const SKINNED_VERTEX_WGSL: &str = r"
+/// Linear blend skinning: the vertex at `index` moved by the blend of its nodes' affine
+/// transforms, read from storage buffers (group 1), so a new pose uploads only the
+/// transforms. Shared with the on-screen view.
+pub(crate) const SKIN_WGSL: &str = r"
 @group(1) @binding(0) var<storage, read> rows: array<u32>;
 @group(1) @binding(1) var<storage, read> entries: array<vec2<u32>>;
 @group(1) @binding(2) var<storage, read> transforms: array<vec4<f32>>;
 
-@vertex
-fn vs(@builtin(vertex_index) index: u32, @location(0) rest: vec2<f32>) -> Out {
+fn skin(index: u32, rest: vec2<f32>) -> vec2<f32> {
     var position = vec2<f32>(0.0, 0.0);
     for (var i = rows[index]; i < rows[index + 1u]; i = i + 1u) {
         let entry = entries[i];
@@ -86,7 +86,15 @@ fn vs(@builtin(vertex_index) index: u32, @location(0) rest: vec2<f32>) -> Out {
         let shift = transforms[2u * entry.x + 1u];
         position += w * (linear_part.xy * rest.x + linear_part.zw * rest.y + shift.xy);
     }
-    return place(position, rest);
+    return position;
+}
+";
+
+/// Vertices move by [`SKIN_WGSL`].
+const SKINNED_VERTEX_WGSL: &str = r"
+@vertex
+fn vs(@builtin(vertex_index) index: u32, @location(0) rest: vec2<f32>) -> Out {
+    return place(skin(index, rest), rest);
 }
 ";
 
@@ -102,6 +110,71 @@ pub struct SkinnedMesh<'a> {
     pub weights: &'a [f32],
     /// Triangles as vertex index triples.
     pub triangles: &'a [[u32; 3]],
+}
+
+impl SkinnedMesh<'_> {
+    /// Checks that rows, nodes, weights and triangles refer to one another consistently
+    /// and hold finite values, for `transforms` node transforms.
+    pub(crate) fn validate(&self, transforms: &[Affine]) -> Result<(), RenderError> {
+        let n = self.rest.len();
+        let bad = |what: &str| RenderError::Gpu(format!("invalid skinned mesh: {what}"));
+        if self.rows.len() != n + 1 || self.nodes.len() != self.weights.len() {
+            return Err(bad("row table lengths"));
+        }
+        if self.rows.windows(2).any(|w| w[0] > w[1]) || self.rows[n] as usize != self.nodes.len() {
+            return Err(bad("row offsets"));
+        }
+        if self.nodes.iter().any(|&k| k as usize >= transforms.len()) {
+            return Err(bad("a node without a transform"));
+        }
+        if self.triangles.iter().flatten().any(|&v| v as usize >= n) {
+            return Err(bad("a triangle index out of range"));
+        }
+        if !transforms
+            .iter()
+            .flatten()
+            .chain(self.weights)
+            .all(|x| x.is_finite())
+            || !self.rest.iter().all(|p| p.is_finite())
+        {
+            return Err(bad("non-finite values"));
+        }
+        Ok(())
+    }
+
+    /// The weight entries as the shader reads them: `(node, weight bits)`, never empty
+    /// (storage buffers may not be).
+    pub(crate) fn packed_entries(&self) -> Vec<[u32; 2]> {
+        let entries = self
+            .nodes
+            .iter()
+            .zip(self.weights)
+            .map(|(&k, &w)| [k, w.to_bits()])
+            .collect();
+        nonempty(entries, [0, 0])
+    }
+}
+
+/// Node transforms as the shader reads them: two `vec4`s each, never empty.
+pub(crate) fn pack_transforms(transforms: &[Affine]) -> Vec<[f32; 4]> {
+    let packed = transforms
+        .iter()
+        .flat_map(|t| [[t[0], t[1], t[2], t[3]], [t[4], t[5], 0.0, 0.0]])
+        .collect();
+    nonempty(packed, [0.0; 4])
+}
+
+/// Texels with their colour multiplied by alpha, so filtering does not bleed the colour
+/// of transparent texels.
+pub(crate) fn premultiply(texture: &RgbaImage) -> Vec<u8> {
+    texture
+        .pixels()
+        .flat_map(|p| {
+            let a = u16::from(p[3]);
+            let m = |c: u8| ((u16::from(c) * a + 127) / 255) as u8;
+            [m(p[0]), m(p[1]), m(p[2]), p[3]]
+        })
+        .collect()
 }
 
 /// An affine transform of pixel coordinates, `x ↦ A x + t`, as
@@ -190,7 +263,9 @@ impl GpuContext {
         );
         let skinned_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("skinned warp"),
-            source: wgpu::ShaderSource::Wgsl(format!("{COMMON_WGSL}{SKINNED_VERTEX_WGSL}").into()),
+            source: wgpu::ShaderSource::Wgsl(
+                format!("{COMMON_WGSL}{SKIN_WGSL}{SKINNED_VERTEX_WGSL}").into(),
+            ),
         });
         let skinned = make_pipeline(
             &device,
@@ -271,52 +346,14 @@ impl GpuContext {
         width: u32,
         height: u32,
     ) -> Result<RgbaImage, RenderError> {
-        let n = mesh.rest.len();
-        let bad = |what: &str| RenderError::Gpu(format!("invalid skinned mesh: {what}"));
-        if mesh.rows.len() != n + 1 || mesh.nodes.len() != mesh.weights.len() {
-            return Err(bad("row table lengths"));
-        }
-        if mesh.rows.windows(2).any(|w| w[0] > w[1]) || mesh.rows[n] as usize != mesh.nodes.len() {
-            return Err(bad("row offsets"));
-        }
-        if mesh.nodes.iter().any(|&k| k as usize >= transforms.len()) {
-            return Err(bad("a node without a transform"));
-        }
-        if mesh.triangles.iter().flatten().any(|&v| v as usize >= n) {
-            return Err(bad("a triangle index out of range"));
-        }
-        if !transforms
-            .iter()
-            .flatten()
-            .chain(mesh.weights)
-            .all(|x| x.is_finite())
-            || !mesh.rest.iter().all(|p| p.is_finite())
-        {
-            return Err(bad("non-finite values"));
-        }
-        let entries: Vec<[u32; 2]> = mesh
-            .nodes
-            .iter()
-            .zip(mesh.weights)
-            .map(|(&k, &w)| [k, w.to_bits()])
-            .collect();
-        let packed: Vec<[f32; 4]> = transforms
-            .iter()
-            .flat_map(|t| [[t[0], t[1], t[2], t[3]], [t[4], t[5], 0.0, 0.0]])
-            .collect();
+        mesh.validate(transforms)?;
+        let entries = mesh.packed_entries();
+        let packed = pack_transforms(transforms);
         let storage = wgpu::BufferUsages::STORAGE;
         // Storage buffers may not be empty.
         let rows = self.buffer("rows", bytemuck::cast_slice(mesh.rows), storage);
-        let entries = self.buffer(
-            "entries",
-            bytemuck::cast_slice(&nonempty(entries, [0, 0])),
-            storage,
-        );
-        let packed = self.buffer(
-            "transforms",
-            bytemuck::cast_slice(&nonempty(packed, [0.0; 4])),
-            storage,
-        );
+        let entries = self.buffer("entries", bytemuck::cast_slice(&entries), storage);
+        let packed = self.buffer("transforms", bytemuck::cast_slice(&packed), storage);
         let skin = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("skin"),
             layout: &self.skin_layout,
@@ -390,14 +427,7 @@ impl GpuContext {
         {
             return Err(RenderError::OutputTooLarge { width, height });
         }
-        let premultiplied: Vec<u8> = texture
-            .pixels()
-            .flat_map(|p| {
-                let a = u16::from(p[3]);
-                let m = |c: u8| ((u16::from(c) * a + 127) / 255) as u8;
-                [m(p[0]), m(p[1]), m(p[2]), p[3]]
-            })
-            .collect();
+        let premultiplied = premultiply(texture);
         let size = |w, h| wgpu::Extent3d {
             width: w,
             height: h,
@@ -418,16 +448,6 @@ impl GpuContext {
             wgpu::util::TextureDataOrder::LayerMajor,
             &premultiplied,
         );
-        let target = self.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("target"),
-            size: size(width, height),
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
         let sizes = Sizes {
             output: [width as f32, height as f32],
             texture: [texture.width() as f32, texture.height() as f32],
@@ -455,6 +475,52 @@ impl GpuContext {
                     resource: wgpu::BindingResource::Sampler(&self.sampler),
                 },
             ],
+        });
+        self.offscreen(width, height, |pass| {
+            pass.set_bind_group(0, &bind_group, &[]);
+            record(pass);
+        })
+    }
+
+    /// The device, for drawing with [`crate::MeshView`] offscreen.
+    pub fn device(&self) -> &wgpu::Device {
+        &self.device
+    }
+
+    /// The queue of [`GpuContext::device`].
+    pub fn queue(&self) -> &wgpu::Queue {
+        &self.queue
+    }
+
+    /// Runs `record` in a render pass into a `width × height` RGBA8 (unorm) target
+    /// cleared to transparent, and reads the target back, unpremultiplied.
+    ///
+    /// # Errors
+    /// A size the device cannot hold, or a GPU failure.
+    pub fn offscreen(
+        &self,
+        width: u32,
+        height: u32,
+        record: impl FnOnce(&mut wgpu::RenderPass<'_>),
+    ) -> Result<RgbaImage, RenderError> {
+        let max = self.device.limits().max_texture_dimension_2d;
+        if width == 0 || height == 0 || width > max || height > max {
+            return Err(RenderError::OutputTooLarge { width, height });
+        }
+        let size = |w, h| wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        };
+        let target = self.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("target"),
+            size: size(width, height),
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
         });
         let row_bytes = width * 4;
         let padded = row_bytes.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
@@ -484,7 +550,6 @@ impl GpuContext {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_bind_group(0, &bind_group, &[]);
             record(&mut pass);
         }
         encoder.copy_texture_to_buffer(

@@ -7,6 +7,9 @@
 //!
 //! * [`warp_cpu`] rasterises at full resolution on the CPU (in parallel with
 //!   rayon), for export on machines without a GPU.
+//! * [`MeshView`] draws the mesh into a caller's render pass (an editor's window),
+//!   skinned in the vertex shader, with heat-map, cell, wireframe and fold-over
+//!   overlays.
 //! * [`load_image`] / [`decode_image`] decode PNG and JPEG under
 //!   [`ImageLimits`], failing fast on hostile headers.
 //! * [`save_png_atomic`] / [`write_atomic`] replace files atomically, so a
@@ -25,6 +28,7 @@ mod image_io;
 mod mesh;
 mod raster;
 mod sample;
+mod view;
 mod warp;
 
 pub use atomic::{save_png_atomic, write_atomic};
@@ -32,4 +36,5 @@ pub use error::RenderError;
 pub use gpu::{Affine, GpuContext, SkinnedMesh};
 pub use image_io::{ImageLimits, decode_image, load_image};
 pub use mesh::WarpMesh;
+pub use view::{MeshView, Overlay, ViewParams};
 pub use warp::{RasterOptions, coverage_counts, warp_cpu};

@@ -1,4 +1,5 @@
-//! Image + project → mesh → rig → warped image: the path every command shares.
+//! Image + project → mesh → rig → warped image: the path the `c2warp` command line and
+//! the editor share, so an export from either gives the same pixels.
 
 use anyhow::{Context, Result, bail};
 use glam::{DVec2, Vec2};
@@ -6,6 +7,30 @@ use image::RgbaImage;
 use mesh::{Constraints, DomainOptions, MeshOptions};
 use project::{HandleSpec, MetricChoice, Middle, Project};
 use weights_core::{Basis, Domain, Handle, Metric, MiddleControls, Rig, RigOptions, Similarity};
+
+/// The picture the editor opens with and the demo warps (public domain, see
+/// `assets/LICENSES.md`).
+pub const DEFAULT_IMAGE: &[u8] = include_bytes!("../../../assets/lizard.png");
+/// The sample rig on [`DEFAULT_IMAGE`].
+pub const DEFAULT_RIG: &str = include_str!("../../../assets/lizard-rig.json");
+
+/// Reads and parses a rig file.
+///
+/// # Errors
+/// An unreadable file or malformed rig, naming the file.
+pub fn load_project(path: &std::path::Path) -> Result<Project> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("cannot read rig file {}", path.display()))?;
+    Project::from_json(&text).with_context(|| format!("rig file {}", path.display()))
+}
+
+/// Decodes an image file under the default size limits.
+///
+/// # Errors
+/// A missing, corrupt, truncated, unsupported or oversized image, as one sentence.
+pub fn load_image(path: &std::path::Path) -> Result<RgbaImage> {
+    Ok(render::load_image(path, &render::ImageLimits::default())?)
+}
 
 /// Target vertex count of the mesh when neither the project nor the command says.
 pub const DEFAULT_DENSITY: usize = 20_000;

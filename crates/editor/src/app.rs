@@ -1,0 +1,696 @@
+//! The editor application: the document, its undo history, the view and tool state,
+//! and the one place where edits are applied ([`EditorApp::edit`]).
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::{Context as _, Result};
+use glam::DVec2;
+use project::HandleSpec;
+
+use crate::dialogs::{Dialogs, NativeDialogs};
+use crate::document::{Document, Edit, posed};
+use crate::history::History;
+use crate::scene::{GpuFrame, MeshData, SceneResources, Versioned};
+use crate::viewport::Viewport;
+
+/// What a primary click or drag on the canvas does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Tool {
+    /// Select, move, rotate (Alt or the ring) and scale (Shift) handles.
+    Select,
+    /// Click to add a point handle.
+    AddPoint,
+    /// Drag to add a bar handle.
+    AddBar,
+}
+
+/// Which overlays are on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Show {
+    /// Mesh edges.
+    pub mesh: bool,
+    /// Virtual handles.
+    pub virtual_handles: bool,
+    /// Voronoi cells of all nodes.
+    pub cells: bool,
+    /// The dual (Delaunay) graph of the nodes.
+    pub dual_graph: bool,
+    /// The selected handle's weight as a heat map with isolines.
+    pub heat: bool,
+    /// Fold-overs in red.
+    pub folds: bool,
+    /// The weights under the cursor.
+    pub hover_weights: bool,
+}
+
+impl Default for Show {
+    fn default() -> Self {
+        Self {
+            mesh: false,
+            virtual_handles: true,
+            cells: false,
+            dual_graph: false,
+            heat: false,
+            folds: true,
+            hover_weights: true,
+        }
+    }
+}
+
+/// A message in the status bar.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Message {
+    /// One line.
+    pub text: String,
+    /// Shown in red.
+    pub is_error: bool,
+}
+
+/// Something that would discard unsaved changes, waiting for the user's answer.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Pending {
+    /// Open this picture or project.
+    Open(PathBuf),
+    /// Close the window.
+    Close,
+}
+
+/// A drag of a handle in progress.
+#[derive(Clone, Debug)]
+pub(crate) struct HandleDrag {
+    pub index: usize,
+    pub grip: Grip,
+    /// The handle when the drag began.
+    pub start: HandleSpec,
+    /// The pointer when the drag began (image pixels).
+    pub pointer: DVec2,
+    /// The document before the drag, recorded in the history if the drag changed it.
+    pub before: project::Project,
+}
+
+/// What part of a handle is being dragged, and how.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Grip {
+    /// Move the whole handle.
+    Move,
+    /// Move one end of a bar.
+    End(usize),
+    /// Rotate about the handle's centre.
+    Rotate,
+    /// Scale about the handle's centre.
+    Scale,
+}
+
+/// The editor.
+pub struct EditorApp {
+    pub(crate) doc: Option<Document>,
+    pub(crate) history: History,
+    pub(crate) dirty: bool,
+    /// The view: pan and zoom.
+    pub viewport: Viewport,
+    pub(crate) needs_fit: bool,
+    /// The active tool.
+    pub tool: Tool,
+    /// The selected handle.
+    pub selected: Option<usize>,
+    pub(crate) drag: Option<HandleDrag>,
+    pub(crate) bar_start: Option<DVec2>,
+    pub(crate) context_point: Option<DVec2>,
+    pub(crate) panning: bool,
+    /// Overlays.
+    pub show: Show,
+    /// Point handles turn with their neighbours' motion.
+    pub auto_rotate: bool,
+    /// The status line.
+    pub message: Option<Message>,
+    /// A question waiting for an answer.
+    pub pending: Option<Pending>,
+    pub(crate) allow_close: bool,
+    /// The keyboard shortcuts window is open.
+    pub help_open: bool,
+    pub(crate) dialogs: Box<dyn Dialogs>,
+    pub(crate) gpu: GpuFrame,
+    pub(crate) has_gpu: bool,
+    next_version: u64,
+    seen: Seen,
+    pub(crate) dual_graph: (u64, Arc<Vec<(u32, u32)>>),
+    pub(crate) settings_draft: Option<crate::document::Settings>,
+    /// Milliseconds the last frame's logic took on the CPU.
+    pub frame_ms: f64,
+}
+
+/// Versions the GPU frame was last built from.
+#[derive(Default, PartialEq, Clone, Copy)]
+struct Seen {
+    weights: u64,
+    pose: u64,
+    heat: Option<(usize, u64)>,
+    cells: u64,
+}
+
+impl EditorApp {
+    /// The editor on `path` (a picture, or a `.json` project), or on the built-in
+    /// picture. Sets up the GPU resources when eframe runs on wgpu.
+    pub fn new(cc: &eframe::CreationContext<'_>, path: Option<&Path>) -> Self {
+        let has_gpu = if let Some(state) = &cc.wgpu_render_state {
+            let resources = SceneResources::new(&state.device, &state.queue, state.target_format);
+            state.renderer.write().callback_resources.insert(resources);
+            true
+        } else {
+            false
+        };
+        let mut app = Self::headless(has_gpu);
+        if let Some(path) = path {
+            app.open(path);
+        }
+        app
+    }
+
+    /// The editor on the built-in picture, without GPU resources (nothing is drawn
+    /// through the GPU unless `has_gpu`).
+    pub fn headless(has_gpu: bool) -> Self {
+        let (doc, message) = match Document::built_in() {
+            Ok(doc) => (Some(doc), None),
+            Err(e) => (
+                None,
+                Some(Message {
+                    text: format!("cannot open the built-in picture: {e:#}"),
+                    is_error: true,
+                }),
+            ),
+        };
+        Self {
+            doc,
+            history: History::default(),
+            dirty: false,
+            viewport: Viewport::default(),
+            needs_fit: true,
+            tool: Tool::Select,
+            selected: None,
+            drag: None,
+            bar_start: None,
+            context_point: None,
+            panning: false,
+            show: Show::default(),
+            auto_rotate: false,
+            message,
+            pending: None,
+            allow_close: false,
+            help_open: false,
+            dialogs: Box::new(NativeDialogs),
+            gpu: GpuFrame::default(),
+            has_gpu,
+            next_version: 0,
+            seen: Seen::default(),
+            dual_graph: (0, Arc::new(Vec::new())),
+            settings_draft: None,
+            frame_ms: 0.0,
+        }
+    }
+
+    /// Replaces the file dialogs (tests answer them with fixed paths).
+    pub fn set_dialogs(&mut self, dialogs: Box<dyn Dialogs>) {
+        self.dialogs = dialogs;
+    }
+
+    /// The open document.
+    pub fn document(&self) -> Option<&Document> {
+        self.doc.as_ref()
+    }
+
+    /// Whether there are changes not saved to a project file.
+    pub fn is_dirty(&self) -> bool {
+        self.dirty
+    }
+
+    pub(crate) fn info(&mut self, text: impl Into<String>) {
+        self.message = Some(Message {
+            text: text.into(),
+            is_error: false,
+        });
+    }
+
+    pub(crate) fn error(&mut self, error: &anyhow::Error) {
+        self.message = Some(Message {
+            text: format!("{error:#}"),
+            is_error: true,
+        });
+    }
+
+    /// Applies an edit as one undo step. Errors go to the status line; the document is
+    /// then unchanged.
+    pub fn edit(&mut self, edit: Edit) {
+        let Some(doc) = &mut self.doc else { return };
+        let before = doc.project().clone();
+        let removes = match edit {
+            Edit::Remove(i) => Some(i),
+            Edit::Clear => Some(0),
+            _ => None,
+        };
+        match doc.apply(edit) {
+            Ok(()) => {
+                if doc.project() != &before {
+                    self.history.push(before);
+                    self.dirty = true;
+                }
+                if let Some(i) = removes {
+                    self.selected = match self.selected {
+                        Some(s) if s > i && doc.project().handles.len() > s - 1 => Some(s - 1),
+                        Some(s) if s < i => Some(s),
+                        _ => None,
+                    };
+                }
+                self.settings_draft = None;
+            }
+            Err(e) => self.error(&e),
+        }
+    }
+
+    /// Adds a point handle under `at` (image pixels, current pose): its rest position is
+    /// the point of the picture shown there, and it starts with the pose's local
+    /// rotation and scale so the warp does not jump.
+    pub fn add_point(&mut self, at: DVec2) {
+        let Some(doc) = &mut self.doc else { return };
+        let Some((rest, rotate, scale)) = doc.unwarp(at) else {
+            self.error(&anyhow::anyhow!("click on the picture to add a handle"));
+            return;
+        };
+        let handle = HandleSpec::Point {
+            rest: rest.to_array(),
+            translate: (at - rest).to_array(),
+            rotate,
+            scale,
+        };
+        self.edit(Edit::Add(handle));
+        if let Some(doc) = &self.doc {
+            if doc.project().handles.len() > 0 && self.message.as_ref().is_none_or(|m| !m.is_error)
+            {
+                self.selected = Some(doc.project().handles.len() - 1);
+                let ms = doc.last_update_ms;
+                self.info(format!(
+                    "added a point handle; weights updated in {ms:.1} ms"
+                ));
+            }
+        }
+    }
+
+    /// Adds a bar from `a` to `b` (image pixels, current pose).
+    pub fn add_bar(&mut self, a: DVec2, b: DVec2) {
+        let Some(doc) = &mut self.doc else { return };
+        let (Some((ra, _, _)), Some((rb, _, _))) = (doc.unwarp(a), doc.unwarp(b)) else {
+            self.error(&anyhow::anyhow!("a bar must start and end on the picture"));
+            return;
+        };
+        let handle = HandleSpec::Bar {
+            rest: [ra.to_array(), rb.to_array()],
+            pose: Some([a.to_array(), b.to_array()]),
+        };
+        let count = doc.project().handles.len();
+        self.edit(Edit::Add(handle));
+        if let Some(doc) = &self.doc
+            && doc.project().handles.len() > count
+        {
+            self.selected = Some(count);
+            let ms = doc.last_update_ms;
+            self.info(format!("added a bar handle; weights updated in {ms:.1} ms"));
+        }
+    }
+
+    /// Deletes the selected handle.
+    pub fn delete_selected(&mut self) {
+        if let Some(i) = self.selected {
+            self.edit(Edit::Remove(i));
+            if let Some(doc) = &self.doc {
+                let ms = doc.last_update_ms;
+                self.info(format!("removed a handle; weights updated in {ms:.1} ms"));
+            }
+        }
+    }
+
+    /// Sets the pose of handle `index` during a drag (no undo step; the drag makes one
+    /// when it ends). With auto-rotation, other point handles turn with their
+    /// neighbours.
+    pub(crate) fn set_pose(&mut self, index: usize, handle: HandleSpec) {
+        let Some(doc) = &mut self.doc else { return };
+        let mut project = doc.project().clone();
+        let Some(slot) = project.handles.get_mut(index) else {
+            return;
+        };
+        *slot = handle;
+        if self.auto_rotate {
+            auto_rotate(&mut project.handles);
+        }
+        if let Err(e) = doc.restore(project) {
+            self.error(&e);
+        }
+    }
+
+    /// Ends a handle drag: one undo step if it changed anything.
+    pub(crate) fn finish_drag(&mut self) {
+        if let (Some(drag), Some(doc)) = (self.drag.take(), &self.doc)
+            && doc.project() != &drag.before
+        {
+            self.history.push(drag.before);
+            self.dirty = true;
+        }
+    }
+
+    /// Steps back one edit.
+    pub fn undo(&mut self) {
+        self.step_history(true);
+    }
+
+    /// Steps forward one edit.
+    pub fn redo(&mut self) {
+        self.step_history(false);
+    }
+
+    fn step_history(&mut self, back: bool) {
+        self.finish_drag();
+        let Some(doc) = &mut self.doc else { return };
+        let current = doc.project().clone();
+        let taken = if back {
+            self.history.undo(current)
+        } else {
+            self.history.redo(current)
+        };
+        let Some(target) = taken else { return };
+        match doc.restore(target.clone()) {
+            Ok(()) => {
+                self.dirty = true;
+                self.settings_draft = None;
+                if self
+                    .selected
+                    .is_some_and(|s| s >= doc.project().handles.len())
+                {
+                    self.selected = None;
+                }
+            }
+            Err(e) => {
+                self.history.unpop(back, target);
+                self.error(&e);
+            }
+        }
+    }
+
+    /// Opens a picture or (for `.json`) a project, asking first if there are unsaved
+    /// changes.
+    pub fn request_open(&mut self, path: PathBuf) {
+        if self.dirty {
+            self.pending = Some(Pending::Open(path));
+        } else {
+            self.open(&path);
+        }
+    }
+
+    /// Opens a picture or (for `.json`) a project now. On failure the current document
+    /// stays and the status line says why.
+    pub fn open(&mut self, path: &Path) {
+        let is_project = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("json"));
+        let opened = if is_project {
+            Document::open_project(path)
+        } else {
+            Document::open_image(path)
+        };
+        match opened {
+            Ok(doc) => {
+                let stats = doc.rig().stats();
+                let what = if is_project { "project" } else { "image" };
+                self.doc = Some(doc);
+                self.history.clear();
+                self.dirty = false;
+                self.selected = None;
+                self.drag = None;
+                self.needs_fit = true;
+                self.settings_draft = None;
+                self.info(format!(
+                    "opened {what} {} ({} mesh vertices)",
+                    path.display(),
+                    stats.samples
+                ));
+            }
+            Err(e) => self.error(&e.context(format!("cannot open {}", path.display()))),
+        }
+    }
+
+    /// Saves the project where it was last saved, or asks where.
+    pub fn save(&mut self) {
+        let path = self
+            .doc
+            .as_ref()
+            .and_then(|d| d.project_path.clone())
+            .or_else(|| self.dialogs.save_project(&self.suggested_name("json")));
+        if let Some(path) = path {
+            self.save_to(&path);
+        }
+    }
+
+    /// Asks where to save the project, then saves it.
+    pub fn save_as(&mut self) {
+        if let Some(path) = self.dialogs.save_project(&self.suggested_name("json")) {
+            self.save_to(&path);
+        }
+    }
+
+    /// Writes the project to `path` atomically (a failure leaves any old file intact).
+    pub fn save_to(&mut self, path: &Path) {
+        let Some(doc) = &mut self.doc else { return };
+        let project = doc.project_for_saving(Some(path));
+        match render::write_atomic(path, project.to_json().as_bytes()) {
+            Ok(()) => {
+                doc.project_path = Some(path.to_path_buf());
+                self.dirty = false;
+                self.info(format!("saved {}", path.display()));
+            }
+            Err(e) => self.error(&anyhow::Error::from(e)),
+        }
+    }
+
+    /// Asks where to export, then writes the warped PNG.
+    pub fn export(&mut self) {
+        if let Some(path) = self.dialogs.export_png(&self.suggested_name("warped.png")) {
+            self.export_to(&path);
+        }
+    }
+
+    /// Writes the warped picture at full resolution to `path` atomically: the same
+    /// pixels as `c2warp render` of the saved project.
+    pub fn export_to(&mut self, path: &Path) {
+        let Some(doc) = &self.doc else { return };
+        let clock = Instant::now();
+        let result = (|| -> Result<()> {
+            let project = doc.project_for_saving(None);
+            let prepared = pipeline::prepare(&doc.image, &project, None)?;
+            let warped = pipeline::warp(&doc.image, &prepared.rig)?;
+            render::save_png_atomic(path, &warped)?;
+            Ok(())
+        })();
+        match result.with_context(|| format!("cannot export {}", path.display())) {
+            Ok(()) => {
+                let ms = clock.elapsed().as_secs_f64() * 1e3;
+                self.info(format!("exported {} in {ms:.0} ms", path.display()));
+            }
+            Err(e) => self.error(&e),
+        }
+    }
+
+    fn suggested_name(&self, extension: &str) -> String {
+        let stem = self
+            .doc
+            .as_ref()
+            .and_then(|d| d.image_path.as_ref())
+            .and_then(|p| p.file_stem())
+            .map_or_else(|| "lizard".to_owned(), |s| s.to_string_lossy().into_owned());
+        if extension.contains('.') {
+            format!("{stem}-{extension}")
+        } else {
+            format!("{stem}.{extension}")
+        }
+    }
+
+    /// Brings the GPU frame up to date with the document: weights after a structural
+    /// change, transforms after a pose change, overlay values when asked for.
+    pub(crate) fn update_gpu_frame(&mut self) {
+        let Some(doc) = &self.doc else { return };
+        let counter = &mut self.next_version;
+        let mut bump = || {
+            *counter += 1;
+            *counter
+        };
+        let gpu = &mut self.gpu;
+        let seen = &mut self.seen;
+        let weights = doc.weights_version;
+        let image_is_new = gpu.image.version == 0 || !Arc::ptr_eq(&gpu.image.value, &doc.image);
+        if image_is_new {
+            gpu.image = Versioned {
+                version: bump(),
+                value: doc.image.clone(),
+            };
+        }
+        let weights_changed = image_is_new || weights != seen.weights;
+        if weights_changed {
+            let rig = doc.rig();
+            let (rows, nodes, weights) = rig.weight_table();
+            let mesh = MeshData {
+                rest: rig
+                    .domain()
+                    .positions()
+                    .iter()
+                    .map(|p| p.as_vec2())
+                    .collect(),
+                rows,
+                nodes,
+                weights,
+                triangles: rig.domain().triangles().to_vec(),
+                source_size: [doc.image.width(), doc.image.height()],
+            };
+            gpu.mesh = Versioned {
+                version: bump(),
+                value: Arc::new(mesh),
+            };
+            seen.heat = None;
+            seen.cells = 0;
+        }
+        if weights_changed || doc.pose_version != seen.pose {
+            gpu.pose = Versioned {
+                version: bump(),
+                value: Arc::new(doc.rig().node_affines()),
+            };
+        }
+        let heat_key = self
+            .selected
+            .filter(|_| self.show.heat)
+            .map(|s| (s, weights));
+        if let Some((handle, _)) = heat_key
+            && heat_key != seen.heat
+        {
+            gpu.heat = Versioned {
+                version: bump(),
+                value: Arc::new(doc.influence(handle)),
+            };
+            seen.heat = heat_key;
+        }
+        if self.show.cells && seen.cells != weights {
+            let rig = doc.rig();
+            let colors = rig
+                .cells()
+                .iter()
+                .map(|&k| cell_color(rig.nodes()[k as usize].vertex))
+                .collect();
+            gpu.cells = Versioned {
+                version: bump(),
+                value: Arc::new(colors),
+            };
+            seen.cells = weights;
+        }
+        if self.show.dual_graph && self.dual_graph.0 != weights {
+            self.dual_graph = (weights, Arc::new(doc.rig().dual_graph()));
+        }
+        seen.weights = weights;
+        seen.pose = doc.pose_version;
+    }
+}
+
+/// A stable, well-spread colour for a node (keyed by its sample, so it survives
+/// renumbering).
+pub(crate) fn cell_color(key: u32) -> [u8; 4] {
+    let hue = (key.wrapping_mul(2_654_435_761) >> 8) as f32 / (1u32 << 24) as f32;
+    let rgb = egui::ecolor::Hsva::new(hue, 0.75, 0.95, 1.0).to_srgb();
+    [rgb[0], rgb[1], rgb[2], 255]
+}
+
+/// Sets each point handle's rotation to the one that best turns the directions to its
+/// neighbours (all other handles, nearer ones weighing more) from rest to now: the
+/// pseudo-edge heuristic of bounded biharmonic weights.
+pub(crate) fn auto_rotate(handles: &mut [HandleSpec]) {
+    let centres: Vec<(DVec2, DVec2)> = handles
+        .iter()
+        .map(|h| match *h {
+            HandleSpec::Point { rest, .. } => {
+                let now = posed(h)[0];
+                (DVec2::from(rest), now)
+            }
+            HandleSpec::Bar { rest, .. } => {
+                let [a, b] = posed(h);
+                (
+                    (DVec2::from(rest[0]) + DVec2::from(rest[1])) * 0.5,
+                    (a + b) * 0.5,
+                )
+            }
+        })
+        .collect();
+    for (i, h) in handles.iter_mut().enumerate() {
+        let HandleSpec::Point { rotate, .. } = h else {
+            continue;
+        };
+        let (mut dot, mut cross) = (0.0, 0.0);
+        for (j, &(rest_j, now_j)) in centres.iter().enumerate() {
+            if i == j {
+                continue;
+            }
+            let r = rest_j - centres[i].0;
+            let c = now_j - centres[i].1;
+            let w = 1.0 / r.length_squared().max(1e-9);
+            dot += w * r.dot(c);
+            cross += w * r.perp_dot(c);
+        }
+        if dot != 0.0 || cross != 0.0 {
+            *rotate = cross.atan2(dot);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn point(rest: [f64; 2], translate: [f64; 2]) -> HandleSpec {
+        HandleSpec::Point {
+            rest,
+            translate,
+            rotate: 0.0,
+            scale: 1.0,
+        }
+    }
+
+    #[test]
+    fn auto_rotation_follows_a_turn_of_the_neighbours() {
+        // Three handles turned by 90° about the first: the first turns by 90°.
+        let mut handles = vec![
+            point([0.0, 0.0], [0.0, 0.0]),
+            point([10.0, 0.0], [-10.0, 10.0]),
+            point([0.0, 10.0], [-10.0, -10.0]),
+        ];
+        auto_rotate(&mut handles);
+        let HandleSpec::Point { rotate, .. } = handles[0] else {
+            unreachable!()
+        };
+        assert!(
+            (rotate - std::f64::consts::FRAC_PI_2).abs() < 1e-9,
+            "{rotate}"
+        );
+        // A pure translation turns nothing.
+        let mut handles = vec![
+            point([0.0, 0.0], [5.0, 5.0]),
+            point([10.0, 0.0], [5.0, 5.0]),
+        ];
+        auto_rotate(&mut handles);
+        assert!(
+            handles
+                .iter()
+                .all(|h| matches!(h, HandleSpec::Point { rotate, .. } if rotate.abs() < 1e-12))
+        );
+    }
+
+    #[test]
+    fn cell_colours_are_opaque_and_differ() {
+        let a = cell_color(1);
+        let b = cell_color(2);
+        assert_eq!(a[3], 255);
+        assert_ne!(a, b);
+    }
+}

@@ -1,0 +1,471 @@
+//! The canvas: the warped picture (drawn by the GPU through a paint callback), the
+//! handles and overlays on top, and the pointer input that turns into edits.
+
+use egui::{
+    Color32, CursorIcon, Key, PointerButton, Pos2, Rect, Sense, Shape, Stroke, StrokeKind, Ui, Vec2,
+};
+use glam::DVec2;
+use project::HandleSpec;
+use weights_core::NodeKind;
+
+use crate::app::{EditorApp, Grip, HandleDrag, Tool};
+use crate::document::posed;
+use crate::scene::MeshCallback;
+
+/// Radius of a point handle's dot, screen points.
+const DOT: f32 = 6.0;
+/// How close the pointer must be to grab a handle, screen points.
+const GRAB: f32 = 9.0;
+/// Radius of the rotation ring around the selected point handle, screen points.
+pub const RING: f32 = 26.0;
+
+const HANDLE: Color32 = Color32::from_rgb(255, 255, 255);
+const SELECTED: Color32 = Color32::from_rgb(255, 212, 0);
+const OUTLINE: Color32 = Color32::from_rgb(20, 20, 20);
+const VIRTUAL: Color32 = Color32::from_rgb(255, 80, 220);
+const DUAL: Color32 = Color32::from_rgba_premultiplied(0, 200, 255, 200);
+
+impl EditorApp {
+    /// Lays out the canvas in the remaining space, handles its input, and paints it.
+    pub(crate) fn canvas_ui(&mut self, ui: &mut Ui) {
+        let (rect, response) = ui.allocate_exact_size(ui.available_size(), Sense::click_and_drag());
+        response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "Canvas"));
+        self.viewport.canvas = rect;
+        if self.needs_fit
+            && let Some(doc) = &self.doc
+        {
+            self.viewport.fit([doc.image.width(), doc.image.height()]);
+            self.needs_fit = false;
+        }
+        self.canvas_input(ui, &response);
+        self.update_gpu_frame();
+
+        let painter = ui.painter_at(rect);
+        painter.rect_filled(rect, 0.0, Color32::from_gray(38));
+        if let Some(doc) = &self.doc {
+            // The picture's frame, so a transparent picture still shows its extent.
+            let frame = Rect::from_two_pos(
+                self.viewport.to_screen(DVec2::ZERO),
+                self.viewport.to_screen(DVec2::new(
+                    f64::from(doc.image.width()),
+                    f64::from(doc.image.height()),
+                )),
+            );
+            painter.rect_filled(frame, 0.0, Color32::from_gray(56));
+        }
+        if self.has_gpu {
+            let (scale, offset) = self.viewport.device_map();
+            let overlay = if self.show.heat && self.selected.is_some() {
+                render::Overlay::Heat
+            } else if self.show.cells {
+                render::Overlay::Cells
+            } else {
+                render::Overlay::None
+            };
+            let params = render::ViewParams {
+                scale,
+                offset,
+                overlay,
+                show_folds: self.show.folds,
+                wireframe: self.show.mesh,
+            };
+            painter.add(egui_wgpu::Callback::new_paint_callback(
+                rect,
+                MeshCallback {
+                    frame: self.gpu.clone(),
+                    params,
+                },
+            ));
+        } else {
+            painter.text(
+                rect.center(),
+                egui::Align2::CENTER_CENTER,
+                "No GPU renderer: the picture cannot be shown",
+                egui::FontId::proportional(16.0),
+                Color32::LIGHT_RED,
+            );
+        }
+        self.paint_overlays(&painter);
+        if let (Some(a), Some(b)) = (self.bar_start, response.interact_pointer_pos()) {
+            let a = self.viewport.to_screen(a);
+            painter.line_segment([a, b], Stroke::new(4.0, SELECTED));
+        }
+        self.hover_weights(ui, &response);
+    }
+
+    /// The handle under `pos` (screen), and which grip.
+    pub(crate) fn hit(&self, pos: Pos2) -> Option<(usize, Grip)> {
+        let doc = self.doc.as_ref()?;
+        let mut best: Option<(f32, usize, Grip)> = None;
+        let mut consider = |d: f32, i: usize, grip: Grip| {
+            if d < GRAB && best.is_none_or(|(bd, _, _)| d < bd) {
+                best = Some((d, i, grip));
+            }
+        };
+        for (i, h) in doc.project().handles.iter().enumerate() {
+            let [a, b] = posed(h).map(|p| self.viewport.to_screen(p));
+            match h {
+                HandleSpec::Point { .. } => {
+                    let d = a.distance(pos);
+                    consider(d, i, Grip::Move);
+                    if self.selected == Some(i) {
+                        consider((d - RING).abs(), i, Grip::Rotate);
+                    }
+                }
+                HandleSpec::Bar { .. } => {
+                    // Ends win over the body at equal distance.
+                    consider(a.distance(pos) - 0.5, i, Grip::End(0));
+                    consider(b.distance(pos) - 0.5, i, Grip::End(1));
+                    consider(segment_distance(pos, a, b), i, Grip::Move);
+                }
+            }
+        }
+        best.map(|(_, i, g)| (i, g))
+    }
+
+    fn canvas_input(&mut self, ui: &Ui, response: &egui::Response) {
+        let (modifiers, space, scroll, zoom) = ui.input(|i| {
+            (
+                i.modifiers,
+                i.key_down(Key::Space),
+                i.smooth_scroll_delta.y,
+                i.zoom_delta(),
+            )
+        });
+        if let Some(hover) = response.hover_pos() {
+            let factor = zoom * (scroll * 0.0015).exp();
+            if (factor - 1.0).abs() > 1e-4 {
+                self.viewport.zoom_about(hover, factor);
+            }
+        }
+        let press = ui
+            .input(|i| i.pointer.press_origin())
+            .or(response.interact_pointer_pos());
+        if response.drag_started_by(PointerButton::Middle)
+            || (response.drag_started_by(PointerButton::Primary) && space)
+        {
+            self.panning = true;
+        } else if response.drag_started_by(PointerButton::Primary)
+            && let Some(pos) = press
+        {
+            match self.tool {
+                Tool::AddBar => self.bar_start = Some(self.viewport.to_image(pos)),
+                Tool::Select | Tool::AddPoint => match self.hit(pos) {
+                    Some((index, grip)) => self.start_drag(index, grip, pos, modifiers),
+                    None => self.panning = self.tool == Tool::Select,
+                },
+            }
+        }
+        if response.dragged() {
+            if self.panning {
+                self.viewport.origin += response.drag_delta();
+            } else if let Some(pos) = response.interact_pointer_pos() {
+                self.drag_to(self.viewport.to_image(pos));
+            }
+        }
+        if response.drag_stopped() {
+            self.panning = false;
+            self.finish_drag();
+            if let (Some(a), Some(pos)) = (self.bar_start.take(), response.interact_pointer_pos()) {
+                if self.viewport.to_screen(a).distance(pos) > 4.0 {
+                    self.add_bar(a, self.viewport.to_image(pos));
+                }
+            }
+        }
+        if response.clicked_by(PointerButton::Primary)
+            && let Some(pos) = response.interact_pointer_pos()
+        {
+            let hit = self.hit(pos).map(|(i, _)| i);
+            match (self.tool, hit) {
+                (_, Some(i)) => self.selected = Some(i),
+                (Tool::Select, None) => self.selected = None,
+                (Tool::AddPoint, None) => self.add_point(self.viewport.to_image(pos)),
+                (Tool::AddBar, None) => {}
+            }
+        }
+        if response.secondary_clicked()
+            && let Some(pos) = response.interact_pointer_pos()
+        {
+            self.selected = self.hit(pos).map(|(i, _)| i);
+            self.context_point = Some(self.viewport.to_image(pos));
+        }
+        response.context_menu(|ui| self.context_menu(ui));
+        let cursor = if self.panning {
+            Some(CursorIcon::Grabbing)
+        } else if self.drag.is_some() {
+            Some(CursorIcon::Grabbing)
+        } else if response.hover_pos().and_then(|p| self.hit(p)).is_some() {
+            Some(CursorIcon::Grab)
+        } else if self.tool != Tool::Select && response.hovered() {
+            Some(CursorIcon::Crosshair)
+        } else {
+            None
+        };
+        if let Some(cursor) = cursor {
+            ui.ctx().set_cursor_icon(cursor);
+        }
+    }
+
+    fn context_menu(&mut self, ui: &mut Ui) {
+        if let Some(i) = self.selected {
+            if ui.button("Delete handle").clicked() {
+                self.selected = Some(i);
+                self.delete_selected();
+                ui.close();
+            }
+            if ui.button("Reset handle pose").clicked() {
+                if let Some(h) = self.doc.as_ref().and_then(|d| d.project().handles.get(i)) {
+                    let rest = crate::document::at_rest(h);
+                    self.edit(crate::document::Edit::Pose(i, rest));
+                }
+                ui.close();
+            }
+        } else if let Some(at) = self.context_point
+            && ui.button("Add point handle here").clicked()
+        {
+            self.add_point(at);
+            ui.close();
+        }
+    }
+
+    fn start_drag(&mut self, index: usize, grip: Grip, pos: Pos2, modifiers: egui::Modifiers) {
+        let Some(doc) = &self.doc else { return };
+        let Some(start) = doc.project().handles.get(index).cloned() else {
+            return;
+        };
+        let grip = if modifiers.alt {
+            Grip::Rotate
+        } else if modifiers.shift {
+            Grip::Scale
+        } else {
+            grip
+        };
+        self.selected = Some(index);
+        self.drag = Some(HandleDrag {
+            index,
+            grip,
+            start,
+            pointer: self.viewport.to_image(pos),
+            before: doc.project().clone(),
+        });
+    }
+
+    /// Moves the dragged handle so the grabbed point follows the pointer.
+    pub(crate) fn drag_to(&mut self, pointer: DVec2) {
+        let Some(drag) = &self.drag else { return };
+        let delta = pointer - drag.pointer;
+        let [a, b] = posed(&drag.start);
+        let centre = (a + b) * 0.5;
+        let turn = angle_between(drag.pointer - centre, pointer - centre);
+        let stretch = ((pointer - centre).length() / (drag.pointer - centre).length().max(1e-9))
+            .clamp(0.05, 20.0);
+        let handle = match (drag.start.clone(), drag.grip) {
+            (
+                HandleSpec::Point {
+                    rest,
+                    translate,
+                    rotate,
+                    scale,
+                },
+                grip,
+            ) => {
+                let (mut translate, mut rotate, mut scale) = (translate, rotate, scale);
+                match grip {
+                    Grip::Move | Grip::End(_) => {
+                        translate = (DVec2::from(translate) + delta).to_array();
+                    }
+                    Grip::Rotate => rotate += turn,
+                    Grip::Scale => scale = (scale * stretch).clamp(0.01, 100.0),
+                }
+                HandleSpec::Point {
+                    rest,
+                    translate,
+                    rotate,
+                    scale,
+                }
+            }
+            (HandleSpec::Bar { rest, .. }, grip) => {
+                let pose = match grip {
+                    Grip::Move => [a + delta, b + delta],
+                    Grip::End(0) => [a + delta, b],
+                    Grip::End(_) => [a, b + delta],
+                    Grip::Rotate => {
+                        let r = DVec2::from_angle(turn);
+                        [centre + r.rotate(a - centre), centre + r.rotate(b - centre)]
+                    }
+                    Grip::Scale => [
+                        centre + (a - centre) * stretch,
+                        centre + (b - centre) * stretch,
+                    ],
+                };
+                HandleSpec::Bar {
+                    rest,
+                    pose: Some(pose.map(|p| p.to_array())),
+                }
+            }
+        };
+        let index = drag.index;
+        self.set_pose(index, handle);
+    }
+
+    fn paint_overlays(&self, painter: &egui::Painter) {
+        let Some(doc) = &self.doc else { return };
+        let rig = doc.rig();
+        let v = &self.viewport;
+        if self.show.dual_graph {
+            for &(a, b) in self.dual_graph.1.iter() {
+                let (a, b) = (a as usize, b as usize);
+                if a < rig.nodes().len() && b < rig.nodes().len() {
+                    painter.line_segment(
+                        [
+                            v.to_screen(doc.node_position(a)),
+                            v.to_screen(doc.node_position(b)),
+                        ],
+                        Stroke::new(1.5, DUAL),
+                    );
+                }
+            }
+        }
+        if self.show.virtual_handles {
+            for (k, node) in rig.nodes().iter().enumerate() {
+                if matches!(node.kind, NodeKind::Virtual) {
+                    let c = v.to_screen(doc.node_position(k));
+                    let r = 4.5;
+                    painter.add(Shape::convex_polygon(
+                        vec![
+                            c + Vec2::new(0.0, -r),
+                            c + Vec2::new(r, 0.0),
+                            c + Vec2::new(0.0, r),
+                            c + Vec2::new(-r, 0.0),
+                        ],
+                        VIRTUAL,
+                        Stroke::new(1.0, OUTLINE),
+                    ));
+                }
+            }
+        }
+        for (i, h) in doc.project().handles.iter().enumerate() {
+            let fill = if self.selected == Some(i) {
+                SELECTED
+            } else {
+                HANDLE
+            };
+            let [a, b] = posed(h).map(|p| v.to_screen(p));
+            match h {
+                HandleSpec::Point { rotate, scale, .. } => {
+                    if self.selected == Some(i) {
+                        painter.circle_stroke(a, RING, Stroke::new(2.0, OUTLINE));
+                        painter.circle_stroke(a, RING, Stroke::new(1.0, SELECTED));
+                        let tick = Vec2::angled(*rotate as f32) * RING;
+                        painter.line_segment([a, a + tick], Stroke::new(2.0, SELECTED));
+                        painter.circle_filled(a + tick, 4.0, SELECTED);
+                    } else if rotate.abs() > 1e-6 || (scale - 1.0).abs() > 1e-6 {
+                        let tick = Vec2::angled(*rotate as f32) * (DOT + 6.0 * *scale as f32);
+                        painter.line_segment([a, a + tick], Stroke::new(2.0, OUTLINE));
+                    }
+                    painter.circle(a, DOT, fill, Stroke::new(2.0, OUTLINE));
+                }
+                HandleSpec::Bar { .. } => {
+                    painter.line_segment([a, b], Stroke::new(6.0, OUTLINE));
+                    painter.line_segment([a, b], Stroke::new(3.0, fill));
+                    painter.circle(a, DOT - 1.0, fill, Stroke::new(2.0, OUTLINE));
+                    painter.circle(b, DOT - 1.0, fill, Stroke::new(2.0, OUTLINE));
+                }
+            }
+        }
+        painter.rect_stroke(
+            v.canvas,
+            0.0,
+            Stroke::new(1.0, Color32::from_gray(70)),
+            StrokeKind::Inside,
+        );
+    }
+
+    /// A tooltip with the weights of the mesh vertex under the pointer.
+    fn hover_weights(&mut self, ui: &Ui, response: &egui::Response) {
+        if !self.show.hover_weights || self.drag.is_some() || self.panning {
+            return;
+        }
+        let Some(pos) = response.hover_pos() else {
+            return;
+        };
+        let Some(doc) = &mut self.doc else { return };
+        let Some((rest, _, _)) = doc.unwarp(self.viewport.to_image(pos)) else {
+            return;
+        };
+        let rig = doc.rig();
+        let Some(vertex) = rig.domain().nearest_vertex(rest) else {
+            return;
+        };
+        let mut weights: Vec<(usize, f64)> = rig.weights(vertex as usize).collect();
+        weights.sort_by(|a, b| b.1.total_cmp(&a.1));
+        let lines: Vec<String> = weights
+            .iter()
+            .take(5)
+            .map(|&(k, w)| format!("{:>6.3}  {}", w, node_name(rig, k)))
+            .collect();
+        let more = weights.len().saturating_sub(5);
+        let header = format!(
+            "vertex {vertex} at ({:.1}, {:.1}): {} weights",
+            rest.x,
+            rest.y,
+            weights.len()
+        );
+        egui::Tooltip::always_open(
+            ui.ctx().clone(),
+            ui.layer_id(),
+            response.id.with("weights"),
+            egui::PopupAnchor::Pointer,
+        )
+        .gap(12.0)
+        .show(|ui| {
+            ui.label(egui::RichText::new(header).strong());
+            for line in &lines {
+                ui.monospace(line);
+            }
+            if more > 0 {
+                ui.label(format!("… and {more} smaller"));
+            }
+        });
+    }
+}
+
+/// How a node is called in the user interface.
+pub(crate) fn node_name(rig: &weights_core::Rig, k: usize) -> String {
+    match rig.nodes()[k].kind {
+        NodeKind::Point { handle } => format!("point handle {}", handle + 1),
+        NodeKind::BarSample { handle, t } => format!("bar {} at {:.0}%", handle + 1, t * 100.0),
+        NodeKind::Boundary => "pinned border".to_owned(),
+        NodeKind::Virtual => match rig.owner_handle(k) {
+            Some(h) => format!("virtual node {k} (mostly handle {})", h + 1),
+            None => format!("virtual node {k}"),
+        },
+    }
+}
+
+/// The signed angle that turns `from` onto `to`.
+fn angle_between(from: DVec2, to: DVec2) -> f64 {
+    from.perp_dot(to).atan2(from.dot(to))
+}
+
+/// Distance from `p` to the segment `a`–`b`.
+fn segment_distance(p: Pos2, a: Pos2, b: Pos2) -> f32 {
+    let ab = b - a;
+    let t = ((p - a).dot(ab) / ab.length_sq().max(1e-9)).clamp(0.0, 1.0);
+    p.distance(a + ab * t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn angles_and_distances() {
+        let a = angle_between(DVec2::X, DVec2::Y);
+        assert!((a - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+        let d = segment_distance(Pos2::new(5.0, 3.0), Pos2::ZERO, Pos2::new(10.0, 0.0));
+        assert!((d - 3.0).abs() < 1e-6);
+        let d = segment_distance(Pos2::new(-4.0, 3.0), Pos2::ZERO, Pos2::new(10.0, 0.0));
+        assert!((d - 5.0).abs() < 1e-6);
+    }
+}

@@ -1,0 +1,559 @@
+//! The document: the picture, its rig file ([`Project`]) and the weighted rig built from
+//! them. Every change goes through [`Document::apply`] with an [`Edit`]; the rig is
+//! brought up to date incrementally (handles) or rebuilt (parameters), and a failed
+//! edit leaves the document as it was.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use glam::{DAffine2, DVec2};
+use image::RgbaImage;
+use project::{HandleSpec, MetricChoice, Middle, Project};
+use weights_core::{Domain, NodeKind, Rig};
+
+/// The parameters of the weighting a user can change in the side panel.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Settings {
+    /// Shape factor α ∈ [0, 1].
+    pub alpha: f64,
+    /// Basis degree (5…25).
+    pub degree: u32,
+    /// Middle controls of the basis.
+    pub middle: Middle,
+    /// Pin the image border.
+    pub fixed_boundary: bool,
+    /// Distance: auto, Euclidean or intrinsic (shape-aware).
+    pub metric: MetricChoice,
+    /// Target number of mesh vertices.
+    pub density: usize,
+}
+
+impl Settings {
+    fn of(project: &Project) -> Self {
+        Self {
+            alpha: project.alpha,
+            degree: project.degree,
+            middle: project.middle,
+            fixed_boundary: project.fixed_boundary,
+            metric: project.metric,
+            density: project.density.unwrap_or(pipeline::DEFAULT_DENSITY),
+        }
+    }
+
+    fn write_to(self, project: &mut Project) {
+        project.alpha = self.alpha;
+        project.degree = self.degree;
+        project.middle = self.middle;
+        project.fixed_boundary = self.fixed_boundary;
+        project.metric = self.metric;
+        project.density = Some(self.density);
+    }
+}
+
+/// One change to the document.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Edit {
+    /// Appends a handle.
+    Add(HandleSpec),
+    /// Removes handle `index`.
+    Remove(usize),
+    /// Replaces handle `index` with the same rest geometry and a new pose.
+    Pose(usize, HandleSpec),
+    /// Removes every handle.
+    Clear,
+    /// Puts every handle back at rest.
+    ResetPose,
+    /// New weighting parameters (a new density re-meshes the picture).
+    Settings(Settings),
+}
+
+/// An open picture with its rig.
+pub struct Document {
+    /// The rig file as it would be saved (virtual handles are filled in on save).
+    project: Project,
+    /// The picture, at full resolution.
+    pub image: Arc<RgbaImage>,
+    /// Where the picture came from (`None`: the built-in picture).
+    pub image_path: Option<PathBuf>,
+    /// Where the project was last saved or loaded from.
+    pub project_path: Option<PathBuf>,
+    rig: Rig,
+    /// Bumped whenever the nodes or weights change (the GPU mesh must be re-uploaded).
+    pub weights_version: u64,
+    /// Bumped whenever a node transform changes.
+    pub pose_version: u64,
+    /// Milliseconds the last change of handles or parameters took to bring the weights
+    /// up to date.
+    pub last_update_ms: f64,
+    deformed: Option<(u64, Vec<DVec2>)>,
+}
+
+impl Document {
+    /// Meshes `image` and builds the rig of `project` on it.
+    ///
+    /// # Errors
+    /// Handles off the picture or the shape, coincident handles, a picture with no
+    /// opaque pixel, bad parameters.
+    pub fn new(
+        image: RgbaImage,
+        image_path: Option<PathBuf>,
+        mut project: Project,
+    ) -> Result<Self> {
+        let clock = Instant::now();
+        project.density = Some(project.density.unwrap_or(pipeline::DEFAULT_DENSITY));
+        let prepared = pipeline::prepare(&image, &project, None)?;
+        // Virtual handles live in the rig while editing; they are written out on save.
+        project.virtual_handles.clear();
+        Ok(Self {
+            project,
+            image: Arc::new(image),
+            image_path,
+            project_path: None,
+            rig: prepared.rig,
+            weights_version: 1,
+            pose_version: 1,
+            last_update_ms: ms(clock),
+            deformed: None,
+        })
+    }
+
+    /// The built-in picture with its sample rig.
+    ///
+    /// # Errors
+    /// Only if the embedded files are broken.
+    pub fn built_in() -> Result<Self> {
+        let image = render::decode_image(pipeline::DEFAULT_IMAGE, &render::ImageLimits::default())?;
+        let project = Project::from_json(pipeline::DEFAULT_RIG).context("built-in rig")?;
+        Self::new(image, None, project)
+    }
+
+    /// A picture file with no handles.
+    ///
+    /// # Errors
+    /// An unreadable, corrupt, unsupported or oversized picture, or one that cannot be
+    /// meshed (no opaque pixel).
+    pub fn open_image(path: &Path) -> Result<Self> {
+        let image = pipeline::load_image(path)?;
+        let project = Project {
+            image: Some(path.to_path_buf()),
+            ..Project::default()
+        };
+        Self::new(image, Some(path.to_path_buf()), project)
+    }
+
+    /// A project file and the picture it names (relative to the project file).
+    ///
+    /// # Errors
+    /// An unreadable or malformed project, a project without a picture, or a missing
+    /// or bad picture, each naming the file.
+    pub fn open_project(path: &Path) -> Result<Self> {
+        let project = pipeline::load_project(path)?;
+        let Some(image) = &project.image else {
+            bail!("{} names no image", path.display());
+        };
+        let image_path = path.parent().unwrap_or(Path::new("")).join(image);
+        let picture = pipeline::load_image(&image_path)
+            .with_context(|| format!("the image of project {}", path.display()))?;
+        let mut document = Self::new(picture, Some(image_path), project)
+            .with_context(|| format!("project {}", path.display()))?;
+        document.project_path = Some(path.to_path_buf());
+        Ok(document)
+    }
+
+    /// The rig file as it stands (without virtual handles).
+    pub fn project(&self) -> &Project {
+        &self.project
+    }
+
+    /// The weighted rig.
+    pub fn rig(&self) -> &Rig {
+        &self.rig
+    }
+
+    /// The weighting parameters.
+    pub fn settings(&self) -> Settings {
+        Settings::of(&self.project)
+    }
+
+    /// The rig file to save next to `path`: the picture's path relative to the file's
+    /// folder where possible, and the virtual handles, so it reloads with the same
+    /// weights.
+    pub fn project_for_saving(&self, path: Option<&Path>) -> Project {
+        let mut project = self.project.clone();
+        let positions = self.rig.domain().positions();
+        project.virtual_handles = self
+            .rig
+            .virtual_vertices()
+            .iter()
+            .map(|&v| positions[v as usize].to_array())
+            .collect();
+        project.image = self.image_path.as_ref().map(|image| {
+            let folder = path.and_then(Path::parent).unwrap_or(Path::new(""));
+            relative_to(image, folder)
+        });
+        project
+    }
+
+    /// Applies an edit. On error nothing changes.
+    ///
+    /// # Errors
+    /// What the rig rejects: a handle off the shape, coincident handles, a zero-length
+    /// bar, non-finite values, a missing handle; or a re-mesh that fails.
+    pub fn apply(&mut self, edit: Edit) -> Result<()> {
+        let mut project = self.project.clone();
+        match edit {
+            Edit::Add(handle) => project.handles.push(handle),
+            Edit::Remove(index) => {
+                if index >= project.handles.len() {
+                    bail!("there is no handle {index}");
+                }
+                project.handles.remove(index);
+            }
+            Edit::Pose(index, handle) => match project.handles.get_mut(index) {
+                Some(slot) if same_rest(slot, &handle) => *slot = handle,
+                Some(_) => bail!("a pose change may not move handle {index} at rest"),
+                None => bail!("there is no handle {index}"),
+            },
+            Edit::Clear => project.handles.clear(),
+            Edit::ResetPose => {
+                for h in &mut project.handles {
+                    *h = at_rest(h);
+                }
+            }
+            Edit::Settings(settings) => settings.write_to(&mut project),
+        }
+        self.restore(project)
+    }
+
+    /// Makes `project` (same picture) the document's rig file, updating the rig as
+    /// cheaply as the difference allows: poses only, handles added or removed
+    /// incrementally, a rebuild for new parameters, a re-mesh for a new density.
+    ///
+    /// # Errors
+    /// As [`Document::apply`]; on error nothing changes.
+    pub fn restore(&mut self, mut project: Project) -> Result<()> {
+        project.virtual_handles.clear();
+        let clock = Instant::now();
+        let old = self.settings();
+        let new = Settings::of(&project);
+        let handles = pipeline::handles(&project);
+        if new.density != old.density {
+            let prepared = pipeline::prepare(&self.image, &project, None)?;
+            self.rig = prepared.rig;
+        } else if new != old {
+            let domain = self.rig.domain();
+            let metric = pipeline::metric(new.metric, domain.is_convex());
+            let domain = if metric == domain.metric() {
+                domain.clone()
+            } else {
+                Domain::new(
+                    domain.positions().to_vec(),
+                    domain.triangles().to_vec(),
+                    metric,
+                )?
+            };
+            self.rig = Rig::new(domain, handles, pipeline::rig_options(&project)?)?;
+        } else {
+            let same_rest = project.handles.len() == self.project.handles.len()
+                && project
+                    .handles
+                    .iter()
+                    .zip(&self.project.handles)
+                    .all(|(a, b)| same_rest(a, b));
+            self.rig.set_handles(handles)?;
+            if same_rest {
+                self.project = project;
+                self.pose_version += 1;
+                return Ok(());
+            }
+        }
+        self.project = project;
+        self.weights_version += 1;
+        self.pose_version += 1;
+        self.last_update_ms = ms(clock);
+        Ok(())
+    }
+
+    /// Every sample's deformed position (cached per pose).
+    pub fn deformed(&mut self) -> &[DVec2] {
+        let version = self.pose_version * 1_000_003 + self.weights_version;
+        if self.deformed.as_ref().is_none_or(|(v, _)| *v != version) {
+            self.deformed = Some((version, self.rig.deform()));
+        }
+        self.deformed.as_ref().map_or(&[], |(_, d)| d)
+    }
+
+    /// The rest position under `p` in the current pose, and the local similarity the
+    /// pose applies there (rotation, scale), found from the deformed triangle that
+    /// contains `p` (the first one, where folds overlap). `None` off the picture.
+    pub fn unwarp(&mut self, p: DVec2) -> Option<(DVec2, f64, f64)> {
+        let deformed = self.deformed().to_vec();
+        let domain = self.rig.domain();
+        let rest = domain.positions();
+        for &[a, b, c] in domain.triangles() {
+            let [pa, pb, pc] = [a, b, c].map(|v| deformed[v as usize]);
+            let area = (pb - pa).perp_dot(pc - pa);
+            if area.abs() < 1e-12 {
+                continue;
+            }
+            let u = (pb - p).perp_dot(pc - p) / area;
+            let v = (pc - p).perp_dot(pa - p) / area;
+            let w = 1.0 - u - v;
+            let eps = -1e-9;
+            if u < eps || v < eps || w < eps {
+                continue;
+            }
+            let [ra, rb, rc] = [a, b, c].map(|v| rest[v as usize]);
+            let at_rest = ra * u + rb * v + rc * w;
+            // The affine map rest → deformed of this triangle, as its similarity part.
+            let rest_frame = glam::DMat2::from_cols(rb - ra, rc - ra);
+            let pose_frame = glam::DMat2::from_cols(pb - pa, pc - pa);
+            let rotation_scale = if rest_frame.determinant().abs() > 1e-12 {
+                let j = pose_frame * rest_frame.inverse();
+                let angle = (j.x_axis.y - j.y_axis.x).atan2(j.x_axis.x + j.y_axis.y);
+                let scale = j.determinant().max(0.0).sqrt();
+                (angle, if scale > 1e-6 { scale } else { 1.0 })
+            } else {
+                (0.0, 1.0)
+            };
+            return Some((at_rest, rotation_scale.0, rotation_scale.1));
+        }
+        None
+    }
+
+    /// Where node `k` is in the current pose.
+    pub fn node_position(&self, k: usize) -> DVec2 {
+        let vertex = self.rig.nodes()[k].vertex as usize;
+        self.rig
+            .node_transform(k)
+            .transform_point2(self.rig.domain().positions()[vertex])
+    }
+
+    /// The share of handle `handle` in every sample's position: its own nodes'
+    /// weights plus the virtual nodes' weights times their harmonic coordinate for it.
+    pub fn influence(&self, handle: usize) -> Vec<f32> {
+        let rig = &self.rig;
+        let share: Vec<f64> = (0..rig.nodes().len())
+            .map(|k| match rig.nodes()[k].kind {
+                NodeKind::Point { handle: h } | NodeKind::BarSample { handle: h, .. } => {
+                    f64::from(u8::from(h == handle))
+                }
+                NodeKind::Virtual => rig
+                    .harmonic_coordinates(k)
+                    .and_then(|c| c.get(handle).copied())
+                    .unwrap_or(0.0),
+                NodeKind::Boundary => 0.0,
+            })
+            .collect();
+        (0..rig.domain().len())
+            .map(|v| {
+                rig.weights(v)
+                    .map(|(k, w)| w * share[k])
+                    .sum::<f64>()
+                    .clamp(0.0, 1.0) as f32
+            })
+            .collect()
+    }
+
+    /// The transform of handle `index` as an affine map (identity for a missing one).
+    pub fn handle_transform(&self, index: usize) -> DAffine2 {
+        match self.project.handles.get(index) {
+            Some(HandleSpec::Point {
+                rest,
+                translate,
+                rotate,
+                scale,
+            }) => {
+                let rest = DVec2::from(*rest);
+                DAffine2::from_translation(rest + DVec2::from(*translate))
+                    * DAffine2::from_scale_angle_translation(
+                        DVec2::splat(*scale),
+                        *rotate,
+                        DVec2::ZERO,
+                    )
+                    * DAffine2::from_translation(-rest)
+            }
+            _ => DAffine2::IDENTITY,
+        }
+    }
+}
+
+/// Whether two handles have the same kind and rest geometry.
+pub fn same_rest(a: &HandleSpec, b: &HandleSpec) -> bool {
+    match (a, b) {
+        (HandleSpec::Point { rest: r, .. }, HandleSpec::Point { rest: s, .. }) => r == s,
+        (HandleSpec::Bar { rest: r, .. }, HandleSpec::Bar { rest: s, .. }) => r == s,
+        _ => false,
+    }
+}
+
+/// The handle with its pose reset.
+pub fn at_rest(h: &HandleSpec) -> HandleSpec {
+    match *h {
+        HandleSpec::Point { rest, .. } => HandleSpec::Point {
+            rest,
+            translate: [0.0; 2],
+            rotate: 0.0,
+            scale: 1.0,
+        },
+        HandleSpec::Bar { rest, .. } => HandleSpec::Bar { rest, pose: None },
+    }
+}
+
+/// Where a handle is now: a point handle's position, or a bar's two ends.
+pub fn posed(h: &HandleSpec) -> [DVec2; 2] {
+    match *h {
+        HandleSpec::Point {
+            rest, translate, ..
+        } => {
+            let p = DVec2::from(rest) + DVec2::from(translate);
+            [p, p]
+        }
+        HandleSpec::Bar { rest, pose } => pose.unwrap_or(rest).map(DVec2::from),
+    }
+}
+
+/// `path` relative to `folder` when it lies inside it, else `path` made absolute.
+fn relative_to(path: &Path, folder: &Path) -> PathBuf {
+    let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+    let (path, folder) = (absolute(path), absolute(folder));
+    match path.strip_prefix(&folder) {
+        Ok(relative) => relative.to_path_buf(),
+        Err(_) => path,
+    }
+}
+
+fn ms(clock: Instant) -> f64 {
+    clock.elapsed().as_secs_f64() * 1e3
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn point(x: f64, y: f64) -> HandleSpec {
+        HandleSpec::Point {
+            rest: [x, y],
+            translate: [0.0; 2],
+            rotate: 0.0,
+            scale: 1.0,
+        }
+    }
+
+    fn document() -> Document {
+        let image = RgbaImage::from_pixel(64, 48, image::Rgba([200, 100, 50, 255]));
+        let project = Project {
+            density: Some(2000),
+            handles: vec![point(10.0, 10.0), point(50.0, 30.0)],
+            ..Project::default()
+        };
+        Document::new(image, None, project).expect("a simple document")
+    }
+
+    #[test]
+    fn a_rejected_edit_changes_nothing() {
+        let mut doc = document();
+        let before = doc.project().clone();
+        let version = doc.weights_version;
+        assert!(
+            doc.apply(Edit::Add(point(10.0, 10.0))).is_err(),
+            "coincident"
+        );
+        assert!(doc.apply(Edit::Add(point(f64::NAN, 3.0))).is_err(), "NaN");
+        assert!(
+            doc.apply(Edit::Add(point(500.0, 3.0))).is_err(),
+            "off the picture"
+        );
+        assert!(doc.apply(Edit::Remove(7)).is_err());
+        assert!(
+            doc.apply(Edit::Pose(0, point(11.0, 10.0))).is_err(),
+            "moves rest"
+        );
+        let bar = HandleSpec::Bar {
+            rest: [[20.0, 20.0], [20.0, 20.0]],
+            pose: None,
+        };
+        assert!(doc.apply(Edit::Add(bar)).is_err(), "zero-length bar");
+        assert_eq!(doc.project(), &before);
+        assert_eq!(doc.weights_version, version);
+        assert_eq!(doc.rig().handles().len(), 2);
+    }
+
+    #[test]
+    fn pose_edits_keep_weights_and_insertions_update_them() {
+        let mut doc = document();
+        let w = doc.weights_version;
+        let moved = HandleSpec::Point {
+            rest: [10.0, 10.0],
+            translate: [5.0, 0.0],
+            rotate: 0.2,
+            scale: 1.1,
+        };
+        doc.apply(Edit::Pose(0, moved)).expect("pose");
+        assert_eq!(doc.weights_version, w, "a pose leaves the weights");
+        let at = doc.node_position(0);
+        assert!((at - DVec2::new(15.0, 10.0)).length() < 1e-9, "{at}");
+        doc.apply(Edit::Add(point(30.0, 40.0))).expect("insert");
+        assert!(doc.weights_version > w);
+        assert_eq!(doc.rig().handles().len(), 3);
+        doc.apply(Edit::ResetPose).expect("reset");
+        let at = doc.node_position(0);
+        assert!((at - DVec2::new(10.0, 10.0)).length() < 1e-9);
+        doc.apply(Edit::Clear).expect("clear");
+        assert!(doc.project().handles.is_empty());
+    }
+
+    #[test]
+    fn unwarp_inverts_the_pose() {
+        let mut doc = document();
+        let moved = HandleSpec::Point {
+            rest: [10.0, 10.0],
+            translate: [4.0, 3.0],
+            rotate: 0.0,
+            scale: 1.0,
+        };
+        doc.apply(Edit::Pose(0, moved)).expect("pose");
+        let rest = DVec2::new(20.0, 15.0);
+        let now = doc
+            .rig()
+            .deform_point(&doc.rig().deform(), rest)
+            .expect("inside");
+        let (back, _, scale) = doc.unwarp(now).expect("on the picture");
+        assert!((back - rest).length() < 1e-6, "{back} vs {rest}");
+        assert!((scale - 1.0).abs() < 0.2);
+        assert!(doc.unwarp(DVec2::new(-50.0, -50.0)).is_none());
+    }
+
+    #[test]
+    fn settings_rebuild_and_influence_partitions_unity() {
+        let mut doc = document();
+        let mut settings = doc.settings();
+        settings.alpha = 0.5;
+        settings.metric = MetricChoice::Intrinsic;
+        doc.apply(Edit::Settings(settings)).expect("rebuild");
+        assert_eq!(doc.rig().options().alpha, 0.5);
+        settings.density = 1000;
+        doc.apply(Edit::Settings(settings)).expect("re-mesh");
+        assert!(doc.rig().domain().len() < 1500);
+        let a = doc.influence(0);
+        let b = doc.influence(1);
+        for (x, y) in a.iter().zip(&b) {
+            assert!((x + y - 1.0).abs() < 1e-4, "{x} + {y}");
+        }
+    }
+
+    #[test]
+    fn saved_projects_name_the_picture_relative_to_the_file() {
+        let mut doc = document();
+        doc.image_path = Some(PathBuf::from("/tmp/pictures/cat.png"));
+        let saved = doc.project_for_saving(Some(Path::new("/tmp/pictures/cat.json")));
+        assert_eq!(saved.image.as_deref(), Some(Path::new("cat.png")));
+        let saved = doc.project_for_saving(Some(Path::new("/elsewhere/cat.json")));
+        assert_eq!(
+            saved.image.as_deref(),
+            Some(Path::new("/tmp/pictures/cat.png"))
+        );
+    }
+}

@@ -1,0 +1,52 @@
+//! The C2Warp editor: open a picture, pin point and bar handles on it, drag, rotate and
+//! scale them, insert and remove them while posed, and export the warped PNG.
+//!
+//! The picture is meshed ([`mesh`]), weighted ([`weights_core`]) and drawn as a
+//! skinned textured mesh through an egui wgpu paint callback ([`render::MeshView`]):
+//! a drag uploads only the node transforms. The [`EditorApp`] holds a [`Document`]
+//! (picture + rig file + weighted rig) and an undo history of whole rig files; widgets
+//! turn input into [`Edit`]s that one place applies.
+
+mod app;
+mod canvas;
+mod dialogs;
+mod document;
+mod history;
+mod panels;
+mod scene;
+mod viewport;
+
+use std::path::PathBuf;
+
+pub use app::{EditorApp, Message, Pending, Show, Tool};
+pub use dialogs::{Dialogs, NativeDialogs};
+pub use document::{Document, Edit, Settings};
+pub use panels::SHORTCUTS;
+pub use scene::SceneResources;
+pub use viewport::Viewport;
+
+/// Opens the editor window on `path` (a picture, or a `.json` project) or on the
+/// built-in picture, and returns when the window closes.
+///
+/// # Errors
+/// No window or no GPU adapter could be had.
+pub fn run(path: Option<PathBuf>) -> anyhow::Result<()> {
+    let options = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default()
+            .with_title("C2Warp")
+            .with_inner_size([1280.0, 820.0])
+            .with_min_inner_size([640.0, 420.0])
+            .with_drag_and_drop(true),
+        renderer: eframe::Renderer::Wgpu,
+        // The mesh pipelines are built for one sample and no depth buffer.
+        multisampling: 0,
+        depth_buffer: 0,
+        ..Default::default()
+    };
+    eframe::run_native(
+        "C2Warp",
+        options,
+        Box::new(move |cc| Ok(Box::new(EditorApp::new(cc, path.as_deref())))),
+    )
+    .map_err(|e| anyhow::anyhow!("cannot open the editor window: {e}"))
+}

@@ -1,0 +1,450 @@
+//! The frame around the canvas: menu bar, side panel (tools, parameters, overlays),
+//! status bar, keyboard shortcuts, the help window and the unsaved-changes question.
+
+use std::time::Instant;
+
+use egui::{Key, KeyboardShortcut, Modifiers, Ui};
+use project::{MetricChoice, Middle};
+
+use crate::app::{EditorApp, Pending, Tool};
+use crate::document::Edit;
+
+/// Every shortcut, as the help window lists them.
+pub const SHORTCUTS: &[(&str, &str)] = &[
+    ("V", "Select / move tool"),
+    ("P", "Add point handle tool"),
+    ("B", "Add bar handle tool"),
+    (
+        "Drag a handle",
+        "Move it (a bar's end: turn and stretch the bar)",
+    ),
+    ("Alt + drag, or drag the ring", "Rotate the handle"),
+    ("Shift + drag", "Scale the handle"),
+    ("Right click", "Handle menu: delete, reset pose"),
+    ("Delete / Backspace", "Delete the selected handle"),
+    ("Middle drag, Space + drag", "Pan"),
+    ("Mouse wheel, pinch", "Zoom about the pointer"),
+    ("F", "Fit the picture to the window"),
+    ("M", "Show or hide the mesh"),
+    ("Ctrl + Z", "Undo"),
+    ("Ctrl + Shift + Z, Ctrl + Y", "Redo"),
+    ("Ctrl + O", "Open an image"),
+    ("Ctrl + Shift + O", "Open a project"),
+    ("Ctrl + S", "Save the project"),
+    ("Ctrl + Shift + S", "Save the project as"),
+    ("Ctrl + E", "Export the warped PNG"),
+    ("Escape", "Deselect, cancel"),
+    ("F1", "This window"),
+];
+
+impl eframe::App for EditorApp {
+    fn ui(&mut self, ui: &mut Ui, _frame: &mut eframe::Frame) {
+        let clock = Instant::now();
+        let ctx = ui.ctx().clone();
+        self.dropped_files(&ctx);
+        self.close_request(&ctx);
+        self.shortcuts(&ctx);
+        egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
+        egui::Panel::bottom("status").show(ui, |ui| self.status_bar(ui));
+        egui::Panel::left("tools")
+            .resizable(false)
+            .default_size(220.0)
+            .show(ui, |ui| {
+                egui::ScrollArea::vertical().show(ui, |ui| self.side_panel(ui));
+            });
+        egui::CentralPanel::default()
+            .frame(egui::Frame::NONE)
+            .show(ui, |ui| self.canvas_ui(ui));
+        self.help_window(&ctx);
+        self.pending_modal(&ctx);
+        self.frame_ms = clock.elapsed().as_secs_f64() * 1e3;
+    }
+}
+
+impl EditorApp {
+    fn dropped_files(&mut self, ctx: &egui::Context) {
+        let dropped = ctx.input(|i| {
+            i.raw
+                .dropped_files
+                .first()
+                .map(|f| f.path().to_path_buf())
+                .filter(|p| !p.as_os_str().is_empty())
+        });
+        if let Some(path) = dropped {
+            self.request_open(path);
+        }
+    }
+
+    fn close_request(&mut self, ctx: &egui::Context) {
+        if ctx.input(|i| i.viewport().close_requested()) && self.dirty && !self.allow_close {
+            ctx.send_viewport_cmd(egui::ViewportCommand::CancelClose);
+            self.pending = Some(Pending::Close);
+        }
+    }
+
+    fn shortcuts(&mut self, ctx: &egui::Context) {
+        if ctx.egui_wants_keyboard_input() {
+            return;
+        }
+        let ctrl = Modifiers::COMMAND;
+        let ctrl_shift = Modifiers::COMMAND | Modifiers::SHIFT;
+        let pressed = |modifiers, key| {
+            ctx.input_mut(|i| i.consume_shortcut(&KeyboardShortcut::new(modifiers, key)))
+        };
+        // Longer combinations first: Ctrl+Shift+Z must not read as Ctrl+Z.
+        if pressed(ctrl_shift, Key::Z) || pressed(ctrl, Key::Y) {
+            self.redo();
+        } else if pressed(ctrl, Key::Z) {
+            self.undo();
+        }
+        if pressed(ctrl_shift, Key::S) {
+            self.save_as();
+        } else if pressed(ctrl, Key::S) {
+            self.save();
+        }
+        if pressed(ctrl_shift, Key::O) {
+            if let Some(path) = self.dialogs.open_project() {
+                self.request_open(path);
+            }
+        } else if pressed(ctrl, Key::O)
+            && let Some(path) = self.dialogs.open_image()
+        {
+            self.request_open(path);
+        }
+        if pressed(ctrl, Key::E) {
+            self.export();
+        }
+        let none = Modifiers::NONE;
+        if pressed(none, Key::Delete) || pressed(none, Key::Backspace) {
+            self.delete_selected();
+        }
+        if pressed(none, Key::V) {
+            self.tool = Tool::Select;
+        }
+        if pressed(none, Key::P) {
+            self.tool = Tool::AddPoint;
+        }
+        if pressed(none, Key::B) {
+            self.tool = Tool::AddBar;
+        }
+        if pressed(none, Key::F) {
+            self.needs_fit = true;
+        }
+        if pressed(none, Key::M) {
+            self.show.mesh = !self.show.mesh;
+        }
+        if pressed(none, Key::F1) {
+            self.help_open = !self.help_open;
+        }
+        if pressed(none, Key::Escape) {
+            self.selected = None;
+            self.bar_start = None;
+            self.pending = None;
+        }
+    }
+
+    fn menu_bar(&mut self, ui: &mut Ui) {
+        egui::MenuBar::new().ui(ui, |ui| {
+            ui.menu_button("File", |ui| {
+                if ui.button("Open image…").clicked() {
+                    ui.close();
+                    if let Some(path) = self.dialogs.open_image() {
+                        self.request_open(path);
+                    }
+                }
+                if ui.button("Open project…").clicked() {
+                    ui.close();
+                    if let Some(path) = self.dialogs.open_project() {
+                        self.request_open(path);
+                    }
+                }
+                ui.separator();
+                if ui.button("Save project").clicked() {
+                    ui.close();
+                    self.save();
+                }
+                if ui.button("Save project as…").clicked() {
+                    ui.close();
+                    self.save_as();
+                }
+                if ui.button("Export PNG…").clicked() {
+                    ui.close();
+                    self.export();
+                }
+                ui.separator();
+                if ui.button("Quit").clicked() {
+                    ui.close();
+                    ui.ctx().send_viewport_cmd(egui::ViewportCommand::Close);
+                }
+            });
+            ui.menu_button("Edit", |ui| {
+                if ui
+                    .add_enabled(self.history.can_undo(), egui::Button::new("Undo"))
+                    .clicked()
+                {
+                    self.undo();
+                }
+                if ui
+                    .add_enabled(self.history.can_redo(), egui::Button::new("Redo"))
+                    .clicked()
+                {
+                    self.redo();
+                }
+                ui.separator();
+                self.edit_buttons(ui);
+            });
+            ui.menu_button("View", |ui| {
+                if ui.button("Fit to window").clicked() {
+                    self.needs_fit = true;
+                }
+                ui.separator();
+                self.overlay_toggles(ui);
+            });
+            ui.menu_button("Help", |ui| {
+                if ui.button("Keyboard shortcuts").clicked() {
+                    self.help_open = true;
+                    ui.close();
+                }
+            });
+        });
+    }
+
+    fn edit_buttons(&mut self, ui: &mut Ui) {
+        if ui
+            .add_enabled(self.selected.is_some(), egui::Button::new("Delete handle"))
+            .clicked()
+        {
+            self.delete_selected();
+        }
+        if ui.button("Clear all handles").clicked() {
+            self.edit(Edit::Clear);
+            self.selected = None;
+        }
+        if ui.button("Reset pose").clicked() {
+            self.edit(Edit::ResetPose);
+        }
+    }
+
+    fn overlay_toggles(&mut self, ui: &mut Ui) {
+        ui.checkbox(&mut self.show.mesh, "Show mesh");
+        ui.checkbox(&mut self.show.virtual_handles, "Virtual handles");
+        ui.checkbox(&mut self.show.cells, "Voronoi cells");
+        ui.checkbox(&mut self.show.dual_graph, "Dual graph");
+        ui.checkbox(&mut self.show.heat, "Weight heat map")
+            .on_hover_text("The selected handle's weight, with isolines every 0.1");
+        ui.checkbox(&mut self.show.folds, "Fold-overs");
+        ui.checkbox(&mut self.show.hover_weights, "Weights under cursor");
+    }
+
+    fn side_panel(&mut self, ui: &mut Ui) {
+        ui.heading("Tools");
+        ui.horizontal_wrapped(|ui| {
+            ui.selectable_value(&mut self.tool, Tool::Select, "Select");
+            ui.selectable_value(&mut self.tool, Tool::AddPoint, "Add point");
+            ui.selectable_value(&mut self.tool, Tool::AddBar, "Add bar");
+        });
+        ui.horizontal_wrapped(|ui| self.edit_buttons(ui));
+        ui.horizontal(|ui| {
+            if ui
+                .add_enabled(self.history.can_undo(), egui::Button::new("Undo"))
+                .clicked()
+            {
+                self.undo();
+            }
+            if ui
+                .add_enabled(self.history.can_redo(), egui::Button::new("Redo"))
+                .clicked()
+            {
+                self.redo();
+            }
+            if ui.button("Fit to window").clicked() {
+                self.needs_fit = true;
+            }
+        });
+        ui.checkbox(&mut self.auto_rotate, "Auto-rotate points")
+            .on_hover_text("Point handles turn with their neighbours' motion");
+        ui.separator();
+        ui.heading("Weights");
+        self.parameters(ui);
+        ui.separator();
+        ui.heading("Show");
+        self.overlay_toggles(ui);
+        ui.separator();
+        if let Some(i) = self.selected
+            && let Some(doc) = &self.doc
+            && let Some(h) = doc.project().handles.get(i)
+        {
+            ui.heading(format!("Handle {}", i + 1));
+            match h {
+                project::HandleSpec::Point {
+                    rest,
+                    translate,
+                    rotate,
+                    scale,
+                } => {
+                    ui.label(format!("point at ({:.1}, {:.1})", rest[0], rest[1]));
+                    ui.label(format!(
+                        "moved by ({:.1}, {:.1})",
+                        translate[0], translate[1]
+                    ));
+                    ui.label(format!(
+                        "rotated {:.1}°, scaled {:.2}×",
+                        rotate.to_degrees(),
+                        scale
+                    ));
+                }
+                project::HandleSpec::Bar { rest, .. } => {
+                    ui.label(format!(
+                        "bar from ({:.1}, {:.1}) to ({:.1}, {:.1})",
+                        rest[0][0], rest[0][1], rest[1][0], rest[1][1]
+                    ));
+                }
+            }
+        }
+    }
+
+    /// Sliders and choices of the weighting. Sliders apply when released, so a drag
+    /// across them does not rebuild the rig every frame.
+    fn parameters(&mut self, ui: &mut Ui) {
+        let Some(doc) = &self.doc else { return };
+        let current = doc.settings();
+        let mut draft = self.settings_draft.unwrap_or(current);
+        let mut commit = false;
+        let released = |r: &egui::Response| r.drag_stopped() || (r.changed() && !r.dragged());
+        let r = ui.add(egui::Slider::new(&mut draft.alpha, 0.0..=1.0).text("α (shape factor)"));
+        commit |= released(&r);
+        let r = ui.add(egui::Slider::new(&mut draft.degree, 5..=25).text("Basis degree"));
+        commit |= released(&r);
+        let r = ui.add(
+            egui::Slider::new(&mut draft.density, 500..=500_000)
+                .logarithmic(true)
+                .text("Mesh density"),
+        );
+        commit |= released(&r);
+        let before = draft;
+        ui.checkbox(&mut draft.fixed_boundary, "Fixed boundary");
+        egui::ComboBox::from_label("Distance")
+            .selected_text(metric_name(draft.metric))
+            .show_ui(ui, |ui| {
+                for m in [
+                    MetricChoice::Auto,
+                    MetricChoice::Intrinsic,
+                    MetricChoice::Euclidean,
+                ] {
+                    ui.selectable_value(&mut draft.metric, m, metric_name(m));
+                }
+            });
+        egui::ComboBox::from_label("Middle controls")
+            .selected_text(middle_name(draft.middle))
+            .show_ui(ui, |ui| {
+                for m in [Middle::Half, Middle::Linear] {
+                    ui.selectable_value(&mut draft.middle, m, middle_name(m));
+                }
+            });
+        commit |= draft != before;
+        if commit && draft != current {
+            self.settings_draft = None;
+            self.edit(Edit::Settings(draft));
+        } else if draft != current {
+            self.settings_draft = Some(draft);
+        }
+    }
+
+    fn status_bar(&mut self, ui: &mut Ui) {
+        ui.horizontal(|ui| {
+            if let Some(doc) = &self.doc {
+                let stats = doc.rig().stats();
+                ui.label(format!("{} vertices", stats.samples));
+                ui.separator();
+                ui.label(format!(
+                    "{} handles ({} nodes) + {} virtual",
+                    stats.real_handles, stats.handle_nodes, stats.virtual_nodes
+                ));
+                ui.separator();
+                ui.label(format!("weights updated in {:.1} ms", doc.last_update_ms));
+                ui.separator();
+                ui.label(format!("frame {:.1} ms", self.frame_ms));
+                ui.separator();
+                ui.label(format!("zoom {:.0}%", self.viewport.zoom * 100.0));
+                if self.dirty {
+                    ui.separator();
+                    ui.label("unsaved");
+                }
+            }
+            if let Some(message) = &self.message {
+                ui.separator();
+                let color = if message.is_error {
+                    ui.visuals().error_fg_color
+                } else {
+                    ui.visuals().text_color()
+                };
+                ui.colored_label(color, &message.text);
+            }
+        });
+    }
+
+    fn help_window(&mut self, ctx: &egui::Context) {
+        let mut open = self.help_open;
+        egui::Window::new("Keyboard shortcuts")
+            .open(&mut open)
+            .resizable(false)
+            .show(ctx, |ui| {
+                egui::Grid::new("shortcuts").striped(true).show(ui, |ui| {
+                    for (keys, what) in SHORTCUTS {
+                        ui.strong(*keys);
+                        ui.label(*what);
+                        ui.end_row();
+                    }
+                });
+            });
+        self.help_open = open;
+    }
+
+    fn pending_modal(&mut self, ctx: &egui::Context) {
+        let Some(pending) = self.pending.clone() else {
+            return;
+        };
+        let mut answer = None;
+        egui::Modal::new(egui::Id::unique("unsaved changes")).show(ctx, |ui| {
+            ui.heading("Unsaved changes");
+            ui.label("The current project has changes that are not saved. Discard them?");
+            ui.horizontal(|ui| {
+                if ui.button("Discard changes").clicked() {
+                    answer = Some(true);
+                }
+                if ui.button("Cancel").clicked() {
+                    answer = Some(false);
+                }
+            });
+        });
+        match answer {
+            Some(true) => {
+                self.pending = None;
+                match pending {
+                    Pending::Open(path) => self.open(&path),
+                    Pending::Close => {
+                        self.allow_close = true;
+                        ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+                    }
+                }
+            }
+            Some(false) => self.pending = None,
+            None => {}
+        }
+    }
+}
+
+fn metric_name(m: MetricChoice) -> &'static str {
+    match m {
+        MetricChoice::Auto => "Auto",
+        MetricChoice::Intrinsic => "Shape-aware (intrinsic)",
+        MetricChoice::Euclidean => "Euclidean",
+    }
+}
+
+fn middle_name(m: Middle) -> &'static str {
+    match m {
+        Middle::Half => "Half",
+        Middle::Linear => "Linear",
+    }
+}

@@ -1,0 +1,163 @@
+//! What the canvas hands the GPU each frame, and the paint callback that uploads what
+//! changed and draws it with [`render::MeshView`].
+//!
+//! Every part carries a version; the callback resources remember the versions they
+//! uploaded, so a drag re-uploads only the node transforms (24 bytes a node) and a new
+//! handle only the weights.
+
+use std::sync::Arc;
+
+use egui_wgpu::wgpu;
+use glam::Vec2;
+use image::RgbaImage;
+use render::{Affine, MeshView, SkinnedMesh, ViewParams};
+
+/// A value with the version it was made at (0: nothing yet).
+#[derive(Default)]
+pub struct Versioned<T> {
+    /// Increases with every new value.
+    pub version: u64,
+    /// The value.
+    pub value: Arc<T>,
+}
+
+impl<T> Clone for Versioned<T> {
+    fn clone(&self) -> Self {
+        Self {
+            version: self.version,
+            value: self.value.clone(),
+        }
+    }
+}
+
+/// The mesh with its weights, as the shader reads them.
+#[derive(Default)]
+pub struct MeshData {
+    /// Rest positions (pixels).
+    pub rest: Vec<Vec2>,
+    /// Row offsets of the weights, one per vertex plus one.
+    pub rows: Vec<u32>,
+    /// Node of each weight.
+    pub nodes: Vec<u32>,
+    /// The weights.
+    pub weights: Vec<f32>,
+    /// Triangles.
+    pub triangles: Vec<[u32; 3]>,
+    /// The picture's size in pixels.
+    pub source_size: [u32; 2],
+}
+
+/// Everything the GPU draws, by version.
+#[derive(Clone, Default)]
+pub struct GpuFrame {
+    /// The picture.
+    pub image: Versioned<RgbaImage>,
+    /// Mesh and weights.
+    pub mesh: Versioned<MeshData>,
+    /// Node transforms.
+    pub pose: Versioned<Vec<Affine>>,
+    /// Heat-map values per vertex.
+    pub heat: Versioned<Vec<f32>>,
+    /// Cell colours per vertex.
+    pub cells: Versioned<Vec<[u8; 4]>>,
+}
+
+/// The GPU side, kept in the renderer's callback resources.
+pub struct SceneResources {
+    view: MeshView,
+    uploaded: [u64; 5],
+    /// The last upload failure, if any (shown in the status bar).
+    pub error: Option<String>,
+}
+
+impl SceneResources {
+    /// Pipelines for the window's target format (no multisampling, no depth buffer,
+    /// as the editor configures eframe).
+    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, format: wgpu::TextureFormat) -> Self {
+        Self {
+            view: MeshView::new(device, queue, format, 1),
+            uploaded: [0; 5],
+            error: None,
+        }
+    }
+
+    fn update(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, frame: &GpuFrame) {
+        let versions = [
+            frame.image.version,
+            frame.mesh.version,
+            frame.pose.version,
+            frame.heat.version,
+            frame.cells.version,
+        ];
+        if versions[0] != self.uploaded[0] {
+            self.view.set_texture(device, queue, &frame.image.value);
+        }
+        let mesh_changed = versions[1] != self.uploaded[1];
+        let mut result = Ok(());
+        if mesh_changed {
+            let m = &frame.mesh.value;
+            let mesh = SkinnedMesh {
+                rest: &m.rest,
+                rows: &m.rows,
+                nodes: &m.nodes,
+                weights: &m.weights,
+                triangles: &m.triangles,
+            };
+            result = self
+                .view
+                .set_mesh(device, &mesh, &frame.pose.value, m.source_size);
+        } else if versions[2] != self.uploaded[2] {
+            result = self.view.set_pose(queue, &frame.pose.value);
+        }
+        if result.is_ok() && (mesh_changed || versions[3] != self.uploaded[3]) {
+            if !frame.heat.value.is_empty() {
+                result = self.view.set_heat(queue, &frame.heat.value);
+            }
+        }
+        if result.is_ok() && (mesh_changed || versions[4] != self.uploaded[4]) {
+            if !frame.cells.value.is_empty() {
+                result = self.view.set_cells(queue, &frame.cells.value);
+            }
+        }
+        self.error = result.err().map(|e| e.to_string());
+        self.uploaded = versions;
+    }
+}
+
+/// The canvas' paint callback.
+pub struct MeshCallback {
+    /// What to draw.
+    pub frame: GpuFrame,
+    /// Where and how.
+    pub params: ViewParams,
+}
+
+impl egui_wgpu::CallbackTrait for MeshCallback {
+    fn prepare(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        _screen: &egui_wgpu::ScreenDescriptor,
+        _encoder: &mut wgpu::CommandEncoder,
+        resources: &mut egui_wgpu::CallbackResources,
+    ) -> Vec<wgpu::CommandBuffer> {
+        if let Some(scene) = resources.get_mut::<SceneResources>() {
+            scene.update(device, queue, &self.frame);
+            scene.view.prepare(queue, &self.params);
+        }
+        Vec::new()
+    }
+
+    fn paint(
+        &self,
+        _info: egui::PaintCallbackInfo,
+        pass: &mut wgpu::RenderPass<'static>,
+        resources: &egui_wgpu::CallbackResources,
+    ) {
+        if let Some(scene) = resources.get::<SceneResources>()
+            && scene.error.is_none()
+        {
+            scene.view.paint(pass, self.params.wireframe);
+        }
+    }
+}
