@@ -277,11 +277,16 @@ impl EditorApp {
             self.error(&anyhow::anyhow!("click on the picture to add a handle"));
             return;
         };
+        // Round-off of an unposed neighbourhood is no rotation or scale.
         let handle = HandleSpec::Point {
             rest: rest.to_array(),
             translate: (at - rest).to_array(),
-            rotate,
-            scale,
+            rotate: if rotate.abs() < 1e-9 { 0.0 } else { rotate },
+            scale: if (scale - 1.0).abs() < 1e-9 {
+                1.0
+            } else {
+                scale
+            },
         };
         self.edit(Edit::Add(handle));
         if let Some(doc) = &self.doc {

@@ -96,7 +96,7 @@ fn a_new_pose_moves_the_mesh() {
     let shifted = [1.0, 0.0, 0.0, 1.0, 4.0, 0.0];
     scene
         .view
-        .set_pose(scene.gpu.queue(), &shifted)
+        .set_pose(scene.gpu.queue(), &[shifted])
         .expect("pose");
     let image = scene.draw(Overlay::None, true);
     for (x, _, p) in image.enumerate_pixels() {

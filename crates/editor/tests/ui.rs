@@ -1,0 +1,345 @@
+//! The editor driven as a user drives it: widgets found by their accessible labels,
+//! pointer and keys simulated, the canvas drawn by the real wgpu paint callback on the
+//! software adapter (snapshots in `tests/snapshots`, tolerances in `kittest.toml`).
+//!
+//! File dialogs are answered by [`Scripted`] with paths in a temporary folder.
+
+use std::path::{Path, PathBuf};
+
+use egui::{Key, Modifiers, Pos2, Vec2};
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use glam::DVec2;
+use project::{HandleSpec, Project};
+
+use editor::{Dialogs, EditorApp, Tool};
+
+/// Answers every file dialog with a fixed file in `dir`.
+struct Scripted {
+    dir: PathBuf,
+}
+
+impl Dialogs for Scripted {
+    fn open_image(&mut self) -> Option<PathBuf> {
+        Some(self.dir.join("lizard.png"))
+    }
+    fn open_project(&mut self) -> Option<PathBuf> {
+        Some(self.dir.join("project.json"))
+    }
+    fn save_project(&mut self, _suggested: &str) -> Option<PathBuf> {
+        Some(self.dir.join("project.json"))
+    }
+    fn export_png(&mut self, _suggested: &str) -> Option<PathBuf> {
+        Some(self.dir.join("warped.png"))
+    }
+}
+
+fn editor(dir: &Path) -> Harness<'static, EditorApp> {
+    let dir = dir.to_path_buf();
+    let mut harness = Harness::builder()
+        .with_size(Vec2::new(1200.0, 800.0))
+        .wgpu()
+        .build_eframe(move |cc| {
+            let mut app = EditorApp::new(cc, None);
+            app.set_dialogs(Box::new(Scripted { dir }));
+            app
+        });
+    harness.run();
+    harness
+}
+
+/// Where image pixel (x, y) is on screen.
+fn at(h: &Harness<'_, EditorApp>, x: f64, y: f64) -> Pos2 {
+    h.state().viewport.to_screen(DVec2::new(x, y))
+}
+
+fn click_at(h: &mut Harness<'_, EditorApp>, pos: Pos2) {
+    h.hover_at(pos);
+    h.run();
+    h.drag_at(pos);
+    h.run();
+    h.drop_at(pos);
+    h.run();
+}
+
+fn drag(h: &mut Harness<'_, EditorApp>, from: Pos2, to: Pos2, modifiers: Modifiers) {
+    h.event(egui::Event::ModifiersChanged(modifiers));
+    h.hover_at(from);
+    h.run();
+    h.event(egui::Event::PointerButton {
+        pos: from,
+        button: egui::PointerButton::Primary,
+        pressed: true,
+        modifiers,
+    });
+    h.run();
+    for i in 1..=8 {
+        h.hover_at(from + (to - from) * (i as f32 / 8.0));
+        h.run();
+    }
+    h.event(egui::Event::PointerButton {
+        pos: to,
+        button: egui::PointerButton::Primary,
+        pressed: false,
+        modifiers,
+    });
+    h.run();
+    h.remove_cursor();
+    h.event(egui::Event::ModifiersChanged(Modifiers::NONE));
+    h.run();
+}
+
+fn click_label(h: &mut Harness<'_, EditorApp>, label: &str) {
+    h.get_by_label(label).click();
+    h.run();
+}
+
+fn handles(h: &Harness<'_, EditorApp>) -> Vec<HandleSpec> {
+    h.state()
+        .document()
+        .map(|d| d.project().handles.clone())
+        .unwrap_or_default()
+}
+
+fn translate(h: &HandleSpec) -> DVec2 {
+    match h {
+        HandleSpec::Point { translate, .. } => DVec2::from(*translate),
+        HandleSpec::Bar { .. } => panic!("a point handle"),
+    }
+}
+
+/// Writes the built-in picture to `dir/lizard.png`.
+fn write_lizard(dir: &Path) -> PathBuf {
+    let path = dir.join("lizard.png");
+    std::fs::write(&path, pipeline::DEFAULT_IMAGE).expect("write the picture");
+    path
+}
+
+#[test]
+fn the_editor_opens_on_the_built_in_picture() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    let doc = h.state().document().expect("the built-in picture");
+    assert_eq!(doc.project().handles.len(), 7);
+    assert!(doc.rig().stats().samples > 10_000);
+    h.get_by_label("Select");
+    h.get_by_label("Show mesh");
+    h.snapshot("editor_default");
+}
+
+#[test]
+fn an_editing_session() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let lizard = write_lizard(dir.path());
+    let mut h = editor(dir.path());
+    // Work on the picture as a file, so the saved project names it.
+    h.get_by_label("File").click();
+    h.run();
+    click_label(&mut h, "Open image…");
+    assert_eq!(
+        h.state().document().and_then(|d| d.image_path.clone()),
+        Some(lizard.clone())
+    );
+    assert!(handles(&h).is_empty());
+
+    // Two point handles and a bar.
+    click_label(&mut h, "Add point");
+    assert_eq!(h.state().tool, Tool::AddPoint);
+    let arm = at(&h, 440.0, 238.0);
+    click_at(&mut h, arm);
+    let leg = at(&h, 190.0, 470.0);
+    click_at(&mut h, leg);
+    assert_eq!(handles(&h).len(), 2, "{:?}", h.state().message);
+    click_label(&mut h, "Add bar");
+    let (a, b) = (at(&h, 110.0, 130.0), at(&h, 250.0, 250.0));
+    drag(&mut h, a, b, Modifiers::NONE);
+    assert_eq!(handles(&h).len(), 3, "{:?}", h.state().message);
+    assert!(matches!(handles(&h)[2], HandleSpec::Bar { .. }));
+
+    // Drag the first point: it follows the pointer; one undo step for the whole drag.
+    click_label(&mut h, "Select");
+    let target = at(&h, 470.0, 200.0);
+    drag(&mut h, arm, target, Modifiers::NONE);
+    let moved = translate(&handles(&h)[0]);
+    assert!((moved - DVec2::new(30.0, -38.0)).length() < 2.0, "{moved}");
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert_eq!(translate(&handles(&h)[0]), DVec2::ZERO, "undo");
+    h.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
+    h.run();
+    assert_eq!(translate(&handles(&h)[0]), moved, "redo");
+
+    // Alt-drag rotates.
+    let now = at(&h, 470.0, 200.0);
+    drag(
+        &mut h,
+        now + Vec2::new(4.0, 0.0),
+        now + Vec2::new(0.0, 4.0),
+        Modifiers::ALT,
+    );
+    match handles(&h)[0] {
+        HandleSpec::Point { rotate, .. } => assert!(rotate > 0.5, "{rotate}"),
+        HandleSpec::Bar { .. } => unreachable!(),
+    }
+
+    // Insert a handle in the posed state: the picture under it does not move.
+    click_label(&mut h, "Add point");
+    let before = h.state().document().map(|d| d.node_position(0));
+    let inside = at(&h, 330.0, 330.0);
+    click_at(&mut h, inside);
+    assert_eq!(handles(&h).len(), 4, "{:?}", h.state().message);
+    assert_eq!(before, h.state().document().map(|d| d.node_position(0)));
+
+    // Delete the new handle with the Delete key (it is selected after adding).
+    h.key_press(Key::Delete);
+    h.run();
+    assert_eq!(handles(&h).len(), 3);
+
+    // Overlays.
+    click_label(&mut h, "Select");
+    let leg = at(&h, 190.0, 470.0);
+    click_at(&mut h, leg);
+    assert_eq!(h.state().selected, Some(1));
+    for label in ["Show mesh", "Dual graph", "Weight heat map"] {
+        click_label(&mut h, label);
+    }
+    assert!(h.state().show.mesh && h.state().show.dual_graph && h.state().show.heat);
+    h.snapshot("editor_overlays");
+    click_label(&mut h, "Weight heat map");
+    click_label(&mut h, "Show mesh");
+    click_label(&mut h, "Voronoi cells");
+    h.snapshot("editor_cells");
+    click_label(&mut h, "Voronoi cells");
+    click_label(&mut h, "Dual graph");
+
+    // Save, export, reload.
+    h.get_by_label("File").click();
+    h.run();
+    click_label(&mut h, "Save project as…");
+    assert!(!h.state().is_dirty());
+    let saved_text = std::fs::read_to_string(dir.path().join("project.json")).expect("saved");
+    let saved = Project::from_json(&saved_text).expect("a valid project");
+    assert_eq!(saved.image.as_deref(), Some(Path::new("lizard.png")));
+    assert_eq!(saved.handles, handles(&h));
+
+    h.get_by_label("File").click();
+    h.run();
+    click_label(&mut h, "Export PNG…");
+    let exported = image::open(dir.path().join("warped.png"))
+        .expect("an exported PNG")
+        .to_rgba8();
+    // `c2warp render lizard.png --rig project.json` runs exactly this.
+    let picture = pipeline::load_image(&lizard).expect("picture");
+    let project = pipeline::load_project(&dir.path().join("project.json")).expect("project");
+    let prepared = pipeline::prepare(&picture, &project, None).expect("rig");
+    let expected = pipeline::warp(&picture, &prepared.rig).expect("warp");
+    assert_eq!(exported.dimensions(), picture.dimensions());
+    assert!(
+        exported == expected,
+        "the export equals the command-line render"
+    );
+
+    click_label(&mut h, "Clear all handles");
+    assert!(handles(&h).is_empty() && h.state().is_dirty());
+    h.get_by_label("File").click();
+    h.run();
+    click_label(&mut h, "Open project…");
+    // Unsaved changes: the editor asks first.
+    assert!(h.state().pending.is_some());
+    click_label(&mut h, "Discard changes");
+    assert_eq!(handles(&h), saved.handles, "{:?}", h.state().message);
+    assert!(!h.state().is_dirty());
+}
+
+#[test]
+fn bad_files_leave_the_work_untouched() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    let before = handles(&h);
+    let png = pipeline::DEFAULT_IMAGE;
+    let cases: [(&str, &[u8]); 5] = [
+        ("corrupt.png", b"not a picture at all"),
+        ("truncated.png", &png[..png.len() / 3]),
+        ("huge.png", &huge_png_header()),
+        (
+            "broken.json",
+            b"{\"version\": 1, \"handles\": [ {\"type\": ",
+        ),
+        (
+            "no-image.json",
+            b"{\"version\": 1, \"image\": \"missing.png\", \"handles\": []}",
+        ),
+    ];
+    for (name, bytes) in cases {
+        let path = dir.path().join(name);
+        std::fs::write(&path, bytes).expect("write");
+        h.state_mut().request_open(path);
+        h.run();
+        let message = h.state().message.clone().expect("a message");
+        assert!(message.is_error, "{name}: {message:?}");
+        assert!(message.text.contains(name), "{name}: {}", message.text);
+        assert_eq!(handles(&h), before, "{name}");
+    }
+    h.state_mut()
+        .request_open(dir.path().join("does-not-exist.png"));
+    h.run();
+    assert!(h.state().message.as_ref().is_some_and(|m| m.is_error));
+    assert_eq!(handles(&h), before);
+}
+
+#[test]
+fn unsaved_changes_can_be_kept() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let lizard = write_lizard(dir.path());
+    let mut h = editor(dir.path());
+    click_label(&mut h, "Reset pose");
+    assert!(h.state().is_dirty());
+    h.state_mut().request_open(lizard);
+    h.run();
+    assert!(h.state().pending.is_some());
+    click_label(&mut h, "Cancel");
+    assert!(h.state().pending.is_none());
+    assert_eq!(handles(&h).len(), 7, "the work is still there");
+    assert!(h.state().document().is_some_and(|d| d.image_path.is_none()));
+}
+
+#[test]
+fn the_help_window_lists_the_shortcuts() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    h.key_press(Key::F1);
+    h.run();
+    assert!(h.state().help_open);
+    for (keys, _) in editor::SHORTCUTS {
+        h.get_by_label(keys);
+    }
+    h.get_by_label("Pan");
+}
+
+/// A PNG header claiming 100000 × 100000 pixels.
+fn huge_png_header() -> Vec<u8> {
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    let mut ihdr = b"IHDR".to_vec();
+    ihdr.extend(100_000u32.to_be_bytes());
+    ihdr.extend(100_000u32.to_be_bytes());
+    ihdr.extend([8, 6, 0, 0, 0]);
+    png.extend(13u32.to_be_bytes());
+    png.extend(&ihdr);
+    png.extend(crc(&ihdr).to_be_bytes());
+    png
+}
+
+fn crc(bytes: &[u8]) -> u32 {
+    let mut c = 0xffff_ffffu32;
+    for &b in bytes {
+        c ^= u32::from(b);
+        for _ in 0..8 {
+            c = if c & 1 != 0 {
+                0xedb8_8320 ^ (c >> 1)
+            } else {
+                c >> 1
+            };
+        }
+    }
+    !c
+}
