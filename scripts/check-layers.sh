@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# The numeric core knows no UI, GPU or dialog crates, and no images: fail if its
-# dependency tree says otherwise (see ARCHITECTURE.md).
+# The numeric core knows no UI, GPU or dialog crates, and no images; meshing and
+# drawing know no UI; fail if a dependency tree says otherwise (see ARCHITECTURE.md).
 set -euo pipefail
 status=0
 for crate in weights-core; do
@@ -17,5 +17,11 @@ for crate in mesh render project; do
     status=1
   fi
 done
+# The shared pipeline serves the command line too: no UI crates.
+tree=$(cargo tree -p pipeline -e normal --prefix none)
+if echo "$tree" | grep -Eq '^(egui|eframe|rfd|winit|editor) '; then
+  echo "layering: pipeline depends on: $(echo "$tree" | grep -Eo '^(egui|eframe|rfd|winit|editor) ' | sort -u | tr '\n' ' ')"
+  status=1
+fi
 [ $status -eq 0 ] && echo "layering: ok"
 exit $status

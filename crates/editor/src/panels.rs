@@ -26,6 +26,10 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("Mouse wheel, pinch", "Zoom about the pointer"),
     ("F", "Fit the picture to the window"),
     ("M", "Show or hide the mesh"),
+    ("H", "Show or hide the selected handle's weight (heat map)"),
+    ("C", "Show or hide the Voronoi cells"),
+    ("G", "Show or hide the dual graph"),
+    ("N, Shift + N", "Select the next / previous handle"),
     ("Ctrl + Z", "Undo"),
     ("Ctrl + Shift + Z, Ctrl + Y", "Redo"),
     ("Ctrl + O", "Open an image"),
@@ -132,6 +136,23 @@ impl EditorApp {
         }
         if pressed(none, Key::M) {
             self.show.mesh = !self.show.mesh;
+        }
+        if pressed(none, Key::H) {
+            self.show.heat = !self.show.heat;
+        }
+        if pressed(none, Key::C) {
+            self.show.cells = !self.show.cells;
+        }
+        if pressed(none, Key::G) {
+            self.show.dual_graph = !self.show.dual_graph;
+        }
+        let count = self.doc.as_ref().map_or(0, |d| d.project().handles.len());
+        if count > 0 {
+            if pressed(Modifiers::SHIFT, Key::N) {
+                self.selected = Some(self.selected.map_or(count - 1, |s| (s + count - 1) % count));
+            } else if pressed(none, Key::N) {
+                self.selected = Some(self.selected.map_or(0, |s| (s + 1) % count));
+            }
         }
         if pressed(none, Key::F1) {
             self.help_open = !self.help_open;

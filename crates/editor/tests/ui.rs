@@ -124,6 +124,11 @@ fn the_editor_opens_on_the_built_in_picture() {
     assert!(doc.rig().stats().samples > 10_000);
     h.get_by_label("Select");
     h.get_by_label("Show mesh");
+    // Hovering the picture shows the weights there.
+    let body = at(&h, 300.0, 300.0);
+    h.hover_at(body);
+    h.run();
+    h.get_by_label_contains("vertex ");
     h.snapshot("editor_default");
 }
 

@@ -105,7 +105,10 @@ fn fs(in: Out, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
     // Derivatives first: they need uniform control flow.
     let steps = in.heat * 10.0;
     let width = max(fwidth(steps), 1e-6);
-    let iso = 1.0 - clamp(abs(fract(steps + 0.5) - 0.5) / width, 0.0, 1.0);
+    // Isolines at the tenths strictly between 0 and 1: the plateaus where the weight
+    // is exactly 0 or 1 are not lines.
+    let inside = select(0.0, 1.0, in.heat > 0.001 && in.heat < 0.999);
+    let iso = inside * (1.0 - clamp(abs(fract(steps + 0.5) - 0.5) / width, 0.0, 1.0));
     if view.mode == 1u {
         let a = max(color.a, 0.35);
         var tint = ramp(clamp(in.heat, 0.0, 1.0));
