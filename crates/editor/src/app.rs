@@ -171,16 +171,25 @@ impl EditorApp {
     /// The editor on the built-in picture, without GPU resources (nothing is drawn
     /// through the GPU unless `has_gpu`).
     pub fn headless(has_gpu: bool) -> Self {
-        let (doc, message) = match Document::built_in() {
-            Ok(doc) => (Some(doc), None),
-            Err(e) => (
+        match Document::built_in() {
+            Ok(doc) => Self::build(Some(doc), None, has_gpu),
+            Err(e) => Self::build(
                 None,
                 Some(Message {
                     text: format!("cannot open the built-in picture: {e:#}"),
                     is_error: true,
                 }),
+                has_gpu,
             ),
-        };
+        }
+    }
+
+    /// The editor on `doc`, without GPU resources (for tests and benchmarks).
+    pub fn with_document(doc: Document) -> Self {
+        Self::build(Some(doc), None, false)
+    }
+
+    fn build(doc: Option<Document>, message: Option<Message>, has_gpu: bool) -> Self {
         Self {
             doc,
             history: History::default(),
@@ -220,6 +229,12 @@ impl EditorApp {
         self.doc.as_ref()
     }
 
+    /// The open document, to change it directly (edits made this way bypass the undo
+    /// history).
+    pub fn document_mut(&mut self) -> Option<&mut Document> {
+        self.doc.as_mut()
+    }
+
     /// Whether there are changes not saved to a project file.
     pub fn is_dirty(&self) -> bool {
         self.dirty
@@ -240,10 +255,13 @@ impl EditorApp {
     }
 
     /// Applies an edit as one undo step. Errors go to the status line; the document is
-    /// then unchanged.
-    pub fn edit(&mut self, edit: Edit) {
-        let Some(doc) = &mut self.doc else { return };
-        let before = doc.project().clone();
+    /// then unchanged. Returns whether the edit was applied.
+    #[must_use = "false when the edit was refused (the status line says why)"]
+    pub fn edit(&mut self, edit: Edit) -> bool {
+        let Some(doc) = &mut self.doc else {
+            return false;
+        };
+        let before = doc.snapshot();
         let removes = match edit {
             Edit::Remove(i) => Some(i),
             Edit::Clear => Some(0),
@@ -251,7 +269,7 @@ impl EditorApp {
         };
         match doc.apply(edit) {
             Ok(()) => {
-                if doc.project() != &before {
+                if doc.project() != &without_virtuals(&before) {
                     self.history.push(before);
                     self.dirty = true;
                 }
@@ -263,8 +281,12 @@ impl EditorApp {
                     };
                 }
                 self.settings_draft = None;
+                true
             }
-            Err(e) => self.error(&e),
+            Err(e) => {
+                self.error(&e);
+                false
+            }
         }
     }
 
@@ -288,16 +310,14 @@ impl EditorApp {
                 scale
             },
         };
-        self.edit(Edit::Add(handle));
-        if let Some(doc) = &self.doc {
-            if doc.project().handles.len() > 0 && self.message.as_ref().is_none_or(|m| !m.is_error)
-            {
-                self.selected = Some(doc.project().handles.len() - 1);
-                let ms = doc.last_update_ms;
-                self.info(format!(
-                    "added a point handle; weights updated in {ms:.1} ms"
-                ));
-            }
+        if self.edit(Edit::Add(handle))
+            && let Some(doc) = &self.doc
+        {
+            self.selected = Some(doc.project().handles.len() - 1);
+            let ms = doc.last_update_ms;
+            self.info(format!(
+                "added a point handle; weights updated in {ms:.1} ms"
+            ));
         }
     }
 
@@ -312,12 +332,10 @@ impl EditorApp {
             rest: [ra.to_array(), rb.to_array()],
             pose: Some([a.to_array(), b.to_array()]),
         };
-        let count = doc.project().handles.len();
-        self.edit(Edit::Add(handle));
-        if let Some(doc) = &self.doc
-            && doc.project().handles.len() > count
+        if self.edit(Edit::Add(handle))
+            && let Some(doc) = &self.doc
         {
-            self.selected = Some(count);
+            self.selected = Some(doc.project().handles.len() - 1);
             let ms = doc.last_update_ms;
             self.info(format!("added a bar handle; weights updated in {ms:.1} ms"));
         }
@@ -325,12 +343,12 @@ impl EditorApp {
 
     /// Deletes the selected handle.
     pub fn delete_selected(&mut self) {
-        if let Some(i) = self.selected {
-            self.edit(Edit::Remove(i));
-            if let Some(doc) = &self.doc {
-                let ms = doc.last_update_ms;
-                self.info(format!("removed a handle; weights updated in {ms:.1} ms"));
-            }
+        if let Some(i) = self.selected
+            && self.edit(Edit::Remove(i))
+            && let Some(doc) = &self.doc
+        {
+            let ms = doc.last_update_ms;
+            self.info(format!("removed a handle; weights updated in {ms:.1} ms"));
         }
     }
 
@@ -355,7 +373,7 @@ impl EditorApp {
     /// Ends a handle drag: one undo step if it changed anything.
     pub(crate) fn finish_drag(&mut self) {
         if let (Some(drag), Some(doc)) = (self.drag.take(), &self.doc)
-            && doc.project() != &drag.before
+            && doc.project() != &without_virtuals(&drag.before)
         {
             self.history.push(drag.before);
             self.dirty = true;
@@ -375,14 +393,14 @@ impl EditorApp {
     fn step_history(&mut self, back: bool) {
         self.finish_drag();
         let Some(doc) = &mut self.doc else { return };
-        let current = doc.project().clone();
+        let current = doc.snapshot();
         let taken = if back {
             self.history.undo(current)
         } else {
             self.history.redo(current)
         };
         let Some(target) = taken else { return };
-        match doc.restore(target.clone()) {
+        match doc.undo_to(target.clone()) {
             Ok(()) => {
                 self.dirty = true;
                 self.settings_draft = None;
@@ -518,8 +536,9 @@ impl EditorApp {
     }
 
     /// Brings the GPU frame up to date with the document: weights after a structural
-    /// change, transforms after a pose change, overlay values when asked for.
-    pub(crate) fn update_gpu_frame(&mut self) {
+    /// change, transforms after a pose change, overlay values when asked for. This is
+    /// the CPU side of what a frame uploads; the canvas calls it every frame.
+    pub fn update_gpu_frame(&mut self) {
         let Some(doc) = &self.doc else { return };
         let counter = &mut self.next_version;
         let mut bump = || {
@@ -597,6 +616,14 @@ impl EditorApp {
         }
         seen.weights = weights;
         seen.pose = doc.pose_version;
+    }
+}
+
+/// `project` without its virtual handles (what [`Document::project`] holds).
+fn without_virtuals(project: &project::Project) -> project::Project {
+    project::Project {
+        virtual_handles: Vec::new(),
+        ..project.clone()
     }
 }
 

@@ -166,10 +166,10 @@ impl EditorApp {
         if response.drag_stopped() {
             self.panning = false;
             self.finish_drag();
-            if let (Some(a), Some(pos)) = (self.bar_start.take(), response.interact_pointer_pos()) {
-                if self.viewport.to_screen(a).distance(pos) > 4.0 {
-                    self.add_bar(a, self.viewport.to_image(pos));
-                }
+            if let (Some(a), Some(pos)) = (self.bar_start.take(), response.interact_pointer_pos())
+                && self.viewport.to_screen(a).distance(pos) > 4.0
+            {
+                self.add_bar(a, self.viewport.to_image(pos));
             }
         }
         if response.clicked_by(PointerButton::Primary)
@@ -190,9 +190,7 @@ impl EditorApp {
             self.context_point = Some(self.viewport.to_image(pos));
         }
         response.context_menu(|ui| self.context_menu(ui));
-        let cursor = if self.panning {
-            Some(CursorIcon::Grabbing)
-        } else if self.drag.is_some() {
+        let cursor = if self.panning || self.drag.is_some() {
             Some(CursorIcon::Grabbing)
         } else if response.hover_pos().and_then(|p| self.hit(p)).is_some() {
             Some(CursorIcon::Grab)
@@ -216,7 +214,7 @@ impl EditorApp {
             if ui.button("Reset handle pose").clicked() {
                 if let Some(h) = self.doc.as_ref().and_then(|d| d.project().handles.get(i)) {
                     let rest = crate::document::at_rest(h);
-                    self.edit(crate::document::Edit::Pose(i, rest));
+                    let _ = self.edit(crate::document::Edit::Pose(i, rest));
                 }
                 ui.close();
             }
@@ -246,7 +244,7 @@ impl EditorApp {
             grip,
             start,
             pointer: self.viewport.to_image(pos),
-            before: doc.project().clone(),
+            before: doc.snapshot(),
         });
     }
 

@@ -204,7 +204,10 @@ impl Document {
     pub fn apply(&mut self, edit: Edit) -> Result<()> {
         let mut project = self.project.clone();
         match edit {
-            Edit::Add(handle) => project.handles.push(handle),
+            Edit::Add(handle) => {
+                self.check_room(&handle)?;
+                project.handles.push(handle);
+            }
             Edit::Remove(index) => {
                 if index >= project.handles.len() {
                     bail!("there is no handle {index}");
@@ -227,21 +230,94 @@ impl Document {
         self.restore(project)
     }
 
+    /// Refuses a new handle closer to an existing one than two mesh edges: nodes one
+    /// edge apart leave no room for graded virtual handles between them, and Algorithm 1
+    /// would turn nearly every sample into a node.
+    fn check_room(&self, handle: &HandleSpec) -> Result<()> {
+        let room = 2.0 * self.rig.domain().mean_edge_length();
+        let segment = |h: &HandleSpec| match *h {
+            HandleSpec::Point { rest, .. } => [DVec2::from(rest); 2],
+            HandleSpec::Bar { rest, .. } => rest.map(DVec2::from),
+        };
+        let new = segment(handle);
+        for (i, other) in self.project.handles.iter().enumerate() {
+            let d = segment_distance(new, segment(other));
+            if d < room {
+                bail!(
+                    "too close to handle {}: at this mesh density handles need {room:.1} px \
+                     between them (raise the density for finer work)",
+                    i + 1
+                );
+            }
+        }
+        Ok(())
+    }
+
     /// Makes `project` (same picture) the document's rig file, updating the rig as
     /// cheaply as the difference allows: poses only, handles added or removed
     /// incrementally, a rebuild for new parameters, a re-mesh for a new density.
     ///
     /// # Errors
     /// As [`Document::apply`]; on error nothing changes.
-    pub fn restore(&mut self, mut project: Project) -> Result<()> {
-        project.virtual_handles.clear();
+    pub fn restore(&mut self, project: Project) -> Result<()> {
+        self.restore_with(project, false)
+    }
+
+    /// The rig file with the rig's virtual handles: a state that [`Document::undo_to`]
+    /// brings back exactly.
+    pub fn snapshot(&self) -> Project {
+        let mut project = self.project.clone();
+        let positions = self.rig.domain().positions();
+        project.virtual_handles = self
+            .rig
+            .virtual_vertices()
+            .iter()
+            .map(|&v| positions[v as usize].to_array())
+            .collect();
+        project
+    }
+
+    /// Goes back (or forward) to a [`Document::snapshot`]: like [`Document::restore`],
+    /// but when handles were added or removed the rig is rebuilt with the snapshot's
+    /// virtual handles, so the weights are exactly those of that state rather than
+    /// keeping the virtual handles placed since.
+    ///
+    /// # Errors
+    /// As [`Document::apply`]; on error nothing changes.
+    pub fn undo_to(&mut self, snapshot: Project) -> Result<()> {
+        self.restore_with(snapshot, true)
+    }
+
+    fn restore_with(&mut self, mut project: Project, exact: bool) -> Result<()> {
+        let virtuals = std::mem::take(&mut project.virtual_handles);
         let clock = Instant::now();
         let old = self.settings();
         let new = Settings::of(&project);
         let handles = pipeline::handles(&project);
+        let same_rest = project.handles.len() == self.project.handles.len()
+            && project
+                .handles
+                .iter()
+                .zip(&self.project.handles)
+                .all(|(a, b)| same_rest(a, b));
         if new.density != old.density {
-            let prepared = pipeline::prepare(&self.image, &project, None)?;
-            self.rig = prepared.rig;
+            let mut with_virtuals = project.clone();
+            if exact {
+                with_virtuals.virtual_handles = virtuals;
+            }
+            self.rig = pipeline::prepare(&self.image, &with_virtuals, None)?.rig;
+        } else if new == old && exact && !same_rest {
+            let domain = self.rig.domain();
+            let vertices: Vec<u32> = virtuals
+                .iter()
+                .filter_map(|&p| domain.nearest_vertex(DVec2::from(p)))
+                .collect();
+            self.rig = Rig::with_virtual_handles(
+                domain.clone(),
+                handles,
+                &vertices,
+                pipeline::rig_options(&project)?,
+            )?;
         } else if new != old {
             let domain = self.rig.domain();
             let metric = pipeline::metric(new.metric, domain.is_convex());
@@ -256,12 +332,6 @@ impl Document {
             };
             self.rig = Rig::new(domain, handles, pipeline::rig_options(&project)?)?;
         } else {
-            let same_rest = project.handles.len() == self.project.handles.len()
-                && project
-                    .handles
-                    .iter()
-                    .zip(&self.project.handles)
-                    .all(|(a, b)| same_rest(a, b));
             self.rig.set_handles(handles)?;
             if same_rest {
                 self.project = project;
@@ -380,6 +450,31 @@ impl Document {
     }
 }
 
+/// Distance between two segments (a point is a segment with equal ends); NaN-free for
+/// finite input.
+fn segment_distance(a: [DVec2; 2], b: [DVec2; 2]) -> f64 {
+    let point_segment = |p: DVec2, [s, t]: [DVec2; 2]| {
+        let st = t - s;
+        let u = if st.length_squared() > 0.0 {
+            ((p - s).dot(st) / st.length_squared()).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (p - (s + st * u)).length()
+    };
+    let cross = |[p, q]: [DVec2; 2], [r, s]: [DVec2; 2]| {
+        let d = |a: DVec2, b: DVec2, c: DVec2| (b - a).perp_dot(c - a);
+        d(p, q, r) * d(p, q, s) < 0.0 && d(r, s, p) * d(r, s, q) < 0.0
+    };
+    if cross(a, b) {
+        return 0.0;
+    }
+    point_segment(a[0], b)
+        .min(point_segment(a[1], b))
+        .min(point_segment(b[0], a))
+        .min(point_segment(b[1], a))
+}
+
 /// Whether two handles have the same kind and rest geometry.
 pub fn same_rest(a: &HandleSpec, b: &HandleSpec) -> bool {
     match (a, b) {
@@ -476,6 +571,11 @@ mod tests {
             pose: None,
         };
         assert!(doc.apply(Edit::Add(bar)).is_err(), "zero-length bar");
+        let close = doc.rig().domain().mean_edge_length();
+        assert!(
+            doc.apply(Edit::Add(point(10.0 + close, 10.0))).is_err(),
+            "too close"
+        );
         assert_eq!(doc.project(), &before);
         assert_eq!(doc.weights_version, version);
         assert_eq!(doc.rig().handles().len(), 2);
@@ -542,6 +642,37 @@ mod tests {
         for (x, y) in a.iter().zip(&b) {
             assert!((x + y - 1.0).abs() < 1e-4, "{x} + {y}");
         }
+    }
+
+    #[test]
+    fn undo_to_a_snapshot_restores_the_virtual_handles() {
+        let mut doc = document();
+        let before = doc.snapshot();
+        let virtuals = doc.rig().virtual_vertices();
+        doc.apply(Edit::Add(point(14.0, 14.0)))
+            .expect("a close handle");
+        assert_ne!(
+            doc.rig().virtual_vertices(),
+            virtuals,
+            "virtual handles added"
+        );
+        doc.undo_to(before.clone()).expect("undo");
+        assert_eq!(doc.rig().virtual_vertices(), virtuals);
+        assert_eq!(doc.snapshot(), before);
+    }
+
+    #[test]
+    fn segment_distances() {
+        let p = |x, y| DVec2::new(x, y);
+        assert_eq!(segment_distance([p(0.0, 0.0); 2], [p(3.0, 4.0); 2]), 5.0);
+        assert_eq!(
+            segment_distance([p(0.0, 1.0), p(4.0, 1.0)], [p(2.0, 3.0); 2]),
+            2.0
+        );
+        assert_eq!(
+            segment_distance([p(0.0, 0.0), p(2.0, 2.0)], [p(0.0, 2.0), p(2.0, 0.0)]),
+            0.0
+        );
     }
 
     #[test]

@@ -238,11 +238,11 @@ impl EditorApp {
             self.delete_selected();
         }
         if ui.button("Clear all handles").clicked() {
-            self.edit(Edit::Clear);
+            let _ = self.edit(Edit::Clear);
             self.selected = None;
         }
         if ui.button("Reset pose").clicked() {
-            self.edit(Edit::ResetPose);
+            let _ = self.edit(Edit::ResetPose);
         }
     }
 
@@ -365,7 +365,7 @@ impl EditorApp {
         commit |= draft != before;
         if commit && draft != current {
             self.settings_draft = None;
-            self.edit(Edit::Settings(draft));
+            let _ = self.edit(Edit::Settings(draft));
         } else if draft != current {
             self.settings_draft = Some(draft);
         }

@@ -109,15 +109,17 @@ impl SceneResources {
         } else if versions[2] != self.uploaded[2] {
             result = self.view.set_pose(queue, &frame.pose.value);
         }
-        if result.is_ok() && (mesh_changed || versions[3] != self.uploaded[3]) {
-            if !frame.heat.value.is_empty() {
-                result = self.view.set_heat(queue, &frame.heat.value);
-            }
+        if result.is_ok()
+            && (mesh_changed || versions[3] != self.uploaded[3])
+            && !frame.heat.value.is_empty()
+        {
+            result = self.view.set_heat(queue, &frame.heat.value);
         }
-        if result.is_ok() && (mesh_changed || versions[4] != self.uploaded[4]) {
-            if !frame.cells.value.is_empty() {
-                result = self.view.set_cells(queue, &frame.cells.value);
-            }
+        if result.is_ok()
+            && (mesh_changed || versions[4] != self.uploaded[4])
+            && !frame.cells.value.is_empty()
+        {
+            result = self.view.set_cells(queue, &frame.cells.value);
         }
         self.error = result.err().map(|e| e.to_string());
         self.uploaded = versions;

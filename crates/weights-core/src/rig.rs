@@ -953,9 +953,18 @@ fn closest_pair(handles: &[Handle]) -> Option<(usize, usize, f64)> {
     best
 }
 
+/// The finest a bar is cut: the longest bar into this many pieces.
+///
+/// The paper samples bars at the smallest distance between two handles. A point placed
+/// a few pixels from a long bar would then cut it into a hundred samples, each with a
+/// tiny r_h, and Algorithm 1 would ring every one of them with virtual handles (seconds
+/// of work and thousands of nodes). Sixteen pieces keep a bar straight in practice.
+pub const MAX_BAR_PIECES: f64 = 16.0;
+
 /// The sample spacing d of bar handles: the smallest distance between two handles
-/// (the paper's rule), or an eighth of the longest bar when there is only one handle.
-/// A rig never samples finer than its mesh's mean edge length.
+/// (the paper's rule) but no finer than the longest bar over [`MAX_BAR_PIECES`], or an
+/// eighth of the longest bar when there is only one handle. A rig never samples finer
+/// than its mesh's mean edge length.
 pub fn bar_spacing(handles: &[Handle]) -> f64 {
     let longest_bar = handles
         .iter()
@@ -965,7 +974,7 @@ pub fn bar_spacing(handles: &[Handle]) -> f64 {
         })
         .fold(0.0, f64::max);
     match closest_pair(handles) {
-        Some((_, _, d)) => d,
+        Some((_, _, d)) => d.max(longest_bar / MAX_BAR_PIECES),
         None => longest_bar / 8.0,
     }
 }

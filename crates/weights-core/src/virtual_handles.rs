@@ -85,27 +85,31 @@ pub(crate) fn insert_virtual_handles(domain: &Domain, partition: &mut Partition)
                 }
             }
         }
-        let batch: Vec<u32> = groups
-            .into_iter()
-            .map(|(members, r_h)| {
-                if members.len() == 1 {
-                    return members[0];
-                }
-                let centroid = members
-                    .iter()
-                    .map(|&b| positions[b as usize])
-                    .sum::<glam::DVec2>()
-                    / members.len() as f64;
-                // The merged handle must not crowd an existing node either.
-                match domain.nearest_vertex(centroid) {
-                    Some(v) if partition.dist[v as usize] >= r_h => v,
-                    _ => members[0],
-                }
-            })
-            .collect();
-        for v in batch {
-            partition.add_node(domain, v);
-            added.push(v);
+        // Each candidate must be at least its violator's r_h from every node, the
+        // ones placed before it in this batch included. A farthest sample always is
+        // (it lies in its cell, r_d ≥ r_h), but a merged centroid, or a candidate of a
+        // tied violator next to another's, need not be; those wait for the next round.
+        // So no insertion ever brings two nodes closer than the smallest r_h so far,
+        // and the refinement stays graded instead of filling the shape.
+        for (members, r_h) in groups {
+            let merged = (members.len() > 1)
+                .then(|| {
+                    let centroid = members
+                        .iter()
+                        .map(|&b| positions[b as usize])
+                        .sum::<glam::DVec2>()
+                        / members.len() as f64;
+                    domain.nearest_vertex(centroid)
+                })
+                .flatten();
+            let candidate = merged
+                .into_iter()
+                .chain(members.iter().copied())
+                .find(|&v| partition.dist[v as usize] >= r_h);
+            if let Some(v) = candidate {
+                partition.add_node(domain, v);
+                added.push(v);
+            }
         }
     }
     added
@@ -129,6 +133,32 @@ mod tests {
                 assert!(s.r_d < s.r_h, "{s:?}");
             }
             part.assert_matches_rebuild(&d);
+        }
+    }
+
+    #[test]
+    fn close_nodes_refine_locally_without_filling_the_shape() {
+        // A line of nodes two edges apart (a finely sampled bar) with a node two edges
+        // beside it: no node may end up nearer another than that (in the metric), and
+        // the refinement must stay far from one node per sample.
+        for metric in [Metric::Intrinsic, Metric::Euclidean] {
+            let (p, t) = grid_mesh(80, 60, 1.0);
+            let samples = p.len();
+            let d = Domain::new(p, t, metric).expect("valid");
+            let id = |i: u32, j: u32| j * 81 + i;
+            let mut nodes: Vec<u32> = (10..=70).step_by(2).map(|i| id(i, 30)).collect();
+            nodes.push(id(40, 32));
+            let mut part = Partition::new(&d, nodes);
+            let added = insert_virtual_handles(&d, &mut part);
+            assert!(
+                added.len() < samples / 4,
+                "{metric:?}: {} of {samples}",
+                added.len()
+            );
+            for s in &part.stats {
+                assert!(s.r_h >= 2.0 - 1e-9, "{metric:?}: nodes {} apart", s.r_h);
+                assert!(s.r_d < s.r_h, "{s:?}");
+            }
         }
     }
 

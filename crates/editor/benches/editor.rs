@@ -1,0 +1,152 @@
+//! The editor's speed targets, measured on the real code paths:
+//! - inserting a handle on the built-in picture at the default density, from the click
+//!   to weights ready for the GPU (`insert_handle`);
+//! - the CPU cost of one frame of a handle drag at 200k mesh vertices, a whole egui
+//!   frame of the real app (input, layout, the edit, the pose upload data, overlays,
+//!   tessellation) (`drag_frame`);
+//! - exporting a 4096 × 4096 picture: mesh, weights, full-resolution CPU drawing, PNG
+//!   encoding, atomic write (`export`).
+
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use editor::{Document, Edit, EditorApp};
+use egui::{Pos2, Vec2};
+use egui_kittest::Harness;
+use glam::DVec2;
+use image::{Rgba, RgbaImage};
+use project::{HandleSpec, Project};
+
+/// Criterion's default 100 samples take minutes for the slower groups; 20 tell enough.
+fn quick() -> Criterion {
+    Criterion::default().sample_size(20)
+}
+
+fn insert_handle(c: &mut Criterion) {
+    let mut app = EditorApp::headless(true);
+    app.update_gpu_frame();
+    // Mesh vertices in a fixed pseudo-random order: clicks spread over the picture.
+    let vertices = app.document().map_or(0, |d| d.rig().domain().len());
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next_click = |app: &mut EditorApp| {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1);
+        let v = (state >> 33) as usize % vertices;
+        let doc = app.document_mut().expect("a document");
+        doc.deformed()[v]
+    };
+    let (mut refused, mut inserted) = (0, 0);
+    c.bench_function("editor/insert_handle/lizard_20k", |b| {
+        b.iter_custom(|iterations| {
+            let mut total = Duration::ZERO;
+            let mut done = 0;
+            while done < iterations {
+                let at = next_click(&mut app);
+                let clock = Instant::now();
+                app.add_point(at);
+                app.update_gpu_frame();
+                let elapsed = clock.elapsed();
+                if app.message.as_ref().is_some_and(|m| m.is_error) {
+                    // Too close to another handle: refused at once, not an insertion.
+                    refused += 1;
+                    continue;
+                }
+                inserted += 1;
+                total += elapsed;
+                done += 1;
+                app.undo();
+                app.update_gpu_frame();
+            }
+            total
+        });
+    });
+    eprintln!("insertions: {inserted}, refused as too close: {refused}");
+}
+
+fn drag_frame(c: &mut Criterion) {
+    let mut doc = Document::built_in().expect("the built-in picture");
+    let mut settings = doc.settings();
+    settings.density = 200_000;
+    doc.apply(Edit::Settings(settings)).expect("200k vertices");
+    let vertices = doc.rig().stats().samples;
+    let mut h = Harness::builder()
+        .with_size(Vec2::new(1280.0, 820.0))
+        .build_eframe(move |_cc| EditorApp::with_document(doc));
+    h.run();
+    let grab = h
+        .state()
+        .viewport
+        .to_screen(DVec2::new(440.0, 238.0) + DVec2::new(-20.0, -60.0));
+    h.hover_at(grab);
+    h.run();
+    h.drag_at(grab);
+    h.run();
+    h.hover_at(grab + Vec2::new(10.0, 0.0));
+    h.run();
+    assert_eq!(h.state().selected, Some(2), "the drag holds handle 3");
+    let mut k = 0u32;
+    c.bench_function(
+        &format!("editor/drag_frame/{}k_vertices", vertices / 1000),
+        |b| {
+            b.iter(|| {
+                k += 1;
+                let wiggle = Vec2::new(12.0 * ((k % 8) as f32 - 4.0), 6.0);
+                h.hover_at(Pos2::new(grab.x, grab.y) + wiggle);
+                h.step();
+            });
+        },
+    );
+    let moved = h.state().document().map(|d| d.project().handles[2].clone());
+    assert!(
+        matches!(moved, Some(HandleSpec::Point { translate, .. }) if translate != [-20.0, -60.0]),
+        "the handle follows the pointer: {moved:?}"
+    );
+}
+
+fn export(c: &mut Criterion) {
+    let size = 4096;
+    let picture = RgbaImage::from_fn(size, size, |x, y| {
+        Rgba([(x / 16) as u8, (y / 16) as u8, ((x ^ y) & 255) as u8, 255])
+    });
+    let point = |rest: [f64; 2], translate: [f64; 2]| HandleSpec::Point {
+        rest,
+        translate,
+        rotate: 0.2,
+        scale: 1.0,
+    };
+    let project = Project {
+        handles: vec![
+            point([800.0, 800.0], [100.0, 50.0]),
+            point([3200.0, 900.0], [-80.0, 120.0]),
+            point([2000.0, 3000.0], [0.0, -200.0]),
+        ],
+        ..Project::default()
+    };
+    let doc = Document::new(picture, None, project).expect("a 4096² document");
+    let mut app = EditorApp::with_document(doc);
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("warped.png");
+    let mut group = c.benchmark_group("editor/export");
+    group.sample_size(10);
+    group.bench_function("4096x4096", |b| {
+        b.iter(|| {
+            app.export_to(black_box(&out));
+        });
+    });
+    group.finish();
+    // (Nothing ran when the group was filtered out.)
+    assert!(
+        app.message.as_ref().is_none_or(|m| !m.is_error),
+        "{:?}",
+        app.message
+    );
+}
+
+criterion_group! {
+    name = benches;
+    config = quick();
+    targets = insert_handle, drag_frame, export
+}
+criterion_main!(benches);
