@@ -339,3 +339,46 @@ fn bad_input_gives_one_clear_line_and_keeps_the_old_output() {
     assert!(!usage.status.success());
     assert!(!String::from_utf8_lossy(&usage.stderr).contains("panicked"));
 }
+
+#[test]
+/// The editor's export and `c2warp render` of the project it saved give the same pixels.
+fn the_editor_exports_what_the_command_renders() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let picture = dir.path().join("dino.png");
+    fs::copy(data("dino.png"), &picture).expect("copy the picture");
+    let mut app = editor::EditorApp::headless(false);
+    app.open(&picture);
+    assert!(
+        app.message.as_ref().is_some_and(|m| !m.is_error),
+        "{:?}",
+        app.message
+    );
+    // A point, then a bar, inserted live, and the point posed: the rig the editor
+    // holds has live-inserted handles and virtual handles.
+    app.add_point(glam::DVec2::new(250.0, 120.0));
+    app.add_bar(
+        glam::DVec2::new(130.0, 100.0),
+        glam::DVec2::new(160.0, 160.0),
+    );
+    let posed = project::HandleSpec::Point {
+        rest: [250.0, 120.0],
+        translate: [12.0, -25.0],
+        rotate: 0.3,
+        scale: 1.1,
+    };
+    assert!(app.edit(editor::Edit::Pose(0, posed)), "{:?}", app.message);
+    let handles = app.document().map_or(0, |d| d.project().handles.len());
+    assert_eq!(handles, 2, "{:?}", app.message);
+    let project = dir.path().join("dino.json");
+    let exported = dir.path().join("exported.png");
+    app.save_to(&project);
+    app.export_to(&exported);
+    assert!(
+        app.message.as_ref().is_some_and(|m| !m.is_error),
+        "{:?}",
+        app.message
+    );
+    let rendered = dir.path().join("rendered.png");
+    ok(&render_args(&picture, &project, &rendered, &[]));
+    assert!(load(&exported) == load(&rendered), "identical pixels");
+}

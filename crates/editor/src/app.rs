@@ -12,6 +12,7 @@ use project::HandleSpec;
 use crate::dialogs::{Dialogs, NativeDialogs};
 use crate::document::{Document, Edit, posed};
 use crate::history::History;
+use crate::jobs::{Job, Outcome};
 use crate::scene::{GpuFrame, MeshData, SceneResources, Versioned};
 use crate::viewport::Viewport;
 
@@ -137,6 +138,9 @@ pub struct EditorApp {
     seen: Seen,
     pub(crate) dual_graph: (u64, Arc<Vec<(u32, u32)>>),
     pub(crate) settings_draft: Option<crate::document::Settings>,
+    pub(crate) job: Option<Job>,
+    /// Repaints the window when a job finishes.
+    wake: Option<egui::Context>,
     /// Milliseconds the last frame's logic took on the CPU.
     pub frame_ms: f64,
 }
@@ -162,8 +166,9 @@ impl EditorApp {
             false
         };
         let mut app = Self::headless(has_gpu);
+        app.wake = Some(cc.egui_ctx.clone());
         if let Some(path) = path {
-            app.open(path);
+            app.open_in_background(path.to_path_buf());
         }
         app
     }
@@ -215,6 +220,8 @@ impl EditorApp {
             seen: Seen::default(),
             dual_graph: (0, Arc::new(Vec::new())),
             settings_draft: None,
+            job: None,
+            wake: None,
             frame_ms: 0.0,
         }
     }
@@ -255,9 +262,19 @@ impl EditorApp {
     }
 
     /// Applies an edit as one undo step. Errors go to the status line; the document is
-    /// then unchanged. Returns whether the edit was applied.
+    /// then unchanged. Returns whether the edit was applied. A new mesh density is
+    /// applied on a worker thread (see [`EditorApp::is_busy`]).
     #[must_use = "false when the edit was refused (the status line says why)"]
     pub fn edit(&mut self, edit: Edit) -> bool {
+        if self.job.is_some() {
+            return false;
+        }
+        if let (Edit::Settings(settings), Some(doc)) = (&edit, &self.doc)
+            && settings.density != doc.settings().density
+        {
+            self.rebuild_in_background(*settings);
+            return true;
+        }
         let Some(doc) = &mut self.doc else {
             return false;
         };
@@ -424,23 +441,88 @@ impl EditorApp {
         if self.dirty {
             self.pending = Some(Pending::Open(path));
         } else {
-            self.open(&path);
+            self.open_in_background(path);
         }
     }
 
-    /// Opens a picture or (for `.json`) a project now. On failure the current document
-    /// stays and the status line says why.
+    /// Opens a picture or (for `.json`) a project now, waiting for it. On failure the
+    /// current document stays and the status line says why.
     pub fn open(&mut self, path: &Path) {
-        let is_project = path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("json"));
-        let opened = if is_project {
-            Document::open_project(path)
-        } else {
-            Document::open_image(path)
-        };
-        match opened {
-            Ok(doc) => {
+        let outcome = open_outcome(path.to_path_buf());
+        self.finish(outcome);
+    }
+
+    /// Opens a picture or project on a worker thread; the editor shows progress and
+    /// takes no edits until it is in.
+    pub fn open_in_background(&mut self, path: PathBuf) {
+        if self.job.is_some() {
+            return;
+        }
+        let name = path.file_name().map_or_else(
+            || path.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
+        self.job = Some(Job::spawn(
+            format!("Opening {name}"),
+            self.wake.clone(),
+            move || open_outcome(path),
+        ));
+    }
+
+    /// Re-meshes and re-weights the picture for `settings` on a worker thread.
+    fn rebuild_in_background(&mut self, settings: crate::document::Settings) {
+        let Some(doc) = &self.doc else { return };
+        if self.job.is_some() {
+            return;
+        }
+        let before = doc.snapshot();
+        let mut project = doc.project().clone();
+        settings.write_to(&mut project);
+        let image = doc.image.clone();
+        let image_path = doc.image_path.clone();
+        let label = format!("Meshing at {} vertices", settings.density);
+        self.job = Some(Job::spawn(label, self.wake.clone(), move || {
+            Outcome::Rebuilt {
+                before,
+                document: Document::with_image(image, image_path, project),
+            }
+        }));
+    }
+
+    /// Whether a job (opening, re-meshing) is running.
+    pub fn is_busy(&self) -> bool {
+        self.job.is_some()
+    }
+
+    /// What the running job does, and for how long it has run (seconds).
+    pub fn busy_with(&self) -> Option<(&str, f64)> {
+        self.job
+            .as_ref()
+            .map(|j| (j.label.as_str(), j.started.elapsed().as_secs_f64()))
+    }
+
+    /// Takes in the running job's result if it is done.
+    pub(crate) fn poll_job(&mut self) {
+        if let Some(outcome) = self.job.as_ref().and_then(Job::poll) {
+            self.job = None;
+            self.finish(outcome);
+        }
+    }
+
+    /// Waits for the running job, if any, and takes in its result.
+    pub fn wait_for_job(&mut self) {
+        if let Some(outcome) = self.job.take().and_then(Job::wait) {
+            self.finish(outcome);
+        }
+    }
+
+    fn finish(&mut self, outcome: Outcome) {
+        match outcome {
+            Outcome::Opened {
+                path,
+                is_project,
+                document: Ok(doc),
+            } => {
                 let stats = doc.rig().stats();
                 let what = if is_project { "project" } else { "image" };
                 self.doc = Some(doc);
@@ -456,7 +538,37 @@ impl EditorApp {
                     stats.samples
                 ));
             }
-            Err(e) => self.error(&e.context(format!("cannot open {}", path.display()))),
+            Outcome::Opened {
+                path,
+                document: Err(e),
+                ..
+            } => self.error(&e.context(format!("cannot open {}", path.display()))),
+            Outcome::Rebuilt {
+                before,
+                document: Ok(mut doc),
+            } => {
+                if let Some(old) = &self.doc {
+                    doc.project_path.clone_from(&old.project_path);
+                    doc.weights_version = old.weights_version + 1;
+                    doc.pose_version = old.pose_version + 1;
+                }
+                let stats = doc.rig().stats();
+                let ms = doc.last_update_ms;
+                self.doc = Some(doc);
+                self.history.push(before);
+                self.dirty = true;
+                self.settings_draft = None;
+                self.info(format!(
+                    "re-meshed: {} vertices, weights in {ms:.0} ms",
+                    stats.samples
+                ));
+            }
+            Outcome::Rebuilt {
+                document: Err(e), ..
+            } => {
+                self.settings_draft = None;
+                self.error(&e.context("cannot re-mesh"));
+            }
         }
     }
 
@@ -616,6 +728,23 @@ impl EditorApp {
         }
         seen.weights = weights;
         seen.pose = doc.pose_version;
+    }
+}
+
+/// Opens a picture or (for `.json`) a project.
+fn open_outcome(path: PathBuf) -> Outcome {
+    let is_project = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"));
+    let document = if is_project {
+        Document::open_project(&path)
+    } else {
+        Document::open_image(&path)
+    };
+    Outcome::Opened {
+        path,
+        is_project,
+        document,
     }
 }
 

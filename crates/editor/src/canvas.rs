@@ -37,7 +37,9 @@ impl EditorApp {
             self.viewport.fit([doc.image.width(), doc.image.height()]);
             self.needs_fit = false;
         }
-        self.canvas_input(ui, &response);
+        if !self.is_busy() {
+            self.canvas_input(ui, &response);
+        }
         self.update_gpu_frame();
 
         let painter = ui.painter_at(rect);
@@ -90,7 +92,18 @@ impl EditorApp {
             let a = self.viewport.to_screen(a);
             painter.line_segment([a, b], Stroke::new(4.0, SELECTED));
         }
-        self.hover_weights(ui, &response);
+        if let Some((what, seconds)) = self.busy_with() {
+            painter.rect_filled(rect, 0.0, Color32::from_black_alpha(120));
+            painter.text(
+                rect.center(),
+                egui::Align2::CENTER_CENTER,
+                format!("{what}… {seconds:.1} s"),
+                egui::FontId::proportional(20.0),
+                Color32::WHITE,
+            );
+        } else {
+            self.hover_weights(ui, &response);
+        }
     }
 
     /// The handle under `pos` (screen), and which grip.

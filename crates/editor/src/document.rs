@@ -42,7 +42,8 @@ impl Settings {
         }
     }
 
-    fn write_to(self, project: &mut Project) {
+    /// Writes these parameters into `project`.
+    pub fn write_to(self, project: &mut Project) {
         project.alpha = self.alpha;
         project.degree = self.degree;
         project.middle = self.middle;
@@ -96,8 +97,16 @@ impl Document {
     /// # Errors
     /// Handles off the picture or the shape, coincident handles, a picture with no
     /// opaque pixel, bad parameters.
-    pub fn new(
-        image: RgbaImage,
+    pub fn new(image: RgbaImage, image_path: Option<PathBuf>, project: Project) -> Result<Self> {
+        Self::with_image(Arc::new(image), image_path, project)
+    }
+
+    /// As [`Document::new`], sharing a picture already in memory.
+    ///
+    /// # Errors
+    /// As [`Document::new`].
+    pub fn with_image(
+        image: Arc<RgbaImage>,
         image_path: Option<PathBuf>,
         mut project: Project,
     ) -> Result<Self> {
@@ -108,7 +117,7 @@ impl Document {
         project.virtual_handles.clear();
         Ok(Self {
             project,
-            image: Arc::new(image),
+            image,
             image_path,
             project_path: None,
             rig: prepared.rig,

@@ -12,6 +12,7 @@ mod canvas;
 mod dialogs;
 mod document;
 mod history;
+mod jobs;
 mod panels;
 mod scene;
 mod viewport;

@@ -45,16 +45,27 @@ impl eframe::App for EditorApp {
     fn ui(&mut self, ui: &mut Ui, _frame: &mut eframe::Frame) {
         let clock = Instant::now();
         let ctx = ui.ctx().clone();
-        self.dropped_files(&ctx);
+        self.poll_job();
+        let idle = !self.is_busy();
+        if idle {
+            self.dropped_files(&ctx);
+            self.shortcuts(&ctx);
+        } else {
+            // Keep the elapsed time and the spinner moving.
+            ctx.request_repaint_after(std::time::Duration::from_millis(100));
+        }
         self.close_request(&ctx);
-        self.shortcuts(&ctx);
-        egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
+        egui::Panel::top("menu").show(ui, |ui| {
+            ui.add_enabled_ui(idle, |ui| self.menu_bar(ui));
+        });
         egui::Panel::bottom("status").show(ui, |ui| self.status_bar(ui));
         egui::Panel::left("tools")
             .resizable(false)
             .default_size(220.0)
             .show(ui, |ui| {
-                egui::ScrollArea::vertical().show(ui, |ui| self.side_panel(ui));
+                ui.add_enabled_ui(idle, |ui| {
+                    egui::ScrollArea::vertical().show(ui, |ui| self.side_panel(ui));
+                });
             });
         egui::CentralPanel::default()
             .frame(egui::Frame::NONE)
@@ -392,6 +403,11 @@ impl EditorApp {
                     ui.label("unsaved");
                 }
             }
+            if let Some((what, seconds)) = self.busy_with() {
+                ui.separator();
+                ui.spinner();
+                ui.label(format!("{what}… {seconds:.1} s"));
+            }
             if let Some(message) = &self.message {
                 ui.separator();
                 let color = if message.is_error {
@@ -442,7 +458,7 @@ impl EditorApp {
             Some(true) => {
                 self.pending = None;
                 match pending {
-                    Pending::Open(path) => self.open(&path),
+                    Pending::Open(path) => self.open_in_background(path),
                     Pending::Close => {
                         self.allow_close = true;
                         ctx.send_viewport_cmd(egui::ViewportCommand::Close);

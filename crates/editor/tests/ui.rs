@@ -89,8 +89,24 @@ fn drag(h: &mut Harness<'_, EditorApp>, from: Pos2, to: Pos2, modifiers: Modifie
     h.run();
 }
 
+/// Steps the UI until the background job (opening, re-meshing) is in.
+fn settle(h: &mut Harness<'_, EditorApp>) {
+    let start = std::time::Instant::now();
+    while h.state().is_busy() {
+        assert!(start.elapsed().as_secs() < 120, "the job never finished");
+        h.step();
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    h.run();
+}
+
 fn click_label(h: &mut Harness<'_, EditorApp>, label: &str) {
     h.get_by_label(label).click();
+    h.step();
+    if h.state().is_busy() {
+        // The click started a job; the test waits for it where it needs to.
+        return;
+    }
     h.run();
 }
 
@@ -141,6 +157,7 @@ fn an_editing_session() {
     h.get_by_label("File").click();
     h.run();
     click_label(&mut h, "Open image…");
+    settle(&mut h);
     assert_eq!(
         h.state().document().and_then(|d| d.image_path.clone()),
         Some(lizard.clone())
@@ -252,6 +269,7 @@ fn an_editing_session() {
     // Unsaved changes: the editor asks first.
     assert!(h.state().pending.is_some());
     click_label(&mut h, "Discard changes");
+    settle(&mut h);
     assert_eq!(handles(&h), saved.handles, "{:?}", h.state().message);
     assert!(!h.state().is_dirty());
 }
@@ -279,7 +297,7 @@ fn bad_files_leave_the_work_untouched() {
         let path = dir.path().join(name);
         std::fs::write(&path, bytes).expect("write");
         h.state_mut().request_open(path);
-        h.run();
+        settle(&mut h);
         let message = h.state().message.clone().expect("a message");
         assert!(message.is_error, "{name}: {message:?}");
         assert!(message.text.contains(name), "{name}: {}", message.text);
@@ -306,6 +324,30 @@ fn unsaved_changes_can_be_kept() {
     assert!(h.state().pending.is_none());
     assert_eq!(handles(&h).len(), 7, "the work is still there");
     assert!(h.state().document().is_some_and(|d| d.image_path.is_none()));
+}
+
+#[test]
+fn re_meshing_runs_in_the_background_and_undoes() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    let vertices =
+        |h: &Harness<'_, EditorApp>| h.state().document().map_or(0, |d| d.rig().stats().samples);
+    let before = vertices(&h);
+    let mut settings = h.state().document().expect("a document").settings();
+    settings.density = 5000;
+    assert!(h.state_mut().edit(editor::Edit::Settings(settings)));
+    assert!(h.state().is_busy(), "the re-mesh runs on a worker thread");
+    // While it runs, edits are refused and the canvas says what is going on.
+    assert!(!h.state_mut().edit(editor::Edit::Clear));
+    h.step();
+    h.get_by_label_contains("Meshing at 5000 vertices");
+    settle(&mut h);
+    let after = vertices(&h);
+    assert!((4500..5500).contains(&after), "{after} vertices");
+    assert_eq!(handles(&h).len(), 7);
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert_eq!(vertices(&h), before, "undo brings the old mesh back");
 }
 
 #[test]
