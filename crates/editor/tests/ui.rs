@@ -350,6 +350,37 @@ fn re_meshing_runs_in_the_background_and_undoes() {
     assert_eq!(vertices(&h), before, "undo brings the old mesh back");
 }
 
+/// A file dropped on the window, as the windowing layer reports it.
+#[derive(Debug)]
+struct Dropped(PathBuf);
+
+impl egui::DroppedFile for Dropped {
+    fn path(&self) -> &Path {
+        &self.0
+    }
+    fn bytes(&self) -> Result<Vec<u8>, String> {
+        std::fs::read(&self.0).map_err(|e| e.to_string())
+    }
+}
+
+#[test]
+fn dropping_a_picture_opens_it() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let lizard = write_lizard(dir.path());
+    let mut h = editor(dir.path());
+    h.input_mut()
+        .dropped_files
+        .push(std::sync::Arc::new(Dropped(lizard.clone())));
+    h.step();
+    assert!(h.state().is_busy(), "opening");
+    settle(&mut h);
+    assert_eq!(
+        h.state().document().and_then(|d| d.image_path.clone()),
+        Some(lizard)
+    );
+    assert!(handles(&h).is_empty());
+}
+
 #[test]
 fn the_help_window_lists_the_shortcuts() {
     let dir = tempfile::tempdir().expect("temp dir");
