@@ -545,7 +545,7 @@ impl MeshView {
             },
             folds: u32::from(params.show_folds),
             _pad: [0; 2],
-            line: [0.0, 0.0, 0.0, 0.45],
+            line: [0.0, 0.0, 0.0, 0.25],
         };
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
     }
