@@ -190,14 +190,7 @@ impl Document {
     /// folder where possible, and the virtual handles, so it reloads with the same
     /// weights.
     pub fn project_for_saving(&self, path: Option<&Path>) -> Project {
-        let mut project = self.project.clone();
-        let positions = self.rig.domain().positions();
-        project.virtual_handles = self
-            .rig
-            .virtual_vertices()
-            .iter()
-            .map(|&v| positions[v as usize].to_array())
-            .collect();
+        let mut project = self.snapshot();
         project.image = self.image_path.as_ref().map(|image| {
             let folder = path.and_then(Path::parent).unwrap_or(Path::new(""));
             relative_to(image, folder)

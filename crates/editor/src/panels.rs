@@ -210,18 +210,7 @@ impl EditorApp {
                 }
             });
             ui.menu_button("Edit", |ui| {
-                if ui
-                    .add_enabled(self.history.can_undo(), egui::Button::new("Undo"))
-                    .clicked()
-                {
-                    self.undo();
-                }
-                if ui
-                    .add_enabled(self.history.can_redo(), egui::Button::new("Redo"))
-                    .clicked()
-                {
-                    self.redo();
-                }
+                self.history_buttons(ui);
                 ui.separator();
                 self.edit_buttons(ui);
             });
@@ -239,6 +228,17 @@ impl EditorApp {
                 }
             });
         });
+    }
+
+    fn history_buttons(&mut self, ui: &mut Ui) {
+        let undo = egui::Button::new("Undo");
+        if ui.add_enabled(self.history.can_undo(), undo).clicked() {
+            self.undo();
+        }
+        let redo = egui::Button::new("Redo");
+        if ui.add_enabled(self.history.can_redo(), redo).clicked() {
+            self.redo();
+        }
     }
 
     fn edit_buttons(&mut self, ui: &mut Ui) {
@@ -277,18 +277,7 @@ impl EditorApp {
         });
         ui.horizontal_wrapped(|ui| self.edit_buttons(ui));
         ui.horizontal(|ui| {
-            if ui
-                .add_enabled(self.history.can_undo(), egui::Button::new("Undo"))
-                .clicked()
-            {
-                self.undo();
-            }
-            if ui
-                .add_enabled(self.history.can_redo(), egui::Button::new("Redo"))
-                .clicked()
-            {
-                self.redo();
-            }
+            self.history_buttons(ui);
             if ui.button("Fit to window").clicked() {
                 self.needs_fit = true;
             }

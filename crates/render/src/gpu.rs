@@ -354,24 +354,7 @@ impl GpuContext {
         let rows = self.buffer("rows", bytemuck::cast_slice(mesh.rows), storage);
         let entries = self.buffer("entries", bytemuck::cast_slice(&entries), storage);
         let packed = self.buffer("transforms", bytemuck::cast_slice(&packed), storage);
-        let skin = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("skin"),
-            layout: &self.skin_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: rows.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: entries.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: packed.as_entire_binding(),
-                },
-            ],
-        });
+        let skin = skin_bind_group(&self.device, &self.skin_layout, [&rows, &entries, &packed]);
         let rest: Vec<[f32; 2]> = mesh.rest.iter().map(|p| p.to_array()).collect();
         let vertex_buffer = self.buffer(
             "rest",
@@ -657,6 +640,27 @@ fn make_pipeline(
         }),
         multiview_mask: None,
         cache: None,
+    })
+}
+
+/// The bind group of [`SKIN_WGSL`]: row offsets, weight entries, node transforms.
+pub(crate) fn skin_bind_group(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    buffers: [&wgpu::Buffer; 3],
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry> = buffers
+        .iter()
+        .enumerate()
+        .map(|(binding, buffer)| wgpu::BindGroupEntry {
+            binding: binding as u32,
+            resource: buffer.as_entire_binding(),
+        })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("skin"),
+        layout,
+        entries: &entries,
     })
 }
 

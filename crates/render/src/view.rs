@@ -10,7 +10,7 @@ use image::RgbaImage;
 use wgpu::util::DeviceExt;
 
 use crate::error::RenderError;
-use crate::gpu::{Affine, SKIN_WGSL, SkinnedMesh, pack_transforms, premultiply};
+use crate::gpu::{Affine, SKIN_WGSL, SkinnedMesh, pack_transforms, premultiply, skin_bind_group};
 
 /// What to tint the mesh with, besides the texture.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -423,24 +423,11 @@ impl MeshView {
             bytemuck::cast_slice(&packed),
             storage | wgpu::BufferUsages::COPY_DST,
         );
-        let skin = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("mesh view skin"),
-            layout: &self.skin_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: rows.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: entries.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: transform_buffer.as_entire_binding(),
-                },
-            ],
-        });
+        let skin = skin_bind_group(
+            device,
+            &self.skin_layout,
+            [&rows, &entries, &transform_buffer],
+        );
         let n = mesh.rest.len();
         let per_vertex = wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST;
         self.mesh = Some(GpuMesh {
