@@ -49,5 +49,10 @@ pub fn run(path: Option<PathBuf>) -> anyhow::Result<()> {
         options,
         Box::new(move |cc| Ok(Box::new(EditorApp::new(cc, path.as_deref())))),
     )
-    .map_err(|e| anyhow::anyhow!("cannot open the editor window: {e}"))
+    .map_err(|e| {
+        anyhow::anyhow!(
+            "cannot open the editor window ({e}); without a display, `c2warp render` warps \
+             pictures from the command line"
+        )
+    })
 }
