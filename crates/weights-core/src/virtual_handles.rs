@@ -85,26 +85,31 @@ pub(crate) fn insert_virtual_handles(domain: &Domain, partition: &mut Partition)
                 }
             }
         }
-        // Each candidate must be at least its violator's r_h from every node, the
-        // ones placed before it in this batch included. A farthest sample always is
-        // (it lies in its cell, r_d ≥ r_h), but a merged centroid, or a candidate of a
-        // tied violator next to another's, need not be; those wait for the next round.
-        // So no insertion ever brings two nodes closer than the smallest r_h so far,
-        // and the refinement stays graded instead of filling the shape.
-        for (members, r_h) in groups {
-            let merged = (members.len() > 1)
-                .then(|| {
-                    let centroid = members
-                        .iter()
-                        .map(|&b| positions[b as usize])
-                        .sum::<glam::DVec2>()
-                        / members.len() as f64;
-                    domain.nearest_vertex(centroid)
-                })
-                .flatten();
-            let candidate = merged
+        // Single candidates are farthest samples: each lies in its cell (at least its
+        // violator's r_h from every node) and, by the grouping, at least that far from
+        // the other groups' members, so they go in as they are. A merged group's
+        // centroid need not keep that distance, from the nodes or from this round's
+        // other candidates: it goes in last, only if it does (else the group's first
+        // member, if that still does; else the group waits for the next round). So no
+        // insertion brings two nodes closer than the smallest r_h so far, and the
+        // refinement stays graded instead of filling the shape.
+        let (singles, merged): (Vec<_>, Vec<_>) = groups
+            .into_iter()
+            .partition(|(members, _)| members.len() == 1);
+        for (members, _) in singles {
+            partition.add_node(domain, members[0]);
+            added.push(members[0]);
+        }
+        for (members, r_h) in merged {
+            let centroid = members
+                .iter()
+                .map(|&b| positions[b as usize])
+                .sum::<glam::DVec2>()
+                / members.len() as f64;
+            let candidate = domain
+                .nearest_vertex(centroid)
                 .into_iter()
-                .chain(members.iter().copied())
+                .chain(members.first().copied())
                 .find(|&v| partition.dist[v as usize] >= r_h);
             if let Some(v) = candidate {
                 partition.add_node(domain, v);
