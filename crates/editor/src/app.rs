@@ -122,6 +122,9 @@ pub struct EditorApp {
     pub(crate) panning: bool,
     /// Overlays.
     pub show: Show,
+    /// The weights under the pointer, as shown beside it (`None` when not hovering the
+    /// picture).
+    pub hover_readout: Option<String>,
     /// Point handles turn with their neighbours' motion.
     pub auto_rotate: bool,
     /// The status line.
@@ -208,6 +211,7 @@ impl EditorApp {
             context_point: None,
             panning: false,
             show: Show::default(),
+            hover_readout: None,
             auto_rotate: false,
             message,
             pending: None,

@@ -392,8 +392,9 @@ impl EditorApp {
         );
     }
 
-    /// A tooltip with the weights of the mesh vertex under the pointer.
+    /// A box beside the pointer with the weights of the mesh vertex under it.
     fn hover_weights(&mut self, ui: &Ui, response: &egui::Response) {
+        self.hover_readout = None;
         if !self.show.hover_weights || self.drag.is_some() || self.panning {
             return;
         }
@@ -408,6 +409,7 @@ impl EditorApp {
         let Some(vertex) = rig.domain().nearest_vertex(rest) else {
             return;
         };
+
         let mut weights: Vec<(usize, f64)> = rig.weights(vertex as usize).collect();
         weights.sort_by(|a, b| b.1.total_cmp(&a.1));
         let lines: Vec<String> = weights
@@ -422,22 +424,35 @@ impl EditorApp {
             rest.y,
             weights.len()
         );
-        egui::Tooltip::always_open(
-            ui.ctx().clone(),
-            ui.layer_id(),
-            response.id.with("weights"),
-            egui::PopupAnchor::Pointer,
-        )
-        .gap(12.0)
-        .show(|ui| {
-            ui.label(egui::RichText::new(header).strong());
-            for line in &lines {
-                ui.monospace(line);
-            }
-            if more > 0 {
-                ui.label(format!("… and {more} smaller"));
-            }
-        });
+        let mut text = header;
+        for line in &lines {
+            text.push('\n');
+            text.push_str(line);
+        }
+        if more > 0 {
+            text.push_str(&format!("\n… and {more} smaller"));
+        }
+        // Painted rather than an egui tooltip: it follows the pointer at once, also
+        // while the pointer moves.
+        let painter = ui.painter_at(self.viewport.canvas);
+        let galley = painter.layout_no_wrap(
+            text.clone(),
+            egui::FontId::monospace(12.0),
+            Color32::from_gray(230),
+        );
+        let mut corner = pos + Vec2::new(16.0, 16.0);
+        let size = galley.size() + Vec2::splat(12.0);
+        let canvas = self.viewport.canvas;
+        if corner.x + size.x > canvas.max.x {
+            corner.x = pos.x - 16.0 - size.x;
+        }
+        if corner.y + size.y > canvas.max.y {
+            corner.y = pos.y - 16.0 - size.y;
+        }
+        let frame = Rect::from_min_size(corner, size);
+        painter.rect_filled(frame, 4.0, Color32::from_black_alpha(200));
+        painter.galley(corner + Vec2::splat(6.0), galley, Color32::from_gray(230));
+        self.hover_readout = Some(text);
     }
 }
 

@@ -144,7 +144,13 @@ fn the_editor_opens_on_the_built_in_picture() {
     let body = at(&h, 300.0, 300.0);
     h.hover_at(body);
     h.run();
-    h.get_by_label_contains("vertex ");
+    let readout = h
+        .state()
+        .hover_readout
+        .clone()
+        .expect("weights under the pointer");
+    assert!(readout.starts_with("vertex "), "{readout}");
+    assert!(readout.contains("handle"), "{readout}");
     h.snapshot("editor_default");
 }
 
