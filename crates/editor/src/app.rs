@@ -567,6 +567,12 @@ impl EditorApp {
                     stats.samples
                 ));
             }
+            Outcome::Exported {
+                path,
+                result: Ok(()),
+                ms,
+            } => self.info(format!("exported {} in {ms:.0} ms", path.display())),
+            Outcome::Exported { result: Err(e), .. } => self.error(&e),
             Outcome::Rebuilt {
                 document: Err(e), ..
             } => {
@@ -612,29 +618,58 @@ impl EditorApp {
     /// Asks where to export, then writes the warped PNG.
     pub fn export(&mut self) {
         if let Some(path) = self.dialogs.export_png(&self.suggested_name("warped.png")) {
-            self.export_to(&path);
+            self.export_in_background(path);
         }
     }
 
-    /// Writes the warped picture at full resolution to `path` atomically: the same
-    /// pixels as `c2warp render` of the saved project.
+    /// Writes the warped picture at full resolution to `path` atomically, now: the
+    /// same pixels as `c2warp render` of the saved project.
     pub fn export_to(&mut self, path: &Path) {
-        let Some(doc) = &self.doc else { return };
-        let clock = Instant::now();
-        let result = (|| -> Result<()> {
-            let project = doc.project_for_saving(None);
-            let prepared = pipeline::prepare(&doc.image, &project, None)?;
-            let warped = pipeline::warp(&doc.image, &prepared.rig)?;
-            render::save_png_atomic(path, &warped)?;
-            Ok(())
-        })();
-        match result.with_context(|| format!("cannot export {}", path.display())) {
-            Ok(()) => {
-                let ms = clock.elapsed().as_secs_f64() * 1e3;
-                self.info(format!("exported {} in {ms:.0} ms", path.display()));
-            }
-            Err(e) => self.error(&e),
+        let Some(work) = self.export_work(path.to_path_buf()) else {
+            return;
+        };
+        self.finish(work());
+    }
+
+    /// As [`EditorApp::export_to`], on a worker thread (the editor shows progress).
+    pub fn export_in_background(&mut self, path: PathBuf) {
+        if self.job.is_some() {
+            return;
         }
+        let Some(work) = self.export_work(path.clone()) else {
+            return;
+        };
+        let name = path.file_name().map_or_else(
+            || path.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
+        self.job = Some(Job::spawn(
+            format!("Exporting {name}"),
+            self.wake.clone(),
+            work,
+        ));
+    }
+
+    /// The export of the current document to `path`, ready to run anywhere.
+    fn export_work(&self, path: PathBuf) -> Option<impl FnOnce() -> Outcome + Send + 'static> {
+        let doc = self.doc.as_ref()?;
+        let project = doc.project_for_saving(None);
+        let image = doc.image.clone();
+        Some(move || {
+            let clock = Instant::now();
+            let result = (|| -> Result<()> {
+                let prepared = pipeline::prepare(&image, &project, None)?;
+                let warped = pipeline::warp(&image, &prepared.rig)?;
+                render::save_png_atomic(&path, &warped)?;
+                Ok(())
+            })()
+            .with_context(|| format!("cannot export {}", path.display()));
+            Outcome::Exported {
+                path,
+                result,
+                ms: clock.elapsed().as_secs_f64() * 1e3,
+            }
+        })
     }
 
     fn suggested_name(&self, extension: &str) -> String {

@@ -1,5 +1,5 @@
 //! Work that can take longer than a frame — opening a picture or project, re-meshing at
-//! a new density — runs on a worker thread; the editor keeps drawing, shows what it is
+//! a new density, exporting — runs on a worker thread; the editor keeps drawing, shows what it is
 //! doing, and takes no edits until the result is in.
 
 use std::path::PathBuf;
@@ -18,6 +18,13 @@ pub(crate) enum Outcome {
         path: PathBuf,
         is_project: bool,
         document: Result<Document>,
+    },
+    /// The warped picture was written.
+    Exported {
+        path: PathBuf,
+        result: Result<()>,
+        /// How long it took.
+        ms: f64,
     },
     /// The picture was re-meshed for new parameters.
     Rebuilt {

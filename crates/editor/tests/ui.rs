@@ -253,6 +253,7 @@ fn an_editing_session() {
     h.get_by_label("File").click();
     h.run();
     click_label(&mut h, "Export PNG…");
+    settle(&mut h);
     let exported = image::open(dir.path().join("warped.png"))
         .expect("an exported PNG")
         .to_rgba8();
