@@ -142,6 +142,8 @@ pub struct EditorApp {
     pub(crate) dual_graph: (u64, Arc<Vec<(u32, u32)>>),
     pub(crate) settings_draft: Option<crate::document::Settings>,
     pub(crate) job: Option<Job>,
+    /// The checkerboard behind transparent pixels.
+    pub(crate) checker: Option<egui::TextureHandle>,
     /// Repaints the window when a job finishes.
     wake: Option<egui::Context>,
     /// Milliseconds the last frame's logic took on the CPU.
@@ -225,6 +227,7 @@ impl EditorApp {
             dual_graph: (0, Arc::new(Vec::new())),
             settings_draft: None,
             job: None,
+            checker: None,
             wake: None,
             frame_ms: 0.0,
         }

@@ -53,7 +53,29 @@ impl EditorApp {
                     f64::from(doc.image.height()),
                 )),
             );
-            painter.rect_filled(frame, 0.0, Color32::from_gray(56));
+            // A checkerboard where the picture is transparent, 8-point squares.
+            let checker = self.checker.get_or_insert_with(|| {
+                let (light, dark) = (Color32::from_gray(72), Color32::from_gray(56));
+                ui.ctx().load_texture(
+                    "checker",
+                    egui::ColorImage::new([2, 2], vec![light, dark, dark, light]),
+                    egui::TextureOptions {
+                        magnification: egui::TextureFilter::Nearest,
+                        minification: egui::TextureFilter::Nearest,
+                        wrap_mode: egui::TextureWrapMode::Repeat,
+                        mipmap_mode: None,
+                    },
+                )
+            });
+            let visible = frame.intersect(rect);
+            if visible.is_positive() {
+                let square = 8.0;
+                let uv = Rect::from_min_max(
+                    ((visible.min - frame.min) / (2.0 * square)).to_pos2(),
+                    ((visible.max - frame.min) / (2.0 * square)).to_pos2(),
+                );
+                painter.image(checker.id(), visible, uv, Color32::WHITE);
+            }
         }
         if self.has_gpu {
             let (scale, offset) = self.viewport.device_map();
