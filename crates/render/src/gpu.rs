@@ -410,27 +410,6 @@ impl GpuContext {
         {
             return Err(RenderError::OutputTooLarge { width, height });
         }
-        let premultiplied = premultiply(texture);
-        let size = |w, h| wgpu::Extent3d {
-            width: w,
-            height: h,
-            depth_or_array_layers: 1,
-        };
-        let source = self.device.create_texture_with_data(
-            &self.queue,
-            &wgpu::TextureDescriptor {
-                label: Some("source"),
-                size: size(texture.width(), texture.height()),
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: FORMAT,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            },
-            wgpu::util::TextureDataOrder::LayerMajor,
-            &premultiplied,
-        );
         let sizes = Sizes {
             output: [width as f32, height as f32],
             texture: [texture.width() as f32, texture.height() as f32],
@@ -440,25 +419,14 @@ impl GpuContext {
             bytemuck::bytes_of(&sizes),
             wgpu::BufferUsages::UNIFORM,
         );
-        let view = source.create_view(&Default::default());
-        let bind_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("warp"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: uniform.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(&view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::Sampler(&self.sampler),
-                },
-            ],
-        });
+        let bind_group = picture_bind_group(
+            &self.device,
+            &self.queue,
+            &self.layout,
+            &uniform,
+            &self.sampler,
+            texture,
+        );
         self.offscreen(width, height, |pass| {
             pass.set_bind_group(0, &bind_group, &[]);
             record(pass);
@@ -640,6 +608,64 @@ fn make_pipeline(
         }),
         multiview_mask: None,
         cache: None,
+    })
+}
+
+/// Uploads `image` premultiplied as an RGBA8 texture and binds it with `uniform` and
+/// `sampler` (bindings 0, 1, 2 of both shaders' group 0). An empty image becomes one
+/// transparent texel.
+pub(crate) fn picture_bind_group(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    layout: &wgpu::BindGroupLayout,
+    uniform: &wgpu::Buffer,
+    sampler: &wgpu::Sampler,
+    image: &RgbaImage,
+) -> wgpu::BindGroup {
+    let blank;
+    let image = if image.width() == 0 || image.height() == 0 {
+        blank = RgbaImage::new(1, 1);
+        &blank
+    } else {
+        image
+    };
+    let texture = device.create_texture_with_data(
+        queue,
+        &wgpu::TextureDescriptor {
+            label: Some("picture"),
+            size: wgpu::Extent3d {
+                width: image.width(),
+                height: image.height(),
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: FORMAT,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        &premultiply(image),
+    );
+    let view = texture.create_view(&Default::default());
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("picture"),
+        layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: uniform.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: wgpu::BindingResource::TextureView(&view),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: wgpu::BindingResource::Sampler(sampler),
+            },
+        ],
     })
 }
 

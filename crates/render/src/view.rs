@@ -10,7 +10,9 @@ use image::RgbaImage;
 use wgpu::util::DeviceExt;
 
 use crate::error::RenderError;
-use crate::gpu::{Affine, SKIN_WGSL, SkinnedMesh, pack_transforms, premultiply, skin_bind_group};
+use crate::gpu::{
+    Affine, SKIN_WGSL, SkinnedMesh, pack_transforms, picture_bind_group, skin_bind_group,
+};
 
 /// What to tint the mesh with, besides the texture.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -307,7 +309,7 @@ impl MeshView {
         });
         let empty = RgbaImage::new(1, 1);
 
-        let texture = texture_group(device, queue, &layout, &uniform, &sampler, &empty);
+        let texture = picture_bind_group(device, queue, &layout, &uniform, &sampler, &empty);
         Self {
             fill,
             lines,
@@ -338,7 +340,7 @@ impl MeshView {
         } else {
             image
         };
-        self.texture = texture_group(
+        self.texture = picture_bind_group(
             device,
             queue,
             &self.layout,
@@ -567,59 +569,4 @@ fn nonempty_u32(mut v: Vec<u32>) -> Vec<u32> {
         v.extend([0, 0, 0]);
     }
     v
-}
-
-fn texture_group(
-    device: &wgpu::Device,
-    queue: &wgpu::Queue,
-    layout: &wgpu::BindGroupLayout,
-    uniform: &wgpu::Buffer,
-    sampler: &wgpu::Sampler,
-    image: &RgbaImage,
-) -> wgpu::BindGroup {
-    let blank;
-    let image = if image.width() == 0 || image.height() == 0 {
-        blank = RgbaImage::new(1, 1);
-        &blank
-    } else {
-        image
-    };
-    let texture = device.create_texture_with_data(
-        queue,
-        &wgpu::TextureDescriptor {
-            label: Some("mesh view picture"),
-            size: wgpu::Extent3d {
-                width: image.width(),
-                height: image.height(),
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba8Unorm,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        },
-        wgpu::util::TextureDataOrder::LayerMajor,
-        &premultiply(image),
-    );
-    let view = texture.create_view(&Default::default());
-    device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("mesh view"),
-        layout,
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: uniform.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: wgpu::BindingResource::TextureView(&view),
-            },
-            wgpu::BindGroupEntry {
-                binding: 2,
-                resource: wgpu::BindingResource::Sampler(sampler),
-            },
-        ],
-    })
 }
