@@ -8,7 +8,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use glam::{DAffine2, DVec2};
+use glam::DVec2;
 use image::RgbaImage;
 use project::{HandleSpec, MetricChoice, Middle, Project};
 use weights_core::{Domain, NodeKind, Rig};
@@ -427,28 +427,6 @@ impl Document {
                     .clamp(0.0, 1.0) as f32
             })
             .collect()
-    }
-
-    /// The transform of handle `index` as an affine map (identity for a missing one).
-    pub fn handle_transform(&self, index: usize) -> DAffine2 {
-        match self.project.handles.get(index) {
-            Some(HandleSpec::Point {
-                rest,
-                translate,
-                rotate,
-                scale,
-            }) => {
-                let rest = DVec2::from(*rest);
-                DAffine2::from_translation(rest + DVec2::from(*translate))
-                    * DAffine2::from_scale_angle_translation(
-                        DVec2::splat(*scale),
-                        *rotate,
-                        DVec2::ZERO,
-                    )
-                    * DAffine2::from_translation(-rest)
-            }
-            _ => DAffine2::IDENTITY,
-        }
     }
 }
 
