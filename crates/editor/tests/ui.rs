@@ -357,6 +357,38 @@ fn re_meshing_runs_in_the_background_and_undoes() {
     assert_eq!(vertices(&h), before, "undo brings the old mesh back");
 }
 
+#[test]
+fn auto_rotation_turns_the_other_points_during_a_drag() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    click_label(&mut h, "Reset pose");
+    click_label(&mut h, "Auto-rotate points");
+    assert!(h.state().auto_rotate);
+    let rotations = |h: &Harness<'_, EditorApp>| -> Vec<f64> {
+        handles(h)
+            .iter()
+            .filter_map(|p| match p {
+                HandleSpec::Point { rotate, .. } => Some(*rotate),
+                HandleSpec::Bar { .. } => None,
+            })
+            .collect()
+    };
+    assert!(rotations(&h).iter().all(|r| *r == 0.0));
+    // Drag the head (handle 1, at rest) far to the right.
+    let head = at(&h, 40.0, 40.0);
+    let away = at(&h, 200.0, 40.0);
+    drag(&mut h, head, away, Modifiers::NONE);
+    let turned = rotations(&h);
+    assert!(
+        turned.iter().filter(|r| r.abs() > 0.01).count() >= 2,
+        "{turned:?}"
+    );
+    // One undo step takes the whole drag back, rotations included.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert!(rotations(&h).iter().all(|r| *r == 0.0));
+}
+
 /// A file dropped on the window, as the windowing layer reports it.
 #[derive(Debug)]
 struct Dropped(PathBuf);
