@@ -71,13 +71,17 @@ fn vs(@location(0) position: vec2<f32>, @location(1) rest: vec2<f32>) -> Out {
 
 /// Linear blend skinning: the vertex at `index` moved by the blend of its nodes' affine
 /// transforms, read from storage buffers (group 1), so a new pose uploads only the
-/// transforms. Shared with the on-screen view.
+/// transforms; a vertex with an empty row stays at rest. Shared with the on-screen view.
 pub(crate) const SKIN_WGSL: &str = r"
 @group(1) @binding(0) var<storage, read> rows: array<u32>;
 @group(1) @binding(1) var<storage, read> entries: array<vec2<u32>>;
 @group(1) @binding(2) var<storage, read> transforms: array<vec4<f32>>;
 
 fn skin(index: u32, rest: vec2<f32>) -> vec2<f32> {
+    // A vertex no node reaches (a rig without handles) stays where it is.
+    if rows[index] == rows[index + 1u] {
+        return rest;
+    }
     var position = vec2<f32>(0.0, 0.0);
     for (var i = rows[index]; i < rows[index + 1u]; i = i + 1u) {
         let entry = entries[i];

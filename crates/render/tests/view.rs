@@ -110,6 +110,50 @@ fn a_new_pose_moves_the_mesh() {
 }
 
 #[test]
+fn vertices_no_node_reaches_stay_at_rest() {
+    // A rig without handles: every row is empty, and the picture must stay put.
+    let gpu = GpuContext::new().expect("a wgpu adapter (run scripts/setup.sh)");
+    let mut view = MeshView::new(
+        gpu.device(),
+        gpu.queue(),
+        wgpu::TextureFormat::Rgba8Unorm,
+        1,
+    );
+    view.set_texture(
+        gpu.device(),
+        gpu.queue(),
+        &RgbaImage::from_pixel(8, 8, Rgba([0, 200, 0, 255])),
+    );
+    let rest = [
+        Vec2::new(0.0, 0.0),
+        Vec2::new(8.0, 0.0),
+        Vec2::new(8.0, 8.0),
+        Vec2::new(0.0, 8.0),
+    ];
+    let mesh = SkinnedMesh {
+        rest: &rest,
+        rows: &[0; 5],
+        nodes: &[],
+        weights: &[],
+        triangles: &[[0, 1, 2], [0, 2, 3]],
+    };
+    view.set_mesh(gpu.device(), &mesh, &[], [8, 8])
+        .expect("a valid mesh");
+    let params = ViewParams {
+        scale: [2.0 / 8.0, -2.0 / 8.0],
+        offset: [-1.0, 1.0],
+        overlay: Overlay::None,
+        show_folds: true,
+        wireframe: false,
+    };
+    view.prepare(gpu.queue(), &params);
+    let image = gpu
+        .offscreen(16, 16, |pass| view.paint(pass, false))
+        .expect("offscreen drawing");
+    assert_eq!(count(&image, green), 256);
+}
+
+#[test]
 fn heat_overlay_tints_by_value() {
     let scene = Scene::new(IDENTITY);
     scene
