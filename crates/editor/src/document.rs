@@ -308,7 +308,9 @@ impl Document {
                 with_virtuals.virtual_handles = virtuals;
             }
             self.rig = pipeline::prepare(&self.image, &with_virtuals, None)?.rig;
-        } else if new == old && exact && !same_rest {
+        } else if new == old && !same_rest && (exact || project.handles.is_empty()) {
+            // Back to a snapshot, or no handles left: rebuild with the snapshot's
+            // virtual handles (none when cleared) rather than keep those placed since.
             let domain = self.rig.domain();
             let vertices: Vec<u32> = virtuals
                 .iter()
@@ -583,6 +585,11 @@ mod tests {
         assert!((at - DVec2::new(10.0, 10.0)).length() < 1e-9);
         doc.apply(Edit::Clear).expect("clear");
         assert!(doc.project().handles.is_empty());
+        assert_eq!(
+            doc.rig().stats().virtual_nodes,
+            0,
+            "no virtual handles without handles"
+        );
     }
 
     #[test]
