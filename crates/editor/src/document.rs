@@ -88,7 +88,8 @@ pub struct Document {
     /// Milliseconds the last change of handles or parameters took to bring the weights
     /// up to date.
     pub last_update_ms: f64,
-    deformed: Option<(u64, Vec<DVec2>)>,
+    /// Deformed samples, and the (pose, weights) versions they were computed for.
+    deformed: Option<((u64, u64), Vec<DVec2>)>,
 }
 
 impl Document {
@@ -308,9 +309,7 @@ impl Document {
                 with_virtuals.virtual_handles = virtuals;
             }
             self.rig = pipeline::prepare(&self.image, &with_virtuals, None)?.rig;
-        } else if new == old && !same_rest && (exact || project.handles.is_empty()) {
-            // Back to a snapshot, or no handles left: rebuild with the snapshot's
-            // virtual handles (none when cleared) rather than keep those placed since.
+        } else if new == old && exact && !same_rest {
             let domain = self.rig.domain();
             let vertices: Vec<u32> = virtuals
                 .iter()
@@ -352,7 +351,7 @@ impl Document {
 
     /// Every sample's deformed position (cached per pose).
     pub fn deformed(&mut self) -> &[DVec2] {
-        let version = self.pose_version * 1_000_003 + self.weights_version;
+        let version = (self.pose_version, self.weights_version);
         if self.deformed.as_ref().is_none_or(|(v, _)| *v != version) {
             self.deformed = Some((version, self.rig.deform()));
         }
@@ -363,7 +362,8 @@ impl Document {
     /// pose applies there (rotation, scale), found from the deformed triangle that
     /// contains `p` (the first one, where folds overlap). `None` off the picture.
     pub fn unwarp(&mut self, p: DVec2) -> Option<(DVec2, f64, f64)> {
-        let deformed = self.deformed().to_vec();
+        self.deformed();
+        let deformed = self.deformed.as_ref().map(|(_, d)| d.as_slice())?;
         let domain = self.rig.domain();
         let rest = domain.positions();
         for &[a, b, c] in domain.triangles() {
@@ -563,17 +563,24 @@ mod tests {
         assert_eq!(doc.rig().handles().len(), 2);
     }
 
+    /// Handle 0 of [`document`] posed.
+    fn first_posed(translate: [f64; 2], rotate: f64, scale: f64) -> Edit {
+        Edit::Pose(
+            0,
+            HandleSpec::Point {
+                rest: [10.0, 10.0],
+                translate,
+                rotate,
+                scale,
+            },
+        )
+    }
+
     #[test]
     fn pose_edits_keep_weights_and_insertions_update_them() {
         let mut doc = document();
         let w = doc.weights_version;
-        let moved = HandleSpec::Point {
-            rest: [10.0, 10.0],
-            translate: [5.0, 0.0],
-            rotate: 0.2,
-            scale: 1.1,
-        };
-        doc.apply(Edit::Pose(0, moved)).expect("pose");
+        doc.apply(first_posed([5.0, 0.0], 0.2, 1.1)).expect("pose");
         assert_eq!(doc.weights_version, w, "a pose leaves the weights");
         let at = doc.node_position(0);
         assert!((at - DVec2::new(15.0, 10.0)).length() < 1e-9, "{at}");
@@ -595,13 +602,7 @@ mod tests {
     #[test]
     fn unwarp_inverts_the_pose() {
         let mut doc = document();
-        let moved = HandleSpec::Point {
-            rest: [10.0, 10.0],
-            translate: [4.0, 3.0],
-            rotate: 0.0,
-            scale: 1.0,
-        };
-        doc.apply(Edit::Pose(0, moved)).expect("pose");
+        doc.apply(first_posed([4.0, 3.0], 0.0, 1.0)).expect("pose");
         let rest = DVec2::new(20.0, 15.0);
         let now = doc
             .rig()

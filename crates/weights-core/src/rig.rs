@@ -363,7 +363,8 @@ impl Rig {
     }
 
     /// Replaces the handles. Poses alone are cheap; handles whose rest geometry changed
-    /// are removed and inserted incrementally.
+    /// are removed and inserted incrementally. Removing every handle rebuilds the rig
+    /// empty, virtual handles included.
     ///
     /// # Errors
     /// As [`Rig::new`]; the rig is unchanged on error.
@@ -377,6 +378,17 @@ impl Rig {
             check_handles(&handles)?;
             self.handles = handles;
             self.update_affines();
+            return Ok(());
+        }
+        if handles.is_empty() {
+            // Virtual handles serve real ones: with none left, none stay (as a fresh
+            // build would have it).
+            let clock = Instant::now();
+            *self = Rig::new(self.domain.clone(), handles, self.options.clone())?;
+            self.update_timings = UpdateTimings {
+                weights_ms: ms(clock),
+                ..UpdateTimings::default()
+            };
             return Ok(());
         }
         let clock = Instant::now();

@@ -772,3 +772,21 @@ fn the_warp_does_not_depend_on_where_the_origin_is() {
         assert!((*p + shift - *q).length() < 1e-6, "{p} + shift != {q}");
     }
 }
+
+#[test]
+fn removing_every_handle_leaves_no_virtual_handles() {
+    let domain = grid_domain(40, 30, 1.0, 0.3, Shape::Holed, 5);
+    let handles = vec![
+        Handle::point(domain.positions()[find_grid(&domain, 10, 10)]),
+        Handle::point(domain.positions()[find_grid(&domain, 12, 10)]),
+    ];
+    let mut rig = Rig::new(domain.clone(), handles, RigOptions::default()).expect("valid");
+    assert!(
+        rig.stats().virtual_nodes > 0,
+        "close handles need virtual ones"
+    );
+    rig.set_handles(Vec::new()).expect("no handles");
+    assert_eq!(rig.stats().virtual_nodes, 0);
+    let fresh = Rig::new(domain, Vec::new(), RigOptions::default()).expect("valid");
+    rig.same_weights_as(&fresh).expect("as a fresh empty rig");
+}
