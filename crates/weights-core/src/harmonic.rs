@@ -15,25 +15,98 @@ use crate::voronoi::{NONE, Partition};
 /// tie-break but to both closed cells, so it also links the other node to the cells
 /// around it; this keeps the graph of a mirror-symmetric rig symmetric.
 pub(crate) fn dual_edges(domain: &Domain, partition: &Partition) -> Vec<(u32, u32)> {
+    let (mut pairs, ties) = match domain.metric() {
+        Metric::Intrinsic => frontier_pairs(domain, partition),
+        Metric::Euclidean => triangle_pairs(domain, partition),
+    };
+    if !ties.is_empty() {
+        // Link each tied sample's other node to every cell around the sample (its graph
+        // neighbours are the other corners of its triangles).
+        let owner = &partition.owner;
+        let mut around = |k: u32, u: u32| {
+            let o = owner[u as usize];
+            if o != k && o != NONE {
+                pairs.push((o.min(k), o.max(k)));
+            }
+        };
+        match domain.metric() {
+            Metric::Intrinsic => {
+                let graph = domain.graph();
+                for &(w, k) in &ties {
+                    for e in graph.neighbors(w) {
+                        around(k, e.to);
+                    }
+                }
+            }
+            Metric::Euclidean => {
+                let mut tied_with: std::collections::HashMap<u32, Vec<u32>> =
+                    std::collections::HashMap::new();
+                for &(w, k) in &ties {
+                    tied_with.entry(w).or_default().push(k);
+                }
+                for t in domain.triangles() {
+                    for (i, &w) in t.iter().enumerate() {
+                        let Some(nodes) = tied_with.get(&w) else {
+                            continue;
+                        };
+                        for &k in nodes {
+                            around(k, t[(i + 1) % 3]);
+                            around(k, t[(i + 2) % 3]);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    pairs.sort_unstable();
+    pairs.dedup();
+    pairs
+}
+
+/// Node pairs whose cells share a mesh edge (possibly repeated), and tied samples with
+/// the other node they are tied with.
+type PairsAndTies = (Vec<(u32, u32)>, Vec<(u32, u32)>);
+
+/// Node pairs and ties, intrinsic metric: from the cells' frontier samples, the only
+/// ones with an edge into another cell. A sample `w` is tied with node `k` when the
+/// path through its neighbour `u` in `k`'s cell reaches it at exactly its distance.
+fn frontier_pairs(domain: &Domain, partition: &Partition) -> PairsAndTies {
+    let (owner, dist) = (&partition.owner, &partition.dist);
+    let graph = domain.graph();
+    let mut pairs = Vec::new();
+    let mut ties = Vec::new();
+    // Each pair is seen from both cells; the lower one records it, once.
+    let mut recorded = vec![NONE; partition.len()];
+    for k in 0..partition.len() as u32 {
+        for &u in partition.frontier(k as usize) {
+            for e in graph.neighbors(u) {
+                let o = owner[e.to as usize];
+                if o != k && o != NONE {
+                    if k < o && recorded[o as usize] != k {
+                        recorded[o as usize] = k;
+                        pairs.push((k, o));
+                    }
+                    if dist[e.to as usize] + f64::from(e.len) == dist[u as usize] {
+                        ties.push((u, o));
+                    }
+                }
+            }
+        }
+    }
+    (pairs, ties)
+}
+
+/// Node pairs and ties, straight-line metric: from every triangle edge. A sample is
+/// tied with node `k` when it is exactly as far from `k` as from its own node.
+fn triangle_pairs(domain: &Domain, partition: &Partition) -> PairsAndTies {
     let owner = &partition.owner;
     let dist = &partition.dist;
     let positions = domain.positions();
-    // Whether sample `w` is as close to node `k` (owner of its neighbour `u`) as to its own.
-    let tied = |w: u32, u: u32, k: u32| -> bool {
-        let dw = dist[w as usize];
-        match domain.metric() {
-            Metric::Euclidean => {
-                (positions[w as usize] - positions[partition.node_vertex[k as usize] as usize])
-                    .length()
-                    == dw
-            }
-            Metric::Intrinsic => {
-                let len = (positions[w as usize] - positions[u as usize]).length() as f32;
-                dist[u as usize] + f64::from(len) == dw
-            }
-        }
+    let tied = |w: u32, k: u32| -> bool {
+        (positions[w as usize] - positions[partition.node_vertex[k as usize] as usize]).length()
+            == dist[w as usize]
     };
-    let (mut pairs, ties) = domain
+    domain
         .triangles()
         .par_chunks(4096)
         .fold(
@@ -44,10 +117,10 @@ pub(crate) fn dual_edges(domain: &Domain, partition: &Partition) -> Vec<(u32, u3
                         let (oa, ob) = (owner[a as usize], owner[b as usize]);
                         if oa != ob && oa != NONE && ob != NONE {
                             acc.push((oa.min(ob), oa.max(ob)));
-                            if tied(a, b, ob) {
+                            if tied(a, ob) {
                                 ties.push((a, ob));
                             }
-                            if tied(b, a, oa) {
+                            if tied(b, oa) {
                                 ties.push((b, oa));
                             }
                         }
@@ -65,35 +138,7 @@ pub(crate) fn dual_edges(domain: &Domain, partition: &Partition) -> Vec<(u32, u3
                 ta.extend(tb);
                 (a, ta)
             },
-        );
-    if !ties.is_empty() {
-        // Link each tied sample's other node to every cell around the sample.
-        let mut tied_with: std::collections::HashMap<u32, Vec<u32>> =
-            std::collections::HashMap::new();
-        let mut is_tied = vec![false; owner.len()];
-        for (w, k) in ties {
-            is_tied[w as usize] = true;
-            tied_with.entry(w).or_default().push(k);
-        }
-        for t in domain.triangles() {
-            for (i, &w) in t.iter().enumerate() {
-                if !is_tied[w as usize] {
-                    continue;
-                }
-                for &k in &tied_with[&w] {
-                    for &u in [t[(i + 1) % 3], t[(i + 2) % 3]].iter() {
-                        let o = owner[u as usize];
-                        if o != k && o != NONE {
-                            pairs.push((o.min(k), o.max(k)));
-                        }
-                    }
-                }
-            }
-        }
-    }
-    pairs.sort_unstable();
-    pairs.dedup();
-    pairs
+        )
 }
 
 /// Harmonic coefficients: for every node, `None` for a real node (it has a group of its
@@ -274,5 +319,71 @@ mod tests {
         let h = harmonic_coordinates(&positions, &node_vertex, &groups, 1, &edges);
         assert_eq!(h[1].as_deref(), Some(&[1.0][..]));
         assert_eq!(h[2].as_deref(), Some(&[0.0][..]));
+    }
+
+    /// The dual graph by brute force: every triangle edge, with the closed-cell ties
+    /// of the intrinsic metric.
+    fn dual_by_scan(domain: &Domain, partition: &Partition) -> Vec<(u32, u32)> {
+        let (owner, dist) = (&partition.owner, &partition.dist);
+        let positions = domain.positions();
+        let mut pairs = Vec::new();
+        let mut ties = Vec::new();
+        for t in domain.triangles() {
+            for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+                let (oa, ob) = (owner[a as usize], owner[b as usize]);
+                if oa != ob {
+                    pairs.push((oa.min(ob), oa.max(ob)));
+                    let len =
+                        f64::from((positions[a as usize] - positions[b as usize]).length() as f32);
+                    if dist[b as usize] + len == dist[a as usize] {
+                        ties.push((a, ob));
+                    }
+                    if dist[a as usize] + len == dist[b as usize] {
+                        ties.push((b, oa));
+                    }
+                }
+            }
+        }
+        for t in domain.triangles() {
+            for (i, &w) in t.iter().enumerate() {
+                for &(tw, k) in ties.iter().filter(|(tw, _)| *tw == w) {
+                    debug_assert_eq!(tw, w);
+                    for u in [t[(i + 1) % 3], t[(i + 2) % 3]] {
+                        let o = owner[u as usize];
+                        if o != k {
+                            pairs.push((o.min(k), o.max(k)));
+                        }
+                    }
+                }
+            }
+        }
+        pairs.sort_unstable();
+        pairs.dedup();
+        pairs
+    }
+
+    #[test]
+    fn dual_graph_from_frontiers_matches_a_scan_of_every_triangle() {
+        use crate::domain::tests::grid_mesh;
+        // A regular grid (many exact ties) and nodes added and removed one by one, so
+        // the frontier lists are the incrementally kept ones.
+        let (p, t) = grid_mesh(24, 18, 1.0);
+        let d = Domain::new(p, t, Metric::Intrinsic).expect("valid");
+        let mut part = Partition::new(&d, vec![0, 60, 200, 333]);
+        assert_eq!(dual_edges(&d, &part), dual_by_scan(&d, &part));
+        for v in [12, 130, 250, 300, 77] {
+            part.add_node(&d, v);
+            assert_eq!(dual_edges(&d, &part), dual_by_scan(&d, &part));
+        }
+        for k in [2, 0, 5] {
+            part.remove_node(&d, k);
+            assert_eq!(dual_edges(&d, &part), dual_by_scan(&d, &part));
+        }
+        assert!(dual_edges(&d, &part).len() >= part.len() - 1);
+        // Cells that touch only through a sample at equal distance from both nodes.
+        for nodes in [vec![113, 219, 294, 372], vec![56, 175, 187, 407]] {
+            let part = Partition::new(&d, nodes);
+            assert_eq!(dual_edges(&d, &part), dual_by_scan(&d, &part));
+        }
     }
 }

@@ -513,6 +513,7 @@ impl Rig {
             .collect();
         self.update_timings.plan_ms += ms(clock);
         let clock = Instant::now();
+        let old_vertex: Vec<u32> = self.nodes.iter().map(|n| n.vertex).collect();
         let mut map: Vec<u32> = (0..self.nodes.len() as u32).collect();
         for &k in doomed.iter().rev() {
             self.partition.remove_node(&self.domain, k);
@@ -563,7 +564,7 @@ impl Rig {
                 })
             })
             .collect();
-        self.weights.renumber(&map);
+        self.weights.renumber(&map, &old_vertex);
         self.weights.update(
             &self.domain,
             &self.partition,

@@ -69,6 +69,13 @@ pub(crate) struct Partition {
     members: Vec<Vec<u32>>,
     /// Position of each sample in its owner's member list.
     slot: Vec<u32>,
+    /// Intrinsic metric only: the samples of each cell with a graph neighbour in another
+    /// cell. Every boundary edge of a cell starts at one of them, so r_h, the closed-cell
+    /// ties and the dual graph need only these (a few hundred of a cell's thousands).
+    frontier: Vec<Vec<u32>>,
+    /// The cell whose frontier list holds each sample (`NONE`: none), and where.
+    frontier_cell: Vec<u32>,
+    frontier_slot: Vec<u32>,
     /// Euclidean metric only: the largest `dist` in each vertex-grid cell.
     bin_max: Vec<f64>,
     /// Radii of each cell.
@@ -99,6 +106,9 @@ impl Partition {
             dist: vec![f64::INFINITY; n],
             members: Vec::new(),
             slot: vec![0; n],
+            frontier: Vec::new(),
+            frontier_cell: Vec::new(),
+            frontier_slot: Vec::new(),
             bin_max: Vec::new(),
             stats: Vec::new(),
         };
@@ -123,6 +133,7 @@ impl Partition {
                         p.members[o as usize].push(v as u32);
                     }
                 }
+                p.build_frontier(domain);
             }
             Metric::Euclidean => p.nearest_euclidean(domain, node_vertex),
         }
@@ -234,8 +245,9 @@ impl Partition {
                     self.set_owner(v, k as u32);
                     heap.push(Entry::new(0.0, v, v));
                 }
+                self.frontier.push(Vec::new());
                 self.propagate(domain, &mut heap, Some(&mut changed));
-                self.neighbour_cells(domain, &changed)
+                self.settle(domain, &changed)
             }
             Metric::Euclidean => self.add_node_euclidean(domain, v),
         };
@@ -419,6 +431,16 @@ impl Partition {
                 *o -= 1;
             }
         }
+        if domain.metric() == Metric::Intrinsic {
+            for v in self.frontier.remove(k) {
+                self.frontier_cell[v as usize] = NONE;
+            }
+            for c in self.frontier_cell.iter_mut() {
+                if *c != NONE && *c > k32 {
+                    *c -= 1;
+                }
+            }
+        }
         let mut changed: Vec<(u32, u32)> = freed.iter().map(|&v| (v, NONE)).collect();
         let mut touched = Vec::new();
         match domain.metric() {
@@ -438,7 +460,7 @@ impl Partition {
                     }
                 }
                 self.propagate(domain, &mut heap, Some(&mut changed));
-                touched.extend(self.neighbour_cells(domain, &changed));
+                touched.extend(self.settle(domain, &changed[freed.len()..]));
             }
             Metric::Euclidean => {
                 let positions = domain.positions();
@@ -481,9 +503,46 @@ impl Partition {
         self.refresh(domain, touched)
     }
 
-    /// Owners (before and after) of the changed samples and of their neighbours, each
-    /// once.
-    fn neighbour_cells(&self, domain: &Domain, changed: &[(u32, u32)]) -> Vec<usize> {
+    /// Whether sample `v` belongs to a cell and has a graph neighbour in another one.
+    fn on_frontier(&self, graph: &crate::domain::Graph, v: u32) -> bool {
+        let o = self.owner[v as usize];
+        o != NONE
+            && graph.neighbors(v).iter().any(|e| {
+                let w = self.owner[e.to as usize];
+                w != o && w != NONE
+            })
+    }
+
+    /// The frontier lists of every cell, from scratch.
+    fn build_frontier(&mut self, domain: &Domain) {
+        use rayon::prelude::*;
+        let graph = domain.graph();
+        let n = self.owner.len();
+        let flags: Vec<bool> = (0..n as u32)
+            .into_par_iter()
+            .map(|v| self.on_frontier(graph, v))
+            .collect();
+        self.frontier = vec![Vec::new(); self.node_vertex.len()];
+        self.frontier_cell = vec![NONE; n];
+        self.frontier_slot = vec![0; n];
+        for (v, _) in flags.iter().enumerate().filter(|(_, f)| **f) {
+            let o = self.owner[v];
+            self.frontier_cell[v] = o;
+            self.frontier_slot[v] = self.frontier[o as usize].len() as u32;
+            self.frontier[o as usize].push(v as u32);
+        }
+    }
+
+    /// After the samples in `changed` changed owner (each listed with its previous
+    /// owner, all moves done): brings the frontier lists up to date and returns the
+    /// cells whose radii may have changed, each once — the owners before and after of
+    /// the changed samples and the owners of their neighbours.
+    ///
+    /// Only the changed samples and their neighbours can enter or leave a frontier. A
+    /// changed sample is checked in full; a neighbour in another cell is on a frontier
+    /// now; a neighbour in the same cell may have lost its only foreign neighbour, which
+    /// matters only if it is on a frontier list.
+    fn settle(&mut self, domain: &Domain, changed: &[(u32, u32)]) -> Vec<usize> {
         let graph = domain.graph();
         let mut seen = vec![false; self.node_vertex.len()];
         let mut cells = Vec::new();
@@ -494,13 +553,57 @@ impl Partition {
             }
         };
         for &(v, old) in changed {
+            let o = self.owner[v as usize];
             note(old, &mut cells);
-            note(self.owner[v as usize], &mut cells);
+            note(o, &mut cells);
+            let mut front = false;
             for e in graph.neighbors(v) {
-                note(self.owner[e.to as usize], &mut cells);
+                let ow = self.owner[e.to as usize];
+                note(ow, &mut cells);
+                if ow == NONE || o == NONE {
+                    continue;
+                }
+                if ow != o {
+                    front = true;
+                    if self.frontier_cell[e.to as usize] != ow {
+                        self.set_frontier(e.to, ow);
+                    }
+                } else if self.frontier_cell[e.to as usize] != NONE
+                    && !self.on_frontier(graph, e.to)
+                {
+                    self.set_frontier(e.to, NONE);
+                }
             }
+            self.set_frontier(v, if front { o } else { NONE });
         }
         cells
+    }
+
+    /// Puts sample `v` on the frontier list of cell `cell` (`NONE`: on none).
+    fn set_frontier(&mut self, v: u32, cell: u32) {
+        let current = self.frontier_cell[v as usize];
+        if current == cell {
+            return;
+        }
+        if current != NONE {
+            let list = &mut self.frontier[current as usize];
+            let at = self.frontier_slot[v as usize] as usize;
+            list.swap_remove(at);
+            if let Some(&moved) = list.get(at) {
+                self.frontier_slot[moved as usize] = at as u32;
+            }
+        }
+        if cell != NONE {
+            self.frontier_slot[v as usize] = self.frontier[cell as usize].len() as u32;
+            self.frontier[cell as usize].push(v);
+        }
+        self.frontier_cell[v as usize] = cell;
+    }
+
+    /// The frontier samples of cell `k` (intrinsic metric): its samples with a graph
+    /// neighbour in another cell.
+    pub fn frontier(&self, k: usize) -> &[u32] {
+        &self.frontier[k]
     }
 
     /// Recomputes the radii of the given cells and returns them, deduplicated.
@@ -540,7 +643,7 @@ impl Partition {
                 let graph = domain.graph();
                 let k32 = k as u32;
                 let mut best = f64::INFINITY;
-                for &u in &self.members[k] {
+                for &u in &self.frontier[k] {
                     let du = self.dist[u as usize];
                     for e in graph.neighbors(u) {
                         let o = self.owner[e.to as usize];
@@ -582,7 +685,7 @@ impl Partition {
             .collect();
         if domain.metric() == Metric::Intrinsic {
             let graph = domain.graph();
-            for &u in &self.members[k] {
+            for &u in &self.frontier[k] {
                 let du = self.dist[u as usize];
                 for e in graph.neighbors(u) {
                     let (o, dw) = (self.owner[e.to as usize], self.dist[e.to as usize]);
@@ -617,6 +720,20 @@ impl Partition {
             a.sort_unstable();
             b.sort_unstable();
             assert_eq!(a, b);
+        }
+        if domain.metric() == Metric::Intrinsic {
+            for k in 0..self.len() {
+                let mut a = self.frontier[k].clone();
+                let mut b = fresh.frontier[k].clone();
+                a.sort_unstable();
+                b.sort_unstable();
+                assert_eq!(a, b, "frontier of cell {k}");
+                for (i, &v) in self.frontier[k].iter().enumerate() {
+                    assert_eq!(self.frontier_cell[v as usize], k as u32);
+                    assert_eq!(self.frontier_slot[v as usize], i as u32);
+                }
+            }
+            assert_eq!(self.frontier_cell, fresh.frontier_cell);
         }
     }
 }

@@ -179,6 +179,9 @@ pub(crate) struct Weights {
     sums: Vec<f64>,
     /// Per node, its cached distance field.
     balls: Vec<Ball>,
+    /// Fields of nodes removed since the last update, by sample: Algorithm 1 often puts
+    /// a virtual handle back where one was removed.
+    spare: std::collections::HashMap<u32, Ball>,
 }
 
 /// A per-node change for [`Weights::update`]: the node, its radius before the change
@@ -236,6 +239,7 @@ impl Weights {
             phi,
             sums: Vec::new(),
             balls,
+            spare: Default::default(),
         };
         w.sums = (0..n).map(|v| w.row_sum(v)).collect();
         w
@@ -343,6 +347,7 @@ impl Weights {
                 };
                 partition.len()
             ],
+            spare: Default::default(),
         };
         let mut at = 0u32;
         for (lens, nodes, phi, sums) in parts {
@@ -380,20 +385,23 @@ impl Weights {
             .collect()
     }
 
-    /// Renumbers nodes after a removal: `map[old] = new` (or `NONE` for a removed node).
-    pub fn renumber(&mut self, map: &[u32]) {
+    /// Renumbers nodes after a removal: `map[old] = new` (or `NONE` for a removed node);
+    /// `old_vertex` are the nodes' samples before it.
+    pub fn renumber(&mut self, map: &[u32], old_vertex: &[u32]) {
         self.nodes.par_iter_mut().for_each(|k| {
             if *k != NONE {
                 *k = map[*k as usize];
             }
         });
         let balls = std::mem::take(&mut self.balls);
-        self.balls = balls
-            .into_iter()
-            .zip(map)
-            .filter(|(_, m)| **m != NONE)
-            .map(|(b, _)| b)
-            .collect();
+        self.balls = Vec::with_capacity(balls.len());
+        for ((ball, &m), &v) in balls.into_iter().zip(map).zip(old_vertex) {
+            if m != NONE {
+                self.balls.push(ball);
+            } else if ball.radius >= 0.0 {
+                self.spare.insert(v, ball);
+            }
+        }
     }
 
     /// Brings the weights up to date after the nodes in `changes` got new radii (or
@@ -413,6 +421,14 @@ impl Weights {
             radius: -1.0,
             entries: Vec::new(),
         });
+        for c in changes {
+            if self.balls[c.node].radius < 0.0
+                && let Some(ball) = self.spare.remove(&partition.node_vertex[c.node])
+            {
+                self.balls[c.node] = ball;
+            }
+        }
+        self.spare.clear();
         /// A changed node, a fresh ball if the cached one was too small, the samples
         /// whose rows it may change, and its new support entries.
         type Reach = (usize, Option<Ball>, Vec<u32>, Vec<(u32, f32)>);
@@ -464,29 +480,38 @@ impl Weights {
                 fill[v as usize] += 1;
             }
         }
-        // Rebuild the rows in parallel chunks: copy clean rows, merge dirty ones.
+        // Rebuild the rows in parallel chunks: runs of clean rows are copied in bulk,
+        // dirty rows merged from their kept entries and the fresh ones.
         const CHUNK: usize = 8192;
         let this = &*self;
-        /// One chunk of rebuilt rows: lengths, nodes, φ, and new sums of dirty rows.
+        /// One chunk of rebuilt rows: row starts (relative to the chunk), nodes, φ, and
+        /// the new sums of dirty rows.
         type Part = (Vec<u32>, Vec<u32>, Vec<f32>, Vec<(usize, f64)>);
         let parts: Vec<Part> = (0..n.div_ceil(CHUNK))
             .into_par_iter()
             .map(|c| {
                 let (lo, hi) = (c * CHUNK, ((c + 1) * CHUNK).min(n));
                 let (a0, a1) = (this.offsets[lo] as usize, this.offsets[hi] as usize);
-                let mut lens = Vec::with_capacity(hi - lo);
+                let mut starts = Vec::with_capacity(hi - lo);
                 let mut nodes = Vec::with_capacity(a1 - a0 + a1 / 16 - a0 / 16);
                 let mut phi = Vec::with_capacity(nodes.capacity());
                 let mut sums = Vec::new();
                 let mut row: Vec<(u32, f32)> = Vec::new();
-                for v in lo..hi {
-                    let (a, b) = (this.offsets[v] as usize, this.offsets[v + 1] as usize);
+                let mut v = lo;
+                while v < hi {
                     if !dirty_mark[v] {
-                        nodes.extend_from_slice(&this.nodes[a..b]);
-                        phi.extend_from_slice(&this.phi[a..b]);
-                        lens.push((b - a) as u32);
+                        let run = v;
+                        while v < hi && !dirty_mark[v] {
+                            v += 1;
+                        }
+                        let (a, b) = (this.offsets[run], this.offsets[v]);
+                        let base = nodes.len() as u32;
+                        starts.extend(this.offsets[run..v].iter().map(|&o| o - a + base));
+                        nodes.extend_from_slice(&this.nodes[a as usize..b as usize]);
+                        phi.extend_from_slice(&this.phi[a as usize..b as usize]);
                         continue;
                     }
+                    let (a, b) = (this.offsets[v] as usize, this.offsets[v + 1] as usize);
                     row.clear();
                     row.extend(
                         (a..b)
@@ -497,6 +522,7 @@ impl Weights {
                         &fresh[fresh_start[v] as usize..fresh_start[v + 1] as usize],
                     );
                     row.sort_unstable_by_key(|&(k, _)| partition.node_vertex[k as usize]);
+                    starts.push(nodes.len() as u32);
                     let mut sum = 0.0;
                     for &(k, f) in &row {
                         nodes.push(k);
@@ -504,28 +530,25 @@ impl Weights {
                         sum += f64::from(f);
                     }
                     sums.push((v, sum));
-                    lens.push(row.len() as u32);
+                    v += 1;
                 }
-                (lens, nodes, phi, sums)
+                (starts, nodes, phi, sums)
             })
             .collect();
         let total: usize = parts.iter().map(|p| p.1.len()).sum();
         let mut offsets = Vec::with_capacity(n + 1);
         let mut nodes = Vec::with_capacity(total);
         let mut phi = Vec::with_capacity(total);
-        let mut at = 0u32;
-        for (lens, part_nodes, part_phi, sums) in parts {
-            for len in lens {
-                offsets.push(at);
-                at += len;
-            }
+        for (starts, part_nodes, part_phi, sums) in parts {
+            let at = nodes.len() as u32;
+            offsets.extend(starts.iter().map(|&s| s + at));
             nodes.extend_from_slice(&part_nodes);
             phi.extend_from_slice(&part_phi);
             for (v, s) in sums {
                 self.sums[v] = s;
             }
         }
-        offsets.push(at);
+        offsets.push(nodes.len() as u32);
         self.offsets = offsets;
         self.nodes = nodes;
         self.phi = phi;
