@@ -13,8 +13,8 @@ use crate::error::RigError;
 use crate::harmonic::{dual_edges, harmonic_coordinates};
 use crate::transform::Similarity;
 use crate::virtual_handles::insert_virtual_handles;
-use crate::voronoi::{NONE, Partition};
-use crate::weights::{Change, Weights, ball};
+use crate::voronoi::{CellStats, NONE, Partition};
+use crate::weights::{Ball, Change, Weights, ball};
 
 /// A handle the user places.
 #[derive(Clone, Debug, PartialEq)]
@@ -302,7 +302,7 @@ impl Rig {
         partition.decompose(&domain);
         timings.voronoi_ms = ms(clock);
         let clock = Instant::now();
-        for v in insert_virtual_handles(&domain, &mut partition) {
+        for v in insert_virtual_handles(&domain, &mut partition, |_, _| {}) {
             nodes.push(Node {
                 vertex: v,
                 kind: NodeKind::Virtual,
@@ -512,44 +512,86 @@ impl Rig {
             })
             .collect();
         self.update_timings.plan_ms += ms(clock);
-        let clock = Instant::now();
         let old_vertex: Vec<u32> = self.nodes.iter().map(|n| n.vertex).collect();
-        let mut map: Vec<u32> = (0..self.nodes.len() as u32).collect();
-        for &k in doomed.iter().rev() {
-            self.partition.remove_node(&self.domain, k);
-            self.nodes.remove(k);
-            map[k] = NONE;
-        }
-        for (next, m) in map.iter_mut().filter(|m| **m != NONE).enumerate() {
-            *m = next as u32;
-        }
-        // Add the new real nodes, then give every real node its (possibly renumbered)
-        // kind from the target.
-        let present: HashMap<u32, usize> = self
-            .nodes
+        // How far each node's cached distance field reaches, by sample.
+        let cached: HashMap<u32, f64> = old_vertex
             .iter()
             .enumerate()
-            .map(|(k, n)| (n.vertex, k))
+            .map(|(k, &v)| (v, self.weights.field_radius(k)))
             .collect();
-        for n in &target {
-            match present.get(&n.vertex) {
-                Some(&k) => self.nodes[k].kind = n.kind,
-                None => {
-                    self.partition.add_node(&self.domain, n.vertex);
-                    self.nodes.push(*n);
+        let mut map: Vec<u32> = (0..self.nodes.len() as u32).collect();
+        let Self {
+            domain,
+            options,
+            nodes,
+            partition,
+            update_timings,
+            ..
+        } = self;
+        let (domain, alpha) = (&*domain, options.alpha);
+        // Distance fields are searched on the other cores while the partition changes:
+        // once the removals and the real nodes are in, Algorithm 1 only adds nodes, so
+        // radii only shrink, and a field searched to a node's radius at that point
+        // covers its final support.
+        let searched = std::sync::Mutex::new(Vec::new());
+        let mut weights_clock = Instant::now();
+        rayon::scope(|scope| {
+            let search = |v: u32, radius: f64| {
+                let searched = &searched;
+                scope.spawn(move |_| {
+                    let field = Ball::compute(domain, v, radius);
+                    searched.lock().expect("not poisoned").push((v, field));
+                });
+            };
+            let clock = Instant::now();
+            for &k in doomed.iter().rev() {
+                partition.remove_node(domain, k);
+                nodes.remove(k);
+                map[k] = NONE;
+            }
+            for (next, m) in map.iter_mut().filter(|m| **m != NONE).enumerate() {
+                *m = next as u32;
+            }
+            // Add the new real nodes, then give every real node its (possibly
+            // renumbered) kind from the target.
+            let present: HashMap<u32, usize> = nodes
+                .iter()
+                .enumerate()
+                .map(|(k, n)| (n.vertex, k))
+                .collect();
+            for n in &target {
+                match present.get(&n.vertex) {
+                    Some(&k) => nodes[k].kind = n.kind,
+                    None => {
+                        partition.add_node(domain, n.vertex);
+                        nodes.push(*n);
+                    }
                 }
             }
-        }
-        self.update_timings.partition_ms = ms(clock);
-        let clock = Instant::now();
-        for v in insert_virtual_handles(&self.domain, &mut self.partition) {
-            self.nodes.push(Node {
+            for (k, n) in nodes.iter().enumerate() {
+                let radius = support_radius(&partition.stats[k], alpha);
+                if cached.get(&n.vertex).is_none_or(|&r| r < radius) {
+                    search(n.vertex, radius);
+                }
+            }
+            update_timings.partition_ms = ms(clock);
+            let clock = Instant::now();
+            let added = insert_virtual_handles(domain, partition, |partition, k| {
+                search(
+                    partition.node_vertex[k],
+                    support_radius(&partition.stats[k], alpha),
+                );
+            });
+            nodes.extend(added.into_iter().map(|v| Node {
                 vertex: v,
                 kind: NodeKind::Virtual,
-            });
-        }
-        self.update_timings.virtual_ms = ms(clock);
-        let clock = Instant::now();
+            }));
+            update_timings.virtual_ms = ms(clock);
+            weights_clock = Instant::now();
+        });
+        let clock = weights_clock;
+        self.weights
+            .offer(searched.into_inner().expect("not poisoned"));
         self.radii = support_radii(&self.partition, self.options.alpha);
         let changes: Vec<Change> = self
             .nodes
@@ -837,16 +879,19 @@ fn support_radii(partition: &Partition, alpha: f64) -> Vec<f64> {
     partition
         .stats
         .iter()
-        .map(|s| {
-            if s.r_h.is_infinite() {
-                f64::INFINITY
-            } else {
-                // Rounded up to an f32 value: distances are kept as f32, and a distance
-                // at or beyond a representable radius rounds to at or beyond it.
-                round_up_f32(((1.0 - alpha) * s.r_d + alpha * s.r_h).min(s.r_h))
-            }
-        })
+        .map(|s| support_radius(s, alpha))
         .collect()
+}
+
+/// The support radius of a cell with radii `s`: (1 − α)·r_d + α·r_h.
+fn support_radius(s: &CellStats, alpha: f64) -> f64 {
+    if s.r_h.is_infinite() {
+        f64::INFINITY
+    } else {
+        // Rounded up to an f32 value: distances are kept as f32, and a distance at or
+        // beyond a representable radius rounds to at or beyond it.
+        round_up_f32(((1.0 - alpha) * s.r_d + alpha * s.r_h).min(s.r_h))
+    }
 }
 
 /// The smallest f32 value at or above `x`, as f64.

@@ -20,7 +20,13 @@ const MAX_TIED_PER_CELL: usize = 4;
 /// Inserts virtual nodes into `partition` until the r_d < r_h condition holds for every
 /// node, and every sample is reached by some node. Returns the new nodes' samples in
 /// insertion order (they are appended to the partition's nodes in that order).
-pub(crate) fn insert_virtual_handles(domain: &Domain, partition: &mut Partition) -> Vec<u32> {
+/// `inserted` is told of each new node (its index) as soon as it is in: its radii can
+/// only shrink from there on.
+pub(crate) fn insert_virtual_handles(
+    domain: &Domain,
+    partition: &mut Partition,
+    mut inserted: impl FnMut(&Partition, usize),
+) -> Vec<u32> {
     let mut added = Vec::new();
     if partition.len() == 0 {
         // No handles: nothing moves, nothing to weigh.
@@ -31,6 +37,7 @@ pub(crate) fn insert_virtual_handles(domain: &Domain, partition: &mut Partition)
         for v in partition.unreached() {
             if partition.owner[v as usize] == crate::voronoi::NONE {
                 partition.add_node(domain, v);
+                inserted(partition, partition.len() - 1);
                 added.push(v);
             }
         }
@@ -98,6 +105,7 @@ pub(crate) fn insert_virtual_handles(domain: &Domain, partition: &mut Partition)
             .partition(|(members, _)| members.len() == 1);
         for (members, _) in singles {
             partition.add_node(domain, members[0]);
+            inserted(partition, partition.len() - 1);
             added.push(members[0]);
         }
         for (members, r_h) in merged {
@@ -113,6 +121,7 @@ pub(crate) fn insert_virtual_handles(domain: &Domain, partition: &mut Partition)
                 .find(|&v| partition.dist[v as usize] >= r_h);
             if let Some(v) = candidate {
                 partition.add_node(domain, v);
+                inserted(partition, partition.len() - 1);
                 added.push(v);
             }
         }
@@ -132,7 +141,7 @@ mod tests {
             let (p, t) = grid_mesh(40, 30, 1.0);
             let d = Domain::new(p, t, metric).expect("valid");
             let mut part = Partition::new(&d, vec![41 * 10 + 20, 41 * 10 + 21]);
-            let added = insert_virtual_handles(&d, &mut part);
+            let added = insert_virtual_handles(&d, &mut part, |_, _| {});
             assert!(!added.is_empty());
             for s in &part.stats {
                 assert!(s.r_d < s.r_h, "{s:?}");
@@ -154,7 +163,7 @@ mod tests {
             let mut nodes: Vec<u32> = (10..=70).step_by(2).map(|i| id(i, 30)).collect();
             nodes.push(id(40, 32));
             let mut part = Partition::new(&d, nodes);
-            let added = insert_virtual_handles(&d, &mut part);
+            let added = insert_virtual_handles(&d, &mut part, |_, _| {});
             assert!(
                 added.len() < samples / 4,
                 "{metric:?}: {} of {samples}",
@@ -172,7 +181,7 @@ mod tests {
         let (p, t) = grid_mesh(10, 10, 1.0);
         let d = Domain::new(p, t, Metric::Intrinsic).expect("valid");
         let mut part = Partition::new(&d, vec![0]);
-        assert!(insert_virtual_handles(&d, &mut part).is_empty());
+        assert!(insert_virtual_handles(&d, &mut part, |_, _| {}).is_empty());
     }
 
     #[test]
@@ -185,7 +194,7 @@ mod tests {
         t.extend(t2.iter().map(|tri| tri.map(|v| v + n)));
         let d = Domain::new(p, t, Metric::Intrinsic).expect("valid");
         let mut part = Partition::new(&d, vec![5]);
-        let added = insert_virtual_handles(&d, &mut part);
+        let added = insert_virtual_handles(&d, &mut part, |_, _| {});
         assert!(added.contains(&n));
         assert!(part.unreached().is_empty());
     }

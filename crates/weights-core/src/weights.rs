@@ -106,7 +106,7 @@ pub(crate) fn ball(domain: &Domain, source: u32, radius: f64) -> Vec<(u32, f64)>
 /// A node's distance field near it, kept so that a new support radius needs no new
 /// search: the samples closer than `radius` with their distances (rounded to f32; the
 /// weights are computed from these rounded values on every path, so rebuilds and
-/// updates agree bit for bit).
+/// updates agree bit for bit). How far it was searched does not matter.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Ball {
     /// How far the search went (negative: nothing cached).
@@ -115,7 +115,8 @@ pub(crate) struct Ball {
 }
 
 impl Ball {
-    fn compute(domain: &Domain, source: u32, radius: f64) -> Self {
+    /// The samples closer than `radius` to sample `source`, searched now.
+    pub fn compute(domain: &Domain, source: u32, radius: f64) -> Self {
         Self {
             radius,
             entries: ball(domain, source, radius)
@@ -385,6 +386,21 @@ impl Weights {
             .collect()
     }
 
+    /// How far node `k`'s cached distance field reaches (negative: none cached).
+    pub fn field_radius(&self, k: usize) -> f64 {
+        self.balls.get(k).map_or(-1.0, |b| b.radius)
+    }
+
+    /// Distance fields searched ahead of the next [`Weights::update`], by sample: it
+    /// uses them where its cached ones fall short.
+    pub fn offer(&mut self, fields: Vec<(u32, Ball)>) {
+        for (v, field) in fields {
+            if self.spare.get(&v).is_none_or(|b| b.radius < field.radius) {
+                self.spare.insert(v, field);
+            }
+        }
+    }
+
     /// Renumbers nodes after a removal: `map[old] = new` (or `NONE` for a removed node);
     /// `old_vertex` are the nodes' samples before it.
     pub fn renumber(&mut self, map: &[u32], old_vertex: &[u32]) {
@@ -422,8 +438,10 @@ impl Weights {
             entries: Vec::new(),
         });
         for c in changes {
-            if self.balls[c.node].radius < 0.0
+            let reach = c.old_radius.map_or(radii[c.node], |o| o.max(radii[c.node]));
+            if !self.balls[c.node].covers(reach)
                 && let Some(ball) = self.spare.remove(&partition.node_vertex[c.node])
+                && ball.covers(reach)
             {
                 self.balls[c.node] = ball;
             }
