@@ -29,6 +29,8 @@ pub(crate) struct Edge {
 pub(crate) struct Graph {
     offsets: Vec<u32>,
     edges: Vec<Edge>,
+    /// The longest edge.
+    max_len: f32,
 }
 
 impl Graph {
@@ -74,10 +76,17 @@ impl Graph {
             }
         }
         new_offsets.push(edges.len() as u32);
+        let max_len = edges.iter().map(|e| e.len).fold(0.0, f32::max);
         Self {
             offsets: new_offsets,
             edges,
+            max_len,
         }
+    }
+
+    /// The length of the longest edge.
+    pub fn max_edge_length(&self) -> f64 {
+        f64::from(self.max_len)
     }
 
     #[inline]

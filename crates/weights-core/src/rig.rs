@@ -513,11 +513,11 @@ impl Rig {
             .collect();
         self.update_timings.plan_ms += ms(clock);
         let old_vertex: Vec<u32> = self.nodes.iter().map(|n| n.vertex).collect();
-        // How far each node's cached distance field reaches, by sample.
-        let cached: HashMap<u32, f64> = old_vertex
+        // Each node's number before the removals, by sample (for its cached field).
+        let cached: HashMap<u32, usize> = old_vertex
             .iter()
             .enumerate()
-            .map(|(k, &v)| (v, self.weights.field_radius(k)))
+            .map(|(k, &v)| (v, k))
             .collect();
         let mut map: Vec<u32> = (0..self.nodes.len() as u32).collect();
         let Self {
@@ -525,10 +525,11 @@ impl Rig {
             options,
             nodes,
             partition,
+            weights,
             update_timings,
             ..
-        } = self;
-        let (domain, alpha) = (&*domain, options.alpha);
+        } = &mut *self;
+        let (domain, weights, alpha) = (&*domain, &*weights, options.alpha);
         // Distance fields are searched on the other cores while the partition changes:
         // once the removals and the real nodes are in, Algorithm 1 only adds nodes, so
         // radii only shrink, and a field searched to a node's radius at that point
@@ -536,10 +537,14 @@ impl Rig {
         let searched = std::sync::Mutex::new(Vec::new());
         let mut weights_clock = Instant::now();
         rayon::scope(|scope| {
-            let search = |v: u32, radius: f64| {
+            // Searched on from the cached field, if there is one.
+            let search = |v: u32, radius: f64, cached: Option<usize>| {
                 let searched = &searched;
                 scope.spawn(move |_| {
-                    let field = Ball::compute(domain, v, radius);
+                    let field = match cached {
+                        Some(k) => weights.field(k).extend(domain, v, radius),
+                        None => Ball::compute(domain, v, radius),
+                    };
                     searched.lock().expect("not poisoned").push((v, field));
                 });
             };
@@ -570,8 +575,9 @@ impl Rig {
             }
             for (k, n) in nodes.iter().enumerate() {
                 let radius = support_radius(&partition.stats[k], alpha);
-                if cached.get(&n.vertex).is_none_or(|&r| r < radius) {
-                    search(n.vertex, radius);
+                let old = cached.get(&n.vertex).copied();
+                if old.is_none_or(|k| weights.field(k).radius() < radius) {
+                    search(n.vertex, radius, old);
                 }
             }
             update_timings.partition_ms = ms(clock);
@@ -580,6 +586,7 @@ impl Rig {
                 search(
                     partition.node_vertex[k],
                     support_radius(&partition.stats[k], alpha),
+                    None,
                 );
             });
             nodes.extend(added.into_iter().map(|v| Node {

@@ -38,6 +38,20 @@ thread_local! {
 /// The samples within `radius` of node sample `source` (and the source itself), with
 /// their distances, in order of distance for the intrinsic metric.
 pub(crate) fn ball(domain: &Domain, source: u32, radius: f64) -> Vec<(u32, f64)> {
+    search(domain, source, radius, None)
+}
+
+/// [`ball`], continuing from `known`: every sample closer than `known_radius`, with its
+/// exact distance. Along the graph only the samples near the known ball's rim are put
+/// back on the queue (the others have no neighbour outside it), and the distances found
+/// beyond are the ones a search from scratch finds: each is the same minimum over the
+/// same neighbours.
+fn search(
+    domain: &Domain,
+    source: u32,
+    radius: f64,
+    known: Option<(&[(u32, f64)], f64)>,
+) -> Vec<(u32, f64)> {
     let mut out = Vec::new();
     match domain.metric() {
         Metric::Intrinsic => SCRATCH.with(|scratch| {
@@ -51,15 +65,37 @@ pub(crate) fn ball(domain: &Domain, source: u32, radius: f64) -> Vec<(u32, f64)>
                 *dist = vec![f64::INFINITY; domain.len()];
             }
             let graph = domain.graph();
-            dist[source as usize] = 0.0;
-            touched.push(source);
-            heap.push(Entry::new(0.0, 0, source));
+            // Samples closer than this are known and final.
+            let mut known_radius = f64::NEG_INFINITY;
+            match known {
+                Some((entries, r)) => {
+                    known_radius = r;
+                    // A known sample with a neighbour beyond the known ball is at most
+                    // one edge inside its rim.
+                    let rim = r - 2.0 * graph.max_edge_length();
+                    for &(v, d) in entries {
+                        dist[v as usize] = d;
+                        touched.push(v);
+                        if d >= rim {
+                            heap.push(Entry::new(d, 0, v));
+                        }
+                    }
+                    out.extend_from_slice(entries);
+                }
+                None => {
+                    dist[source as usize] = 0.0;
+                    touched.push(source);
+                    heap.push(Entry::new(0.0, 0, source));
+                }
+            }
             while let Some(entry) = heap.pop() {
                 let (d, v) = (entry.d(), entry.v());
                 if d > dist[v as usize] {
                     continue;
                 }
-                out.push((v, d));
+                if d >= known_radius && v != source || known.is_none() {
+                    out.push((v, d));
+                }
                 for e in graph.neighbors(v) {
                     let nd = d + f64::from(e.len);
                     let w = e.to as usize;
@@ -104,14 +140,15 @@ pub(crate) fn ball(domain: &Domain, source: u32, radius: f64) -> Vec<(u32, f64)>
 }
 
 /// A node's distance field near it, kept so that a new support radius needs no new
-/// search: the samples closer than `radius` with their distances (rounded to f32; the
-/// weights are computed from these rounded values on every path, so rebuilds and
-/// updates agree bit for bit). How far it was searched does not matter.
+/// search (and a larger one only a search beyond it): the samples closer than `radius`
+/// with their exact distances. Weights are computed from the distances rounded to f32
+/// on every path, so rebuilds and updates agree bit for bit; how far a field was
+/// searched does not matter.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Ball {
     /// How far the search went (negative: nothing cached).
     radius: f64,
-    entries: Vec<(u32, f32)>,
+    entries: Vec<(u32, f64)>,
 }
 
 impl Ball {
@@ -119,11 +156,24 @@ impl Ball {
     pub fn compute(domain: &Domain, source: u32, radius: f64) -> Self {
         Self {
             radius,
-            entries: ball(domain, source, radius)
-                .into_iter()
-                .map(|(v, d)| (v, d as f32))
-                .collect(),
+            entries: ball(domain, source, radius),
         }
+    }
+
+    /// This field (of the node on `source`) searched on to `radius`.
+    pub fn extend(&self, domain: &Domain, source: u32, radius: f64) -> Self {
+        if self.radius < 0.0 || self.entries.is_empty() {
+            return Self::compute(domain, source, radius);
+        }
+        Self {
+            radius,
+            entries: search(domain, source, radius, Some((&self.entries, self.radius))),
+        }
+    }
+
+    /// How far the field reaches (negative: nothing cached).
+    pub fn radius(&self) -> f64 {
+        self.radius
     }
 
     fn covers(&self, radius: f64) -> bool {
@@ -141,7 +191,7 @@ impl Ball {
         self.entries
             .iter()
             .filter_map(|&(v, d)| {
-                support_entry(basis, partition, source, v, d, radius).map(|f| (v, f))
+                support_entry(basis, partition, source, v, d as f32, radius).map(|f| (v, f))
             })
             .collect()
     }
@@ -180,9 +230,30 @@ pub(crate) struct Weights {
     sums: Vec<f64>,
     /// Per node, its cached distance field.
     balls: Vec<Ball>,
-    /// Fields of nodes removed since the last update, by sample: Algorithm 1 often puts
-    /// a virtual handle back where one was removed.
+    /// Fields of nodes removed since the last update, by sample (Algorithm 1 often puts
+    /// a virtual handle back where one was removed), and fields searched ahead of it.
     spare: std::collections::HashMap<u32, Ball>,
+    /// Buffers of [`Weights::update`], kept between updates.
+    scratch: UpdateBuffers,
+}
+
+/// Buffers [`Weights::update`] reuses: allocating them anew each time costs more than
+/// filling them (fresh pages are mapped on first touch). A copy of the weights starts
+/// without them.
+#[derive(Debug, Default)]
+struct UpdateBuffers {
+    dirty_mark: Vec<bool>,
+    fresh_start: Vec<u32>,
+    fill: Vec<u32>,
+    fresh: Vec<(u32, f32)>,
+    /// Row arrays (offsets, nodes, φ) swapped with the current ones at each update.
+    back: (Vec<u32>, Vec<u32>, Vec<f32>),
+}
+
+impl Clone for UpdateBuffers {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
 }
 
 /// A per-node change for [`Weights::update`]: the node, its radius before the change
@@ -241,6 +312,7 @@ impl Weights {
             sums: Vec::new(),
             balls,
             spare: Default::default(),
+            scratch: UpdateBuffers::default(),
         };
         w.sums = (0..n).map(|v| w.row_sum(v)).collect();
         w
@@ -349,6 +421,7 @@ impl Weights {
                 partition.len()
             ],
             spare: Default::default(),
+            scratch: UpdateBuffers::default(),
         };
         let mut at = 0u32;
         for (lens, nodes, phi, sums) in parts {
@@ -381,14 +454,14 @@ impl Weights {
         };
         ball.entries
             .iter()
-            .filter(|&&(_, d)| f64::from(d) < radius || d == 0.0)
+            .filter(|&&(_, d)| f64::from(d as f32) < radius || d == 0.0)
             .map(|&(v, _)| v)
             .collect()
     }
 
-    /// How far node `k`'s cached distance field reaches (negative: none cached).
-    pub fn field_radius(&self, k: usize) -> f64 {
-        self.balls.get(k).map_or(-1.0, |b| b.radius)
+    /// Node `k`'s cached distance field (how far it reaches: [`Ball::radius`]).
+    pub fn field(&self, k: usize) -> &Ball {
+        &self.balls[k]
     }
 
     /// Distance fields searched ahead of the next [`Weights::update`], by sample: it
@@ -457,13 +530,13 @@ impl Weights {
                 let r = radii[c.node];
                 let source = partition.node_vertex[c.node];
                 let reach = c.old_radius.map_or(r, |o| o.max(r));
-                let fresh =
-                    (!balls[c.node].covers(reach)).then(|| Ball::compute(domain, source, reach));
+                let fresh = (!balls[c.node].covers(reach))
+                    .then(|| balls[c.node].extend(domain, source, reach));
                 let ball = fresh.as_ref().unwrap_or(&balls[c.node]);
                 let touched = ball
                     .entries
                     .iter()
-                    .filter(|&&(_, d)| f64::from(d) < reach)
+                    .filter(|&&(_, d)| f64::from(d as f32) < reach)
                     .map(|&(v, _)| v)
                     .chain(std::iter::once(source))
                     .collect();
@@ -475,13 +548,23 @@ impl Weights {
         for c in changes {
             changed_node[c.node] = true;
         }
+        let mut scratch = std::mem::take(&mut self.scratch);
+        let UpdateBuffers {
+            dirty_mark,
+            fresh_start,
+            fill,
+            fresh,
+            back,
+        } = &mut scratch;
         // Dirty samples: every sample a changed or removed node reaches or reached.
-        let mut dirty_mark = vec![false; n];
+        dirty_mark.clear();
+        dirty_mark.resize(n, false);
         for &v in dirty.iter().chain(results.iter().flat_map(|r| r.2.iter())) {
             dirty_mark[v as usize] = true;
         }
         // The changed nodes' new entries, bucketed by sample (counting sort).
-        let mut fresh_start = vec![0u32; n + 1];
+        fresh_start.clear();
+        fresh_start.resize(n + 1, 0);
         for (_, _, _, entries) in &results {
             for &(v, _) in entries {
                 fresh_start[v as usize + 1] += 1;
@@ -490,14 +573,17 @@ impl Weights {
         for v in 0..n {
             fresh_start[v + 1] += fresh_start[v];
         }
-        let mut fill = fresh_start.clone();
-        let mut fresh = vec![(0u32, 0f32); fresh_start[n] as usize];
+        fill.clear();
+        fill.extend_from_slice(fresh_start);
+        fresh.clear();
+        fresh.resize(fresh_start[n] as usize, (0, 0.0));
         for (node, _, _, entries) in &results {
             for &(v, f) in entries {
                 fresh[fill[v as usize] as usize] = (*node as u32, f);
                 fill[v as usize] += 1;
             }
         }
+        let (dirty_mark, fresh_start, fresh) = (&*dirty_mark, &*fresh_start, &*fresh);
         // Rebuild the rows in parallel chunks: runs of clean rows are copied in bulk,
         // dirty rows merged from their kept entries and the fresh ones.
         const CHUNK: usize = 8192;
@@ -553,10 +639,12 @@ impl Weights {
                 (starts, nodes, phi, sums)
             })
             .collect();
-        let total: usize = parts.iter().map(|p| p.1.len()).sum();
-        let mut offsets = Vec::with_capacity(n + 1);
-        let mut nodes = Vec::with_capacity(total);
-        let mut phi = Vec::with_capacity(total);
+        // Assembled in the back buffers (kept from the last update, so their memory is
+        // mapped already), which then swap with the current rows.
+        let (offsets, nodes, phi) = back;
+        offsets.clear();
+        nodes.clear();
+        phi.clear();
         for (starts, part_nodes, part_phi, sums) in parts {
             let at = nodes.len() as u32;
             offsets.extend(starts.iter().map(|&s| s + at));
@@ -567,9 +655,10 @@ impl Weights {
             }
         }
         offsets.push(nodes.len() as u32);
-        self.offsets = offsets;
-        self.nodes = nodes;
-        self.phi = phi;
+        std::mem::swap(offsets, &mut self.offsets);
+        std::mem::swap(nodes, &mut self.nodes);
+        std::mem::swap(phi, &mut self.phi);
+        self.scratch = scratch;
         for (node, ball, _, _) in results {
             if let Some(ball) = ball {
                 self.balls[node] = ball;
