@@ -212,7 +212,9 @@ impl Partition {
             for e in graph.neighbors(v) {
                 let nd = d + f64::from(e.len);
                 let w = e.to as usize;
-                if less((nd, key), (self.dist[w], self.key_of(e.to))) {
+                let dw = self.dist[w];
+                // (The tie-break key is looked up only on a tie.)
+                if nd < dw || (nd == dw && key < self.key_of(e.to)) {
                     self.dist[w] = nd;
                     if let Some(changed) = changed.as_deref_mut() {
                         let old = self.owner[w];
