@@ -613,13 +613,14 @@ impl Rig {
                 })
             })
             .collect();
-        self.weights.renumber(&map, &old_vertex);
+        self.weights.renumber_fields(&map, &old_vertex);
         self.weights.update(
             &self.domain,
             &self.partition,
             &self.radii,
             &self.options.basis,
             &changes,
+            &map,
             &dirty,
         );
         self.update_timings.weights_ms = ms(clock);

@@ -221,39 +221,96 @@ fn support_entry(
     (phi > 0.0).then_some(phi)
 }
 
-/// The sparse weights of every sample.
+/// Rows per chunk of [`Rows`].
+const CHUNK: usize = 4096;
+
+/// Compressed rows of (node, φ) in chunks of [`CHUNK`] consecutive samples, each chunk
+/// with arrays of its own: an update rewrites only the chunks whose rows change.
 #[derive(Clone, Debug, Default)]
-pub(crate) struct Weights {
+struct Rows {
+    chunks: Vec<Chunk>,
+}
+
+/// The rows of one chunk: row `i` is `nodes[offsets[i]..offsets[i + 1]]` with `phi[…]`.
+#[derive(Clone, Debug, Default)]
+struct Chunk {
     offsets: Vec<u32>,
     nodes: Vec<u32>,
     phi: Vec<f32>,
+}
+
+impl Chunk {
+    fn new() -> Self {
+        Self {
+            offsets: vec![0],
+            nodes: Vec::new(),
+            phi: Vec::new(),
+        }
+    }
+
+    /// Appends a row.
+    fn push(&mut self, row: impl IntoIterator<Item = (u32, f32)>) {
+        for (k, f) in row {
+            self.nodes.push(k);
+            self.phi.push(f);
+        }
+        self.offsets.push(self.nodes.len() as u32);
+    }
+
+    fn row(&self, i: usize) -> (&[u32], &[f32]) {
+        let (a, b) = (self.offsets[i] as usize, self.offsets[i + 1] as usize);
+        (&self.nodes[a..b], &self.phi[a..b])
+    }
+}
+
+impl Rows {
+    fn row(&self, v: usize) -> (&[u32], &[f32]) {
+        self.chunks[v / CHUNK].row(v % CHUNK)
+    }
+
+    fn nonzeros(&self) -> usize {
+        self.chunks.iter().map(|c| c.nodes.len()).sum()
+    }
+
+    fn memory_bytes(&self) -> usize {
+        self.chunks
+            .iter()
+            .map(|c| c.offsets.len() * 4 + c.nodes.len() * 4 + c.phi.len() * 4)
+            .sum()
+    }
+}
+
+/// The sparse weights of every sample.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Weights {
+    rows: Rows,
     sums: Vec<f64>,
     /// Per node, its cached distance field.
     balls: Vec<Ball>,
     /// Fields of nodes removed since the last update, by sample (Algorithm 1 often puts
     /// a virtual handle back where one was removed), and fields searched ahead of it.
     spare: std::collections::HashMap<u32, Ball>,
-    /// Buffers of [`Weights::update`], kept between updates.
-    scratch: UpdateBuffers,
 }
 
-/// Buffers [`Weights::update`] reuses: allocating them anew each time costs more than
-/// filling them (fresh pages are mapped on first touch). A copy of the weights starts
-/// without them.
-#[derive(Debug, Default)]
-struct UpdateBuffers {
-    dirty_mark: Vec<bool>,
-    fresh_start: Vec<u32>,
-    fill: Vec<u32>,
-    fresh: Vec<(u32, f32)>,
-    /// Row arrays (offsets, nodes, φ) swapped with the current ones at each update.
-    back: (Vec<u32>, Vec<u32>, Vec<f32>),
-}
-
-impl Clone for UpdateBuffers {
-    fn clone(&self) -> Self {
-        Self::default()
+/// Entries `(sample, node, φ)` of the samples `lo..hi` bucketed by row (a counting
+/// sort that keeps their order within a row): row `v` gets
+/// `by_row[start[v - lo]..start[v - lo + 1]]`.
+fn bucket_rows(lo: usize, hi: usize, entries: Vec<(u32, u32, f32)>) -> (Vec<u32>, Vec<(u32, f32)>) {
+    let mut start = vec![0u32; hi - lo + 1];
+    for e in &entries {
+        start[e.0 as usize - lo + 1] += 1;
     }
+    for i in 0..hi - lo {
+        start[i + 1] += start[i];
+    }
+    let mut fill = start.clone();
+    let mut by_row = vec![(0u32, 0f32); entries.len()];
+    for (v, k, f) in entries {
+        let at = &mut fill[v as usize - lo];
+        by_row[*at as usize] = (k, f);
+        *at += 1;
+    }
+    (start, by_row)
 }
 
 /// A per-node change for [`Weights::update`]: the node, its radius before the change
@@ -281,38 +338,35 @@ impl Weights {
             .collect();
         let mut order: Vec<usize> = (0..partition.len()).collect();
         order.sort_unstable_by_key(|&k| partition.node_vertex[k]);
-        let mut counts = vec![0u32; n];
-        for s in &supports {
-            for &(v, _) in s {
-                counts[v as usize] += 1;
-            }
-        }
-        let mut offsets = Vec::with_capacity(n + 1);
-        let mut acc = 0u32;
-        for c in &counts {
-            offsets.push(acc);
-            acc += c;
-        }
-        offsets.push(acc);
-        let mut nodes = vec![NONE; acc as usize];
-        let mut phi = vec![0f32; acc as usize];
-        let mut fill: Vec<u32> = offsets[..n].to_vec();
+        // Every support's entries bucketed by chunk, nodes in sample order.
+        let mut by_chunk: Vec<Vec<(u32, u32, f32)>> = vec![Vec::new(); n.div_ceil(CHUNK)];
         for &k in &order {
             for &(v, f) in &supports[k] {
-                let at = fill[v as usize] as usize;
-                nodes[at] = k as u32;
-                phi[at] = f;
-                fill[v as usize] += 1;
+                by_chunk[v as usize / CHUNK].push((v, k as u32, f));
             }
         }
+        let chunks: Vec<Chunk> = by_chunk
+            .into_par_iter()
+            .enumerate()
+            .map(|(c, entries)| {
+                let (lo, hi) = (c * CHUNK, ((c + 1) * CHUNK).min(n));
+                let (start, by_row) = bucket_rows(lo, hi, entries);
+                let mut chunk = Chunk::new();
+                for i in 0..hi - lo {
+                    chunk.push(
+                        by_row[start[i] as usize..start[i + 1] as usize]
+                            .iter()
+                            .copied(),
+                    );
+                }
+                chunk
+            })
+            .collect();
         let mut w = Self {
-            offsets,
-            nodes,
-            phi,
+            rows: Rows { chunks },
             sums: Vec::new(),
             balls,
             spare: Default::default(),
-            scratch: UpdateBuffers::default(),
         };
         w.sums = (0..n).map(|v| w.row_sum(v)).collect();
         w
@@ -371,24 +425,16 @@ impl Weights {
                 fill[c as usize] += 1;
             }
         }
-        const CHUNK: usize = 16384;
-        /// One chunk of rows: lengths, nodes, φ and sums.
-        type Rows = (Vec<u32>, Vec<u32>, Vec<f32>, Vec<f64>);
-        let parts: Vec<Rows> = (0..n.div_ceil(CHUNK))
+        let parts: Vec<(Chunk, Vec<f64>)> = (0..n.div_ceil(CHUNK))
             .into_par_iter()
             .map(|chunk| {
                 let (lo, hi) = (chunk * CHUNK, ((chunk + 1) * CHUNK).min(n));
-                let (mut lens, mut nodes, mut phi, mut sums) = (
-                    Vec::with_capacity(hi - lo),
-                    Vec::new(),
-                    Vec::new(),
-                    Vec::with_capacity(hi - lo),
-                );
+                let mut rows = Chunk::new();
+                let mut sums = Vec::with_capacity(hi - lo);
                 for v in lo..hi {
                     let p = positions[v];
                     let (x, y) = grid.cell_of(p);
                     let c = y * grid.nx + x;
-                    let before = nodes.len();
                     let mut sum = 0.0;
                     for &k in &by_cell[cell_start[c] as usize..cell_start[c + 1] as usize] {
                         let source = partition.node_vertex[k as usize];
@@ -396,22 +442,19 @@ impl Weights {
                         if let Some(f) =
                             support_entry(basis, partition, source, v as u32, d, radii[k as usize])
                         {
-                            nodes.push(k);
-                            phi.push(f);
+                            rows.nodes.push(k);
+                            rows.phi.push(f);
                             sum += f64::from(f);
                         }
                     }
-                    lens.push((nodes.len() - before) as u32);
+                    rows.offsets.push(rows.nodes.len() as u32);
                     sums.push(sum);
                 }
-                (lens, nodes, phi, sums)
+                (rows, sums)
             })
             .collect();
-        let total: usize = parts.iter().map(|p| p.1.len()).sum();
         let mut w = Self {
-            offsets: Vec::with_capacity(n + 1),
-            nodes: Vec::with_capacity(total),
-            phi: Vec::with_capacity(total),
+            rows: Rows::default(),
             sums: Vec::with_capacity(n),
             balls: vec![
                 Ball {
@@ -421,25 +464,16 @@ impl Weights {
                 partition.len()
             ],
             spare: Default::default(),
-            scratch: UpdateBuffers::default(),
         };
-        let mut at = 0u32;
-        for (lens, nodes, phi, sums) in parts {
-            for len in lens {
-                w.offsets.push(at);
-                at += len;
-            }
-            w.nodes.extend_from_slice(&nodes);
-            w.phi.extend_from_slice(&phi);
+        for (rows, sums) in parts {
+            w.rows.chunks.push(rows);
             w.sums.extend_from_slice(&sums);
         }
-        w.offsets.push(at);
         w
     }
 
     fn row_sum(&self, v: usize) -> f64 {
-        let (a, b) = (self.offsets[v] as usize, self.offsets[v + 1] as usize);
-        self.phi[a..b].iter().map(|&f| f64::from(f)).sum()
+        self.rows.row(v).1.iter().map(|&f| f64::from(f)).sum()
     }
 
     /// Samples node `k` (on sample `source`) reached within `radius`, from its cached
@@ -474,14 +508,10 @@ impl Weights {
         }
     }
 
-    /// Renumbers nodes after a removal: `map[old] = new` (or `NONE` for a removed node);
-    /// `old_vertex` are the nodes' samples before it.
-    pub fn renumber(&mut self, map: &[u32], old_vertex: &[u32]) {
-        self.nodes.par_iter_mut().for_each(|k| {
-            if *k != NONE {
-                *k = map[*k as usize];
-            }
-        });
+    /// Renumbers the cached distance fields after a removal: `map[old] = new` (or
+    /// `NONE` for a removed node); `old_vertex` are the nodes' samples before it. The
+    /// rows are renumbered by the next [`Weights::update`], which gets the same map.
+    pub fn renumber_fields(&mut self, map: &[u32], old_vertex: &[u32]) {
         let balls = std::mem::take(&mut self.balls);
         self.balls = Vec::with_capacity(balls.len());
         for ((ball, &m), &v) in balls.into_iter().zip(map).zip(old_vertex) {
@@ -494,8 +524,11 @@ impl Weights {
     }
 
     /// Brings the weights up to date after the nodes in `changes` got new radii (or
-    /// appeared), and after nodes were removed (their entries already renumbered to
-    /// `NONE`; `dirty` lists the samples they reached). Rows of other samples are kept.
+    /// appeared), and after nodes were removed (`map[old] = new` numbers the nodes the
+    /// rows still hold, `NONE` for a removed one; `dirty` lists the samples removed
+    /// nodes reached). Only chunks with rows that change are rewritten; the others are
+    /// renumbered in place if nodes were removed.
+    #[allow(clippy::too_many_arguments)]
     pub fn update(
         &mut self,
         domain: &Domain,
@@ -503,6 +536,7 @@ impl Weights {
         radii: &[f64],
         basis: &Basis,
         changes: &[Change],
+        map: &[u32],
         dirty: &[u32],
     ) {
         let n = domain.len();
@@ -548,117 +582,90 @@ impl Weights {
         for c in changes {
             changed_node[c.node] = true;
         }
-        let mut scratch = std::mem::take(&mut self.scratch);
-        let UpdateBuffers {
-            dirty_mark,
-            fresh_start,
-            fill,
-            fresh,
-            back,
-        } = &mut scratch;
-        // Dirty samples: every sample a changed or removed node reaches or reached.
-        dirty_mark.clear();
-        dirty_mark.resize(n, false);
+        // Dirty samples (every sample a changed or removed node reaches or reached) as a
+        // bit set, and the changed nodes' new entries bucketed by chunk.
+        let mut dirty_bits = vec![0u64; n.div_ceil(64)];
         for &v in dirty.iter().chain(results.iter().flat_map(|r| r.2.iter())) {
-            dirty_mark[v as usize] = true;
+            dirty_bits[v as usize / 64] |= 1 << (v % 64);
         }
-        // The changed nodes' new entries, bucketed by sample (counting sort).
-        fresh_start.clear();
-        fresh_start.resize(n + 1, 0);
-        for (_, _, _, entries) in &results {
-            for &(v, _) in entries {
-                fresh_start[v as usize + 1] += 1;
-            }
-        }
-        for v in 0..n {
-            fresh_start[v + 1] += fresh_start[v];
-        }
-        fill.clear();
-        fill.extend_from_slice(fresh_start);
-        fresh.clear();
-        fresh.resize(fresh_start[n] as usize, (0, 0.0));
+        let mut fresh_by_chunk: Vec<Vec<(u32, u32, f32)>> = vec![Vec::new(); n.div_ceil(CHUNK)];
         for (node, _, _, entries) in &results {
             for &(v, f) in entries {
-                fresh[fill[v as usize] as usize] = (*node as u32, f);
-                fill[v as usize] += 1;
+                fresh_by_chunk[v as usize / CHUNK].push((v, *node as u32, f));
             }
         }
-        let (dirty_mark, fresh_start, fresh) = (&*dirty_mark, &*fresh_start, &*fresh);
-        // Rebuild the rows in parallel chunks: runs of clean rows are copied in bulk,
-        // dirty rows merged from their kept entries and the fresh ones.
-        const CHUNK: usize = 8192;
-        let this = &*self;
-        /// One chunk of rebuilt rows: row starts (relative to the chunk), nodes, φ, and
-        /// the new sums of dirty rows.
-        type Part = (Vec<u32>, Vec<u32>, Vec<f32>, Vec<(usize, f64)>);
-        let parts: Vec<Part> = (0..n.div_ceil(CHUNK))
-            .into_par_iter()
-            .map(|c| {
+        let renumbered = map.iter().enumerate().any(|(i, &m)| m != i as u32);
+        let dirty_bits = &dirty_bits;
+        let changed_node = &changed_node;
+        self.rows
+            .chunks
+            .par_iter_mut()
+            .zip(self.sums.par_chunks_mut(CHUNK))
+            .zip(fresh_by_chunk)
+            .enumerate()
+            .for_each(|(c, ((chunk, sums), fresh))| {
                 let (lo, hi) = (c * CHUNK, ((c + 1) * CHUNK).min(n));
-                let (a0, a1) = (this.offsets[lo] as usize, this.offsets[hi] as usize);
-                let mut starts = Vec::with_capacity(hi - lo);
-                let mut nodes = Vec::with_capacity(a1 - a0 + a1 / 16 - a0 / 16);
-                let mut phi = Vec::with_capacity(nodes.capacity());
-                let mut sums = Vec::new();
+                let is_dirty = |v: usize| dirty_bits[v / 64] >> (v % 64) & 1 == 1;
+                if !(lo..hi).step_by(64).any(|v| dirty_bits[v / 64] != 0) {
+                    if renumbered {
+                        for k in chunk.nodes.iter_mut() {
+                            *k = map[*k as usize];
+                        }
+                    }
+                    return;
+                }
+                let (start, by_row) = bucket_rows(lo, hi, fresh);
+                let mut rebuilt = Chunk::new();
+                rebuilt
+                    .nodes
+                    .reserve(chunk.nodes.len() + chunk.nodes.len() / 8);
+                rebuilt.phi.reserve(rebuilt.nodes.capacity());
                 let mut row: Vec<(u32, f32)> = Vec::new();
                 let mut v = lo;
                 while v < hi {
-                    if !dirty_mark[v] {
+                    if !is_dirty(v) {
+                        // A run of clean rows, copied in bulk.
                         let run = v;
-                        while v < hi && !dirty_mark[v] {
+                        while v < hi && !is_dirty(v) {
                             v += 1;
                         }
-                        let (a, b) = (this.offsets[run], this.offsets[v]);
-                        let base = nodes.len() as u32;
-                        starts.extend(this.offsets[run..v].iter().map(|&o| o - a + base));
-                        nodes.extend_from_slice(&this.nodes[a as usize..b as usize]);
-                        phi.extend_from_slice(&this.phi[a as usize..b as usize]);
+                        let (a, b) = (chunk.offsets[run - lo], chunk.offsets[v - lo]);
+                        let base = rebuilt.nodes.len() as u32;
+                        rebuilt.offsets.pop();
+                        rebuilt.offsets.extend(
+                            chunk.offsets[run - lo..=v - lo]
+                                .iter()
+                                .map(|&o| o - a + base),
+                        );
+                        let kept = &chunk.nodes[a as usize..b as usize];
+                        if renumbered {
+                            rebuilt.nodes.extend(kept.iter().map(|&k| map[k as usize]));
+                        } else {
+                            rebuilt.nodes.extend_from_slice(kept);
+                        }
+                        rebuilt
+                            .phi
+                            .extend_from_slice(&chunk.phi[a as usize..b as usize]);
                         continue;
                     }
-                    let (a, b) = (this.offsets[v] as usize, this.offsets[v + 1] as usize);
+                    let i = v - lo;
+                    let (nodes, phi) = chunk.row(i);
                     row.clear();
                     row.extend(
-                        (a..b)
-                            .map(|i| (this.nodes[i], this.phi[i]))
+                        nodes
+                            .iter()
+                            .map(|&k| map[k as usize])
+                            .zip(phi.iter().copied())
                             .filter(|&(k, _)| k != NONE && !changed_node[k as usize]),
                     );
-                    row.extend_from_slice(
-                        &fresh[fresh_start[v] as usize..fresh_start[v + 1] as usize],
-                    );
+                    row.extend_from_slice(&by_row[start[i] as usize..start[i + 1] as usize]);
                     row.sort_unstable_by_key(|&(k, _)| partition.node_vertex[k as usize]);
-                    starts.push(nodes.len() as u32);
-                    let mut sum = 0.0;
-                    for &(k, f) in &row {
-                        nodes.push(k);
-                        phi.push(f);
-                        sum += f64::from(f);
-                    }
-                    sums.push((v, sum));
+                    sums[i] = row.iter().map(|&(_, f)| f64::from(f)).sum();
+                    rebuilt.push(row.iter().copied());
                     v += 1;
                 }
-                (starts, nodes, phi, sums)
-            })
-            .collect();
-        // Assembled in the back buffers (kept from the last update, so their memory is
-        // mapped already), which then swap with the current rows.
-        let (offsets, nodes, phi) = back;
-        offsets.clear();
-        nodes.clear();
-        phi.clear();
-        for (starts, part_nodes, part_phi, sums) in parts {
-            let at = nodes.len() as u32;
-            offsets.extend(starts.iter().map(|&s| s + at));
-            nodes.extend_from_slice(&part_nodes);
-            phi.extend_from_slice(&part_phi);
-            for (v, s) in sums {
-                self.sums[v] = s;
-            }
-        }
-        offsets.push(nodes.len() as u32);
-        std::mem::swap(offsets, &mut self.offsets);
-        std::mem::swap(nodes, &mut self.nodes);
-        std::mem::swap(phi, &mut self.phi);
-        self.scratch = scratch;
+                *chunk = rebuilt;
+            });
         for (node, ball, _, _) in results {
             if let Some(ball) = ball {
                 self.balls[node] = ball;
@@ -673,22 +680,24 @@ impl Weights {
         v: usize,
         owner: &'a [u32],
     ) -> impl Iterator<Item = (usize, f64)> + 'a {
-        let (a, b) = (self.offsets[v] as usize, self.offsets[v + 1] as usize);
+        let (nodes, phi) = self.rows.row(v);
         let s = self.sums[v];
-        let fallback = (a == b && owner[v] != NONE).then_some((owner[v] as usize, 1.0));
-        (a..b)
-            .map(move |i| (self.nodes[i] as usize, f64::from(self.phi[i]) / s))
+        let fallback = (nodes.is_empty() && owner[v] != NONE).then_some((owner[v] as usize, 1.0));
+        nodes
+            .iter()
+            .zip(phi)
+            .map(move |(&k, &f)| (k as usize, f64::from(f) / s))
             .chain(fallback)
     }
 
     /// Number of stored non-zeros.
     pub fn nonzeros(&self) -> usize {
-        self.nodes.len()
+        self.rows.nonzeros()
     }
 
     /// Bytes used by the weights.
     pub fn memory_bytes(&self) -> usize {
-        self.nodes.len() * 4 + self.phi.len() * 4 + self.offsets.len() * 4 + self.sums.len() * 8
+        self.rows.memory_bytes() + self.sums.len() * 8
     }
 
     /// Linear blend of the node transforms at every sample: `out[v] = Σ w_k(v) A_k p_v`.
@@ -699,15 +708,16 @@ impl Weights {
         affines: &[DAffine2],
         out: &mut [DVec2],
     ) {
-        out.par_chunks_mut(8192)
+        out.par_chunks_mut(CHUNK)
+            .zip(&self.rows.chunks)
             .enumerate()
-            .for_each(|(chunk, out)| {
-                let start = chunk * 8192;
+            .for_each(|(c, (out, rows))| {
+                let start = c * CHUNK;
                 for (i, o) in out.iter_mut().enumerate() {
                     let v = start + i;
                     let p = positions[v];
-                    let (a, b) = (self.offsets[v] as usize, self.offsets[v + 1] as usize);
-                    if a == b {
+                    let (nodes, phi) = rows.row(i);
+                    if nodes.is_empty() {
                         *o = match owner[v] {
                             NONE => p,
                             k => affines[k as usize].transform_point2(p),
@@ -715,9 +725,8 @@ impl Weights {
                         continue;
                     }
                     let mut acc = DVec2::ZERO;
-                    for j in a..b {
-                        let t = &affines[self.nodes[j] as usize];
-                        acc += f64::from(self.phi[j]) * t.transform_point2(p);
+                    for (&k, &f) in nodes.iter().zip(phi) {
+                        acc += f64::from(f) * affines[k as usize].transform_point2(p);
                     }
                     *o = acc / self.sums[v];
                 }
