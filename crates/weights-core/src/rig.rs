@@ -549,8 +549,10 @@ impl Rig {
                 });
             };
             let clock = Instant::now();
+            if !doomed.is_empty() {
+                partition.remove_nodes(domain, &doomed);
+            }
             for &k in doomed.iter().rev() {
-                partition.remove_node(domain, k);
                 nodes.remove(k);
                 map[k] = NONE;
             }

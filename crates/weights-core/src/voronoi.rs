@@ -45,6 +45,15 @@ impl Entry {
     }
 }
 
+/// Keeps the items `i` of `list` with `map[i] != NONE`, in order.
+fn retain_kept<T>(list: &mut Vec<T>, map: &[u32]) {
+    let mut i = 0;
+    list.retain(|_| {
+        i += 1;
+        map[i - 1] != NONE
+    });
+}
+
 /// Radii of one cell.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct CellStats {
@@ -418,29 +427,47 @@ impl Partition {
 
     /// Removes node `k` (later nodes shift down by one), hands its samples to the
     /// remaining nodes, and returns the cells whose radii may have changed.
+    #[cfg(test)]
     pub fn remove_node(&mut self, domain: &Domain, k: usize) -> Vec<usize> {
-        let freed = std::mem::take(&mut self.members[k]);
+        self.remove_nodes(domain, &[k])
+    }
+
+    /// Removes the nodes `doomed` (distinct indices; the others keep their order),
+    /// hands their samples to the remaining nodes in one pass, and returns the cells
+    /// whose radii may have changed.
+    pub fn remove_nodes(&mut self, domain: &Domain, doomed: &[usize]) -> Vec<usize> {
+        let mut map = vec![0u32; self.node_vertex.len()];
+        for &k in doomed {
+            map[k] = NONE;
+        }
+        let mut next = 0;
+        for m in map.iter_mut().filter(|m| **m != NONE) {
+            *m = next;
+            next += 1;
+        }
+        let mut freed = Vec::new();
+        for &k in doomed {
+            freed.append(&mut self.members[k]);
+        }
         for &v in &freed {
             self.owner[v as usize] = NONE;
             self.dist[v as usize] = f64::INFINITY;
         }
-        self.members.remove(k);
-        self.node_vertex.remove(k);
-        self.stats.remove(k);
-        let k32 = k as u32;
-        for o in self.owner.iter_mut() {
-            if *o != NONE && *o > k32 {
-                *o -= 1;
-            }
+        retain_kept(&mut self.members, &map);
+        retain_kept(&mut self.node_vertex, &map);
+        retain_kept(&mut self.stats, &map);
+        for o in self.owner.iter_mut().filter(|o| **o != NONE) {
+            *o = map[*o as usize];
         }
         if domain.metric() == Metric::Intrinsic {
-            for v in self.frontier.remove(k) {
-                self.frontier_cell[v as usize] = NONE;
-            }
-            for c in self.frontier_cell.iter_mut() {
-                if *c != NONE && *c > k32 {
-                    *c -= 1;
+            for &k in doomed {
+                for &v in &self.frontier[k] {
+                    self.frontier_cell[v as usize] = NONE;
                 }
+            }
+            retain_kept(&mut self.frontier, &map);
+            for c in self.frontier_cell.iter_mut().filter(|c| **c != NONE) {
+                *c = map[*c as usize];
             }
         }
         let mut changed: Vec<(u32, u32)> = freed.iter().map(|&v| (v, NONE)).collect();
@@ -774,6 +801,11 @@ mod tests {
             p.remove_node(&d, 1);
             p.assert_matches_rebuild(&d);
             p.remove_node(&d, 3);
+            p.assert_matches_rebuild(&d);
+            // Several at once, adjacent cells among them.
+            p.add_node(&d, 401);
+            p.add_node(&d, 3);
+            p.remove_nodes(&d, &[0, 2, 5, 6]);
             p.assert_matches_rebuild(&d);
         }
     }
