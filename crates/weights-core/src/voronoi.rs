@@ -440,10 +440,8 @@ impl Partition {
         for &k in doomed {
             map[k] = NONE;
         }
-        let mut next = 0;
-        for m in map.iter_mut().filter(|m| **m != NONE) {
-            *m = next;
-            next += 1;
+        for (next, m) in map.iter_mut().filter(|m| **m != NONE).enumerate() {
+            *m = next as u32;
         }
         let mut freed = Vec::new();
         for &k in doomed {
