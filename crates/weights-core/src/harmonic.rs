@@ -41,14 +41,17 @@ pub(crate) fn dual_edges(domain: &Domain, partition: &Partition) -> Vec<(u32, u3
             Metric::Euclidean => {
                 let mut tied_with: std::collections::HashMap<u32, Vec<u32>> =
                     std::collections::HashMap::new();
+                let mut is_tied = vec![false; owner.len()];
                 for &(w, k) in &ties {
+                    is_tied[w as usize] = true;
                     tied_with.entry(w).or_default().push(k);
                 }
                 for t in domain.triangles() {
                     for (i, &w) in t.iter().enumerate() {
-                        let Some(nodes) = tied_with.get(&w) else {
+                        if !is_tied[w as usize] {
                             continue;
-                        };
+                        }
+                        let nodes = &tied_with[&w];
                         for &k in nodes {
                             around(k, t[(i + 1) % 3]);
                             around(k, t[(i + 2) % 3]);
