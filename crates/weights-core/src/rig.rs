@@ -8,7 +8,7 @@ use std::time::Instant;
 use glam::{DAffine2, DVec2};
 
 use crate::basis::Basis;
-use crate::domain::Domain;
+use crate::domain::{Domain, Metric};
 use crate::error::RigError;
 use crate::harmonic::{dual_edges, harmonic_coordinates};
 use crate::transform::Similarity;
@@ -513,6 +513,18 @@ impl Rig {
             .collect();
         self.update_timings.plan_ms += ms(clock);
         let old_vertex: Vec<u32> = self.nodes.iter().map(|n| n.vertex).collect();
+        // The node samples once the removals and the real nodes are in, and the new
+        // real nodes among them.
+        let settled: std::collections::HashSet<u32> = (0..self.nodes.len())
+            .filter(|k| doomed.binary_search(k).is_err())
+            .map(|k| self.nodes[k].vertex)
+            .chain(target_vertices.iter().copied())
+            .collect();
+        let arriving: Vec<u32> = target
+            .iter()
+            .map(|n| n.vertex)
+            .filter(|v| !present.contains(v))
+            .collect();
         // Each node's number before the removals, by sample (for its cached field).
         let cached: HashMap<u32, usize> = old_vertex
             .iter()
@@ -548,6 +560,21 @@ impl Rig {
                     searched.lock().expect("not poisoned").push((v, field));
                 });
             };
+            // A new real node's support is at most its distance to the nearest settled
+            // node: its field can be searched before the partition knows that distance.
+            let mut ahead = std::collections::HashSet::new();
+            for &q in &arriving {
+                if domain.metric() == Metric::Intrinsic {
+                    ahead.insert(q);
+                    let (searched, settled) = (&searched, &settled);
+                    scope.spawn(move |_| {
+                        let is_node = |v: u32| v != q && settled.contains(&v);
+                        if let Some(field) = Ball::to_nearest(domain, q, &is_node) {
+                            searched.lock().expect("not poisoned").push((q, field));
+                        }
+                    });
+                }
+            }
             let clock = Instant::now();
             if !doomed.is_empty() {
                 partition.remove_nodes(domain, &doomed);
@@ -578,7 +605,9 @@ impl Rig {
             for (k, n) in nodes.iter().enumerate() {
                 let radius = support_radius(&partition.stats[k], alpha);
                 let old = cached.get(&n.vertex).copied();
-                if old.is_none_or(|k| weights.field(k).radius() < radius) {
+                if !ahead.contains(&n.vertex)
+                    && old.is_none_or(|k| weights.field(k).radius() < radius)
+                {
                     search(n.vertex, radius, old);
                 }
             }

@@ -38,7 +38,7 @@ thread_local! {
 /// The samples within `radius` of node sample `source` (and the source itself), with
 /// their distances, in order of distance for the intrinsic metric.
 pub(crate) fn ball(domain: &Domain, source: u32, radius: f64) -> Vec<(u32, f64)> {
-    search(domain, source, radius, None)
+    search(domain, source, radius, None, None).0
 }
 
 /// [`ball`], continuing from `known`: every sample closer than `known_radius`, with its
@@ -46,12 +46,18 @@ pub(crate) fn ball(domain: &Domain, source: u32, radius: f64) -> Vec<(u32, f64)>
 /// back on the queue (the others have no neighbour outside it), and the distances found
 /// beyond are the ones a search from scratch finds: each is the same minimum over the
 /// same neighbours.
+///
+/// With `nearest`, the search stops at the nearest sample it accepts (other than the
+/// source) instead: at its distance times 1 + 10⁻⁶, beyond any f32 rounding of that
+/// distance, so that the field covers a support radius of at most that distance (any
+/// other node's). Returns the field and the radius it was searched to.
 fn search(
     domain: &Domain,
     source: u32,
-    radius: f64,
+    mut radius: f64,
     known: Option<(&[(u32, f64)], f64)>,
-) -> Vec<(u32, f64)> {
+    nearest: Option<&dyn Fn(u32) -> bool>,
+) -> (Vec<(u32, f64)>, f64) {
     let mut out = Vec::new();
     match domain.metric() {
         Metric::Intrinsic => SCRATCH.with(|scratch| {
@@ -90,8 +96,15 @@ fn search(
             }
             while let Some(entry) = heap.pop() {
                 let (d, v) = (entry.d(), entry.v());
-                if d > dist[v as usize] {
+                if d > dist[v as usize] || (d >= radius && v != source) {
                     continue;
+                }
+                if let Some(accept) = nearest
+                    && radius.is_infinite()
+                    && v != source
+                    && accept(v)
+                {
+                    radius = d * (1.0 + 1e-6);
                 }
                 if d >= known_radius && v != source || known.is_none() {
                     out.push((v, d));
@@ -136,7 +149,7 @@ fn search(
             }
         }
     }
-    out
+    (out, radius)
 }
 
 /// A node's distance field near it, kept so that a new support radius needs no new
@@ -160,6 +173,17 @@ impl Ball {
         }
     }
 
+    /// The field of a node on `source` searched to the nearest sample `is_node`
+    /// accepts: it covers any support radius the node can have while those samples
+    /// carry nodes. (Straight-line distance needs no search ahead: `None`.)
+    pub fn to_nearest(domain: &Domain, source: u32, is_node: &dyn Fn(u32) -> bool) -> Option<Self> {
+        if domain.metric() != Metric::Intrinsic {
+            return None;
+        }
+        let (entries, radius) = search(domain, source, f64::INFINITY, None, Some(is_node));
+        Some(Self { radius, entries })
+    }
+
     /// This field (of the node on `source`) searched on to `radius`.
     pub fn extend(&self, domain: &Domain, source: u32, radius: f64) -> Self {
         if self.radius < 0.0 || self.entries.is_empty() {
@@ -167,7 +191,14 @@ impl Ball {
         }
         Self {
             radius,
-            entries: search(domain, source, radius, Some((&self.entries, self.radius))),
+            entries: search(
+                domain,
+                source,
+                radius,
+                Some((&self.entries, self.radius)),
+                None,
+            )
+            .0,
         }
     }
 
@@ -758,5 +789,58 @@ impl Weights {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::domain::tests::grid_mesh;
+
+    #[test]
+    fn a_field_searched_to_the_nearest_node_covers_the_support_the_node_gets() {
+        // Jittered grid, intrinsic metric, a few nodes; a new node anywhere.
+        let (mut p, t) = grid_mesh(30, 20, 1.0);
+        let mut s = 5u64;
+        for q in p
+            .iter_mut()
+            .filter(|q| q.x > 0.0 && q.y > 0.0 && q.x < 30.0 && q.y < 20.0)
+        {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            q.x += ((s >> 33) as f64 / (1u64 << 31) as f64 - 0.5) * 0.4;
+        }
+        let d = Domain::new(p, t, Metric::Intrinsic).expect("valid");
+        let nodes = vec![40, 300, 555];
+        for q in [41u32, 200, 400, 620] {
+            let is_node = |v: u32| nodes.contains(&v);
+            let field = Ball::to_nearest(&d, q, &is_node).expect("intrinsic");
+            let mut part = Partition::new(&d, nodes.clone());
+            part.add_node(&d, q);
+            let r_h = part.stats[3].r_h;
+            assert!(field.radius() >= r_h, "{} < {r_h}", field.radius());
+            assert!(field.radius() <= r_h * (1.0 + 1e-5));
+            // The same samples and distances as a search to that radius.
+            let mut a = field.entries.clone();
+            let mut b = ball(&d, q, field.radius());
+            a.sort_by_key(|e| e.0);
+            b.sort_by_key(|e| e.0);
+            assert_eq!(a, b);
+        }
+    }
+
+    #[test]
+    fn a_field_searched_on_equals_one_searched_at_once() {
+        let (p, t) = grid_mesh(30, 20, 1.0);
+        let d = Domain::new(p, t, Metric::Intrinsic).expect("valid");
+        let near = Ball::compute(&d, 200, 3.5);
+        let far = near.extend(&d, 200, 9.25);
+        let mut a = far.entries.clone();
+        let mut b = ball(&d, 200, 9.25);
+        a.sort_by_key(|e| e.0);
+        b.sort_by_key(|e| e.0);
+        assert_eq!(a, b);
+        assert!(a.len() > near.entries.len());
     }
 }
