@@ -43,6 +43,7 @@ pub(crate) fn insert_virtual_handles(
         }
     }
     loop {
+        let round_start = added.len();
         let mut violators: Vec<(f64, usize)> = partition
             .stats
             .iter()
@@ -124,6 +125,12 @@ pub(crate) fn insert_virtual_handles(
                 inserted(partition, partition.len() - 1);
                 added.push(v);
             }
+        }
+        // Every round places a node (a violator's farthest sample always qualifies when
+        // nothing else went in); a round that placed none could only repeat itself.
+        if added.len() == round_start {
+            debug_assert!(false, "Algorithm 1 made no progress");
+            break;
         }
     }
     added

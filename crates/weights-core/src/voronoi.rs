@@ -85,6 +85,10 @@ pub(crate) struct Partition {
     /// The cell whose frontier list holds each sample (`NONE`: none), and where.
     frontier_cell: Vec<u32>,
     frontier_slot: Vec<u32>,
+    /// Intrinsic metric only: the farthest member of each cell and its distance (the
+    /// member part of r_d). Adding a node only takes samples from cells and removing
+    /// one only gives them, so this is rescanned only when a cell loses it.
+    far: Vec<(f64, u32)>,
     /// Euclidean metric only: the largest `dist` in each vertex-grid cell.
     bin_max: Vec<f64>,
     /// Radii of each cell.
@@ -118,6 +122,7 @@ impl Partition {
             frontier: Vec::new(),
             frontier_cell: Vec::new(),
             frontier_slot: Vec::new(),
+            far: Vec::new(),
             bin_max: Vec::new(),
             stats: Vec::new(),
         };
@@ -152,6 +157,13 @@ impl Partition {
     /// Radii r_d and r_h of every cell.
     pub fn decompose(&mut self, domain: &Domain) {
         use rayon::prelude::*;
+        if domain.metric() == Metric::Intrinsic {
+            let this = &*self;
+            self.far = (0..this.node_vertex.len())
+                .into_par_iter()
+                .map(|k| this.farthest(k))
+                .collect();
+        }
         let this = &*self;
         self.stats = (0..this.node_vertex.len())
             .into_par_iter()
@@ -258,7 +270,16 @@ impl Partition {
                 }
                 self.frontier.push(Vec::new());
                 self.propagate(domain, &mut heap, Some(&mut changed));
-                self.settle(domain, &changed)
+                let touched = self.settle(domain, &changed);
+                // Old cells only lost samples: their farthest member stands unless it
+                // was taken.
+                self.far.push(self.farthest(k));
+                for &j in touched.iter().filter(|&&j| j != k) {
+                    if self.owner[self.far[j].1 as usize] != j as u32 {
+                        self.far[j] = self.farthest(j);
+                    }
+                }
+                touched
             }
             Metric::Euclidean => self.add_node_euclidean(domain, v),
         };
@@ -464,6 +485,7 @@ impl Partition {
                 }
             }
             retain_kept(&mut self.frontier, &map);
+            retain_kept(&mut self.far, &map);
             for c in self.frontier_cell.iter_mut().filter(|c| **c != NONE) {
                 *c = map[*c as usize];
             }
@@ -487,6 +509,18 @@ impl Partition {
                     }
                 }
                 self.propagate(domain, &mut heap, Some(&mut changed));
+                // The cells only gained samples: their farthest member is the old one
+                // or a gained one.
+                for &(v, _) in &changed[freed.len()..] {
+                    let o = self.owner[v as usize];
+                    if o != NONE {
+                        let (r, f) = self.far[o as usize];
+                        let d = self.dist[v as usize];
+                        if d > r || (d == r && v < f) {
+                            self.far[o as usize] = (d, v);
+                        }
+                    }
+                }
                 touched.extend(self.settle(domain, &changed[freed.len()..]));
             }
             Metric::Euclidean => {
@@ -658,13 +692,17 @@ impl Partition {
         (r_d, farthest)
     }
 
-    /// r_d, the farthest sample and r_h of cell `k`, from scratch.
+    /// r_d, the farthest sample and r_h of cell `k` (from the kept farthest member with
+    /// the intrinsic metric, else from scratch).
     ///
     /// With the intrinsic metric, a sample of a neighbouring cell that this node reaches
     /// at exactly its distance (a tie the tie-break gave away) counts toward r_d too:
     /// cells are closed, so mirror-image nodes get mirror-image radii.
     fn cell_stats(&self, domain: &Domain, k: usize) -> CellStats {
-        let (mut r_d, mut farthest) = self.farthest(k);
+        let (mut r_d, mut farthest) = match domain.metric() {
+            Metric::Intrinsic => self.far[k],
+            Metric::Euclidean => self.farthest(k),
+        };
         let r_h = match domain.metric() {
             Metric::Intrinsic => {
                 let graph = domain.graph();
@@ -761,6 +799,10 @@ impl Partition {
                 }
             }
             assert_eq!(self.frontier_cell, fresh.frontier_cell);
+            assert_eq!(
+                self.far, fresh.far,
+                "farthest members differ from a rebuild"
+            );
         }
     }
 }
