@@ -18,10 +18,10 @@ use crate::domain::{Domain, Metric};
 use crate::voronoi::{Entry, NONE, Partition};
 
 /// Reusable buffers for bounded Dijkstra searches, one set per thread. `dist` is all
-/// infinite between searches (each search resets what it touched).
+/// infinite between searches (each search resets what it set: the samples it returns,
+/// and those it reached beyond a radius that shrank).
 struct Scratch {
     dist: Vec<f64>,
-    touched: Vec<u32>,
     heap: BinaryHeap<Entry>,
 }
 
@@ -29,7 +29,6 @@ thread_local! {
     static SCRATCH: std::cell::RefCell<Scratch> = const {
         std::cell::RefCell::new(Scratch {
             dist: Vec::new(),
-            touched: Vec::new(),
             heap: BinaryHeap::new(),
         })
     };
@@ -62,11 +61,7 @@ fn search(
     match domain.metric() {
         Metric::Intrinsic => SCRATCH.with(|scratch| {
             let mut scratch = scratch.borrow_mut();
-            let Scratch {
-                dist,
-                touched,
-                heap,
-            } = &mut *scratch;
+            let Scratch { dist, heap } = &mut *scratch;
             if dist.len() != domain.len() {
                 *dist = vec![f64::INFINITY; domain.len()];
             }
@@ -81,7 +76,6 @@ fn search(
                     let rim = r - 2.0 * graph.max_edge_length();
                     for &(v, d) in entries {
                         dist[v as usize] = d;
-                        touched.push(v);
                         if d >= rim {
                             heap.push(Entry::new(d, 0, v));
                         }
@@ -90,13 +84,17 @@ fn search(
                 }
                 None => {
                     dist[source as usize] = 0.0;
-                    touched.push(source);
                     heap.push(Entry::new(0.0, 0, source));
                 }
             }
             while let Some(entry) = heap.pop() {
                 let (d, v) = (entry.d(), entry.v());
-                if d > dist[v as usize] || (d >= radius && v != source) {
+                if d > dist[v as usize] {
+                    continue;
+                }
+                if d >= radius && v != source {
+                    // Reached before the radius shrank: not returned, so reset here.
+                    dist[v as usize] = f64::INFINITY;
                     continue;
                 }
                 if let Some(accept) = nearest
@@ -113,19 +111,15 @@ fn search(
                     let nd = d + f64::from(e.len);
                     let w = e.to as usize;
                     if nd < dist[w] && nd < radius {
-                        if dist[w].is_infinite() {
-                            touched.push(e.to);
-                        }
                         dist[w] = nd;
                         heap.push(Entry::new(nd, 0, e.to));
                     }
                 }
             }
             heap.clear();
-            for &v in touched.iter() {
+            for &(v, _) in &out {
                 dist[v as usize] = f64::INFINITY;
             }
-            touched.clear();
         }),
         Metric::Euclidean => {
             let grid = domain.vertex_grid();
