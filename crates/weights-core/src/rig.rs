@@ -186,6 +186,36 @@ impl BuildTimings {
     }
 }
 
+/// The group (real handle, or after them the fixed border) whose transform node `n`
+/// takes: `None` for a virtual handle.
+fn group_of(n: &Node, handle_count: usize) -> Option<usize> {
+    match n.kind {
+        NodeKind::Point { handle } | NodeKind::BarSample { handle, .. } => Some(handle),
+        NodeKind::Boundary => Some(handle_count),
+        NodeKind::Virtual => None,
+    }
+}
+
+/// Harmonic coordinates of the virtual nodes over `groups` groups, on the dual graph of
+/// `partition`.
+fn harmonic_of(
+    domain: &Domain,
+    partition: &Partition,
+    nodes: &[Node],
+    handle_count: usize,
+    groups: usize,
+) -> Vec<Option<Vec<f64>>> {
+    let edges = dual_edges(domain, partition);
+    let node_group: Vec<Option<usize>> = nodes.iter().map(|n| group_of(n, handle_count)).collect();
+    harmonic_coordinates(
+        domain.positions(),
+        &partition.node_vertex,
+        &node_group,
+        groups,
+        &edges,
+    )
+}
+
 /// Sizes of a rig.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct RigStats {
@@ -395,11 +425,11 @@ impl Rig {
         let target = real_nodes(&self.domain, &handles, &self.options, self.resolution)?;
         self.update_timings = UpdateTimings::default();
         self.update_timings.plan_ms = ms(clock);
-        self.apply(target);
         self.handles = handles;
+        self.apply(target);
         let clock = Instant::now();
-        self.update_transforms();
-        self.update_timings.transforms_ms = ms(clock);
+        self.update_affines();
+        self.update_timings.transforms_ms += ms(clock);
         Ok(())
     }
 
@@ -645,32 +675,58 @@ impl Rig {
             })
             .collect();
         self.weights.renumber_fields(&map, &old_vertex);
-        self.weights.update(
-            &self.domain,
-            &self.partition,
-            &self.radii,
-            &self.options.basis,
-            &changes,
-            &map,
-            &dirty,
+        // The weights and the virtual handles' harmonic coordinates depend on the new
+        // partition, not on each other: one core each.
+        let Self {
+            domain,
+            options,
+            handles,
+            nodes,
+            partition,
+            radii,
+            weights,
+            ..
+        } = &mut *self;
+        let ((), (harmonic, transforms_ms)) = rayon::join(
+            || {
+                weights.update(
+                    domain,
+                    partition,
+                    radii,
+                    &options.basis,
+                    &changes,
+                    &map,
+                    &dirty,
+                )
+            },
+            || {
+                let clock = Instant::now();
+                let groups = handles.len() + usize::from(options.fixed_boundary);
+                let harmonic = harmonic_of(domain, partition, nodes, handles.len(), groups);
+                (harmonic, ms(clock))
+            },
         );
+        self.harmonic = harmonic;
         self.update_timings.weights_ms = ms(clock);
+        self.update_timings.transforms_ms = transforms_ms;
     }
 
     /// Recomputes the dual graph, the virtual handles' harmonic coordinates and all
     /// node transforms.
     fn update_transforms(&mut self) {
-        let edges = dual_edges(&self.domain, &self.partition);
-        let groups = self.group_count();
-        let node_group: Vec<Option<usize>> = self.nodes.iter().map(|n| self.group_of(n)).collect();
-        self.harmonic = harmonic_coordinates(
-            self.domain.positions(),
-            &self.partition.node_vertex,
-            &node_group,
-            groups,
-            &edges,
-        );
+        self.harmonic = self.harmonic_coordinates_now();
         self.update_affines();
+    }
+
+    /// The virtual handles' harmonic coordinates on the current dual graph.
+    fn harmonic_coordinates_now(&self) -> Vec<Option<Vec<f64>>> {
+        harmonic_of(
+            &self.domain,
+            &self.partition,
+            &self.nodes,
+            self.handles.len(),
+            self.group_count(),
+        )
     }
 
     fn group_count(&self) -> usize {
@@ -678,11 +734,7 @@ impl Rig {
     }
 
     fn group_of(&self, n: &Node) -> Option<usize> {
-        match n.kind {
-            NodeKind::Point { handle } | NodeKind::BarSample { handle, .. } => Some(handle),
-            NodeKind::Boundary => Some(self.handles.len()),
-            NodeKind::Virtual => None,
-        }
+        group_of(n, self.handles.len())
     }
 
     /// Node transforms from the handles' poses (virtual ones blended harmonically).
