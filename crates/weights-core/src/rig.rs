@@ -555,6 +555,21 @@ impl Rig {
             .map(|n| n.vertex)
             .filter(|v| !present.contains(v))
             .collect();
+        // Surviving nodes whose nearest node may be a removed one (no closer in a
+        // straight line than their r_h): their supports may grow.
+        let leaving: Vec<DVec2> = doomed
+            .iter()
+            .map(|&k| positions[self.nodes[k].vertex as usize])
+            .collect();
+        let growing: Vec<(u32, usize)> = (0..self.nodes.len())
+            .filter(|k| doomed.binary_search(k).is_err())
+            .filter(|&k| {
+                let p = positions[self.nodes[k].vertex as usize];
+                let r_h = self.partition.stats[k].r_h;
+                leaving.iter().any(|q| (*q - p).length() <= r_h)
+            })
+            .map(|k| (self.nodes[k].vertex, k))
+            .collect();
         // Each node's number before the removals, by sample (for its cached field).
         let cached: HashMap<u32, usize> = old_vertex
             .iter()
@@ -590,16 +605,29 @@ impl Rig {
                     searched.lock().expect("not poisoned").push((v, field));
                 });
             };
-            // A new real node's support is at most its distance to the nearest settled
-            // node: its field can be searched before the partition knows that distance.
+            // A node's support is at most its distance to the nearest settled node:
+            // the fields of new real nodes, and of nodes whose nearest node may be
+            // leaving, can be searched that far before the partition knows it.
             let mut ahead = std::collections::HashSet::new();
-            for &q in &arriving {
-                if domain.metric() == Metric::Intrinsic {
+            if domain.metric() == Metric::Intrinsic {
+                for &q in &arriving {
                     ahead.insert(q);
                     let (searched, settled) = (&searched, &settled);
                     scope.spawn(move |_| {
                         let is_node = |v: u32| v != q && settled.contains(&v);
                         if let Some(field) = Ball::to_nearest(domain, q, &is_node) {
+                            searched.lock().expect("not poisoned").push((q, field));
+                        }
+                    });
+                }
+                for &(q, old) in &growing {
+                    ahead.insert(q);
+                    let (searched, settled) = (&searched, &settled);
+                    scope.spawn(move |_| {
+                        let is_node = |v: u32| v != q && settled.contains(&v);
+                        if let Some(field) =
+                            weights.field(old).extend_to_nearest(domain, q, &is_node)
+                        {
                             searched.lock().expect("not poisoned").push((q, field));
                         }
                     });

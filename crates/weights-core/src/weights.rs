@@ -71,6 +71,19 @@ fn search(
             match known {
                 Some((entries, r)) => {
                     known_radius = r;
+                    if let Some(accept) = nearest {
+                        // The nearest accepted sample may lie inside the known ball.
+                        let inside = entries
+                            .iter()
+                            .filter(|&&(v, _)| v != source && accept(v))
+                            .map(|&(_, d)| d)
+                            .fold(f64::INFINITY, f64::min);
+                        radius = inside * (1.0 + 1e-6);
+                        if radius <= r {
+                            // Reached already: nothing to search.
+                            return;
+                        }
+                    }
                     // A known sample with a neighbour beyond the known ball is at most
                     // one edge inside its rim.
                     let rim = r - 2.0 * graph.max_edge_length();
@@ -176,6 +189,23 @@ impl Ball {
         }
         let (entries, radius) = search(domain, source, f64::INFINITY, None, Some(is_node));
         Some(Self { radius, entries })
+    }
+
+    /// This field (of the node on `source`) searched on to the nearest sample `is_node`
+    /// accepts, if that lies beyond it: `None` when the field reaches that far already
+    /// (or distances are straight-line).
+    pub fn extend_to_nearest(
+        &self,
+        domain: &Domain,
+        source: u32,
+        is_node: &dyn Fn(u32) -> bool,
+    ) -> Option<Self> {
+        if domain.metric() != Metric::Intrinsic || self.radius < 0.0 || self.entries.is_empty() {
+            return None;
+        }
+        let known = Some((self.entries.as_slice(), self.radius));
+        let (entries, radius) = search(domain, source, f64::INFINITY, known, Some(is_node));
+        (radius > self.radius).then_some(Self { radius, entries })
     }
 
     /// This field (of the node on `source`) searched on to `radius`.
@@ -822,6 +852,26 @@ mod tests {
             b.sort_by_key(|e| e.0);
             assert_eq!(a, b);
         }
+    }
+
+    #[test]
+    fn a_field_searched_on_to_the_nearest_node_covers_it() {
+        let (p, t) = grid_mesh(30, 20, 1.0);
+        let d = Domain::new(p, t, Metric::Intrinsic).expect("valid");
+        let nodes = [205u32, 500];
+        let is_node = |v: u32| nodes.contains(&v);
+        // Node 200 is 5 edges from node 205: a field of radius 3.5 must grow to 5.
+        let near = Ball::compute(&d, 200, 3.5);
+        let grown = near.extend_to_nearest(&d, 200, &is_node).expect("grows");
+        assert!(grown.radius() >= 5.0 && grown.radius() <= 5.0 * (1.0 + 1e-5));
+        let mut a = grown.entries.clone();
+        let mut b = ball(&d, 200, grown.radius());
+        a.sort_by_key(|e| e.0);
+        b.sort_by_key(|e| e.0);
+        assert_eq!(a, b);
+        // A field that reaches the nearest node already needs nothing more.
+        let wide = Ball::compute(&d, 200, 6.0);
+        assert!(wide.extend_to_nearest(&d, 200, &is_node).is_none());
     }
 
     #[test]
