@@ -54,6 +54,57 @@ fn retain_kept<T>(list: &mut Vec<T>, map: &[u32]) {
     });
 }
 
+/// One list of samples per cell, with each listed sample's position in its list, so
+/// that a sample moves between lists in constant time. Which list holds a sample is
+/// kept by the caller (the owner for members, `frontier_cell` for frontiers).
+#[derive(Clone, Debug, Default)]
+struct CellLists {
+    lists: Vec<Vec<u32>>,
+    slot: Vec<u32>,
+}
+
+impl CellLists {
+    fn new(cells: usize, samples: usize) -> Self {
+        Self {
+            lists: vec![Vec::new(); cells],
+            slot: vec![0; samples],
+        }
+    }
+
+    fn add_cell(&mut self) {
+        self.lists.push(Vec::new());
+    }
+
+    fn push(&mut self, cell: u32, v: u32) {
+        let list = &mut self.lists[cell as usize];
+        self.slot[v as usize] = list.len() as u32;
+        list.push(v);
+    }
+
+    /// Moves sample `v` from list `from` to list `to` (either may be `NONE`: none).
+    fn relocate(&mut self, v: u32, from: u32, to: u32) {
+        if from != NONE {
+            let list = &mut self.lists[from as usize];
+            let at = self.slot[v as usize] as usize;
+            list.swap_remove(at);
+            if let Some(&moved) = list.get(at) {
+                self.slot[moved as usize] = at as u32;
+            }
+        }
+        if to != NONE {
+            self.push(to, v);
+        }
+    }
+}
+
+impl std::ops::Index<usize> for CellLists {
+    type Output = [u32];
+
+    fn index(&self, cell: usize) -> &[u32] {
+        &self.lists[cell]
+    }
+}
+
 /// Radii of one cell.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct CellStats {
@@ -75,16 +126,13 @@ pub(crate) struct Partition {
     /// Distance from each sample to its owning node.
     pub dist: Vec<f64>,
     /// Samples of each cell (unordered).
-    members: Vec<Vec<u32>>,
-    /// Position of each sample in its owner's member list.
-    slot: Vec<u32>,
+    members: CellLists,
     /// Intrinsic metric only: the samples of each cell with a graph neighbour in another
     /// cell. Every boundary edge of a cell starts at one of them, so r_h, the closed-cell
     /// ties and the dual graph need only these (a few hundred of a cell's thousands).
-    frontier: Vec<Vec<u32>>,
-    /// The cell whose frontier list holds each sample (`NONE`: none), and where.
+    frontier: CellLists,
+    /// The cell whose frontier list holds each sample (`NONE`: none).
     frontier_cell: Vec<u32>,
-    frontier_slot: Vec<u32>,
     /// Intrinsic metric only: the farthest member of each cell and its distance (the
     /// member part of r_d). Adding a node only takes samples from cells and removing
     /// one only gives them, so this is rescanned only when a cell loses it.
@@ -117,11 +165,9 @@ impl Partition {
             node_vertex: Vec::new(),
             owner: vec![NONE; n],
             dist: vec![f64::INFINITY; n],
-            members: Vec::new(),
-            slot: vec![0; n],
-            frontier: Vec::new(),
+            members: CellLists::default(),
+            frontier: CellLists::default(),
             frontier_cell: Vec::new(),
-            frontier_slot: Vec::new(),
             far: Vec::new(),
             bin_max: Vec::new(),
             stats: Vec::new(),
@@ -129,7 +175,7 @@ impl Partition {
         match domain.metric() {
             Metric::Intrinsic => {
                 p.node_vertex = node_vertex;
-                p.members = vec![Vec::new(); p.node_vertex.len()];
+                p.members = CellLists::new(p.node_vertex.len(), n);
                 let mut heap = BinaryHeap::new();
                 for (k, &v) in p.node_vertex.iter().enumerate() {
                     let entry = Entry::new(0.0, v, v);
@@ -143,8 +189,7 @@ impl Partition {
                 for v in 0..n {
                     let o = p.owner[v];
                     if o != NONE {
-                        p.slot[v] = p.members[o as usize].len() as u32;
-                        p.members[o as usize].push(v as u32);
+                        p.members.push(o, v as u32);
                     }
                 }
                 p.build_frontier(domain);
@@ -198,19 +243,8 @@ impl Partition {
         if old == k {
             return;
         }
-        if old != NONE {
-            let list = &mut self.members[old as usize];
-            let at = self.slot[v as usize] as usize;
-            list.swap_remove(at);
-            if let Some(&moved) = list.get(at) {
-                self.slot[moved as usize] = at as u32;
-            }
-        }
+        self.members.relocate(v, old, k);
         self.owner[v as usize] = k;
-        if k != NONE {
-            self.slot[v as usize] = self.members[k as usize].len() as u32;
-            self.members[k as usize].push(v);
-        }
     }
 
     /// Multi-source Dijkstra from the entries in `heap`, claiming samples for the
@@ -259,7 +293,7 @@ impl Partition {
         let mut touched = match domain.metric() {
             Metric::Intrinsic => {
                 self.node_vertex.push(v);
-                self.members.push(Vec::new());
+                self.members.add_cell();
                 let mut changed = Vec::new();
                 let mut heap = BinaryHeap::new();
                 if less((0.0, v), (self.dist[v as usize], self.key_of(v))) {
@@ -268,7 +302,7 @@ impl Partition {
                     self.set_owner(v, k as u32);
                     heap.push(Entry::new(0.0, v, v));
                 }
-                self.frontier.push(Vec::new());
+                self.frontier.add_cell();
                 self.propagate(domain, &mut heap, Some(&mut changed));
                 let touched = self.settle(domain, &changed);
                 // Old cells only lost samples: their farthest member stands unless it
@@ -359,13 +393,12 @@ impl Partition {
                 (best.0, best.2)
             })
             .collect();
-        self.members = vec![Vec::new(); node_vertex.len()];
+        self.members = CellLists::new(node_vertex.len(), n);
         for (v, &(d, k)) in nearest.iter().enumerate() {
             self.dist[v] = d;
             self.owner[v] = k;
             if k != NONE {
-                self.slot[v] = self.members[k as usize].len() as u32;
-                self.members[k as usize].push(v as u32);
+                self.members.push(k, v as u32);
             }
         }
         self.node_vertex = node_vertex;
@@ -389,7 +422,7 @@ impl Partition {
     fn add_node_euclidean(&mut self, domain: &Domain, v: u32) -> Vec<usize> {
         let k = self.node_vertex.len() as u32;
         self.node_vertex.push(v);
-        self.members.push(Vec::new());
+        self.members.add_cell();
         let grid = domain.vertex_grid();
         let p = domain.positions()[v as usize];
         let diagonal = grid.cell_size() * std::f64::consts::SQRT_2;
@@ -466,13 +499,13 @@ impl Partition {
         }
         let mut freed = Vec::new();
         for &k in doomed {
-            freed.append(&mut self.members[k]);
+            freed.append(&mut self.members.lists[k]);
         }
         for &v in &freed {
             self.owner[v as usize] = NONE;
             self.dist[v as usize] = f64::INFINITY;
         }
-        retain_kept(&mut self.members, &map);
+        retain_kept(&mut self.members.lists, &map);
         retain_kept(&mut self.node_vertex, &map);
         retain_kept(&mut self.stats, &map);
         for o in self.owner.iter_mut().filter(|o| **o != NONE) {
@@ -484,7 +517,7 @@ impl Partition {
                     self.frontier_cell[v as usize] = NONE;
                 }
             }
-            retain_kept(&mut self.frontier, &map);
+            retain_kept(&mut self.frontier.lists, &map);
             retain_kept(&mut self.far, &map);
             for c in self.frontier_cell.iter_mut().filter(|c| **c != NONE) {
                 *c = map[*c as usize];
@@ -583,14 +616,12 @@ impl Partition {
             .into_par_iter()
             .map(|v| self.on_frontier(graph, v))
             .collect();
-        self.frontier = vec![Vec::new(); self.node_vertex.len()];
+        self.frontier = CellLists::new(self.node_vertex.len(), n);
         self.frontier_cell = vec![NONE; n];
-        self.frontier_slot = vec![0; n];
         for (v, _) in flags.iter().enumerate().filter(|(_, f)| **f) {
             let o = self.owner[v];
             self.frontier_cell[v] = o;
-            self.frontier_slot[v] = self.frontier[o as usize].len() as u32;
-            self.frontier[o as usize].push(v as u32);
+            self.frontier.push(o, v as u32);
         }
     }
 
@@ -646,18 +677,7 @@ impl Partition {
         if current == cell {
             return;
         }
-        if current != NONE {
-            let list = &mut self.frontier[current as usize];
-            let at = self.frontier_slot[v as usize] as usize;
-            list.swap_remove(at);
-            if let Some(&moved) = list.get(at) {
-                self.frontier_slot[moved as usize] = at as u32;
-            }
-        }
-        if cell != NONE {
-            self.frontier_slot[v as usize] = self.frontier[cell as usize].len() as u32;
-            self.frontier[cell as usize].push(v);
-        }
+        self.frontier.relocate(v, current, cell);
         self.frontier_cell[v as usize] = cell;
     }
 
@@ -780,22 +800,22 @@ impl Partition {
         assert_eq!(self.dist, fresh.dist, "distances differ from a rebuild");
         assert_eq!(self.stats, fresh.stats, "cell radii differ from a rebuild");
         for k in 0..self.len() {
-            let mut a = self.members[k].clone();
-            let mut b = fresh.members[k].clone();
+            let mut a = self.members[k].to_vec();
+            let mut b = fresh.members[k].to_vec();
             a.sort_unstable();
             b.sort_unstable();
             assert_eq!(a, b);
         }
         if domain.metric() == Metric::Intrinsic {
             for k in 0..self.len() {
-                let mut a = self.frontier[k].clone();
-                let mut b = fresh.frontier[k].clone();
+                let mut a = self.frontier[k].to_vec();
+                let mut b = fresh.frontier[k].to_vec();
                 a.sort_unstable();
                 b.sort_unstable();
                 assert_eq!(a, b, "frontier of cell {k}");
                 for (i, &v) in self.frontier[k].iter().enumerate() {
                     assert_eq!(self.frontier_cell[v as usize], k as u32);
-                    assert_eq!(self.frontier_slot[v as usize], i as u32);
+                    assert_eq!(self.frontier.slot[v as usize], i as u32);
                 }
             }
             assert_eq!(self.frontier_cell, fresh.frontier_cell);
