@@ -594,15 +594,14 @@ impl Rig {
         let searched = std::sync::Mutex::new(Vec::new());
         let mut weights_clock = Instant::now();
         rayon::scope(|scope| {
+            let searched = &searched;
             // Searched on from the cached field, if there is one.
             let search = |v: u32, radius: f64, cached: Option<usize>| {
-                let searched = &searched;
-                scope.spawn(move |_| {
-                    let field = match cached {
+                search_aside(scope, searched, v, move || {
+                    Some(match cached {
                         Some(k) => weights.field(k).extend(domain, v, radius),
                         None => Ball::compute(domain, v, radius),
-                    };
-                    searched.lock().expect("not poisoned").push((v, field));
+                    })
                 });
             };
             // A node's support is at most its distance to the nearest settled node:
@@ -610,26 +609,18 @@ impl Rig {
             // leaving, can be searched that far before the partition knows it.
             let mut ahead = std::collections::HashSet::new();
             if domain.metric() == Metric::Intrinsic {
+                let settled = &settled;
                 for &q in &arriving {
                     ahead.insert(q);
-                    let (searched, settled) = (&searched, &settled);
-                    scope.spawn(move |_| {
-                        let is_node = |v: u32| v != q && settled.contains(&v);
-                        if let Some(field) = Ball::to_nearest(domain, q, &is_node) {
-                            searched.lock().expect("not poisoned").push((q, field));
-                        }
+                    search_aside(scope, searched, q, move || {
+                        Ball::to_nearest(domain, q, &|v| v != q && settled.contains(&v))
                     });
                 }
                 for &(q, old) in &growing {
                     ahead.insert(q);
-                    let (searched, settled) = (&searched, &settled);
-                    scope.spawn(move |_| {
+                    search_aside(scope, searched, q, move || {
                         let is_node = |v: u32| v != q && settled.contains(&v);
-                        if let Some(field) =
-                            weights.field(old).extend_to_nearest(domain, q, &is_node)
-                        {
-                            searched.lock().expect("not poisoned").push((q, field));
-                        }
+                        weights.field(old).extend_to_nearest(domain, q, &is_node)
                     });
                 }
             }
@@ -1000,6 +991,21 @@ fn support_radii(partition: &Partition, alpha: f64) -> Vec<f64> {
         .iter()
         .map(|s| support_radius(s, alpha))
         .collect()
+}
+
+/// Runs `search` (the distance field of the node on sample `v`) on another core of
+/// `scope`, adding what it finds to `found`.
+fn search_aside<'s>(
+    scope: &rayon::Scope<'s>,
+    found: &'s std::sync::Mutex<Vec<(u32, Ball)>>,
+    v: u32,
+    search: impl FnOnce() -> Option<Ball> + Send + 's,
+) {
+    scope.spawn(move |_| {
+        if let Some(field) = search() {
+            found.lock().expect("not poisoned").push((v, field));
+        }
+    });
 }
 
 /// The support radius of a cell with radii `s`: (1 − α)·r_d + α·r_h.

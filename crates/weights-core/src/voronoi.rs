@@ -2,6 +2,10 @@
 //! handle node), kept up to date when nodes are added or removed, and the per-cell
 //! radii r_d (farthest sample of the cell) and r_h (nearest other node).
 //!
+//! With the intrinsic metric each cell also keeps its frontier (its samples with a
+//! graph neighbour in another cell, which every boundary edge starts from) and its
+//! farthest member, so that a change re-reads a few hundred samples per touched cell.
+//!
 //! Ties between nodes at equal distance go to the node on the lower sample index, so
 //! the partition depends on the set of nodes, not on the order they were added in.
 

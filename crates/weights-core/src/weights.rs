@@ -1,8 +1,9 @@
 //! Sparse per-sample weights: for each sample the nodes whose support reaches it with
 //! their unnormalised basis values φ(d/r), and the sum that normalises them.
 //!
-//! Storage is compressed rows of (node: u32, φ: f32) — 8 bytes per non-zero — plus one
-//! f64 sum per sample. Normalising in f64 keeps Σw = 1 to rounding, whatever the
+//! Storage is compressed rows of (node: u32, φ: f32) — 8 bytes per non-zero — in chunks
+//! of 4096 samples (an update rewrites only the chunks it touches), plus one f64 sum per
+//! sample. Normalising in f64 keeps Σw = 1 to rounding, whatever the
 //! precision of φ. Rows are ordered by the node's sample index, so a row (and its sum)
 //! does not depend on how nodes are numbered. A sample that no support reaches (only
 //! possible exactly on a support boundary) has an empty row and takes its own cell's
