@@ -558,9 +558,15 @@ impl Weights {
     /// uses them where its cached ones fall short.
     pub fn offer(&mut self, fields: Vec<(u32, Ball)>) {
         for (v, field) in fields {
-            if self.spare.get(&v).is_none_or(|b| b.radius < field.radius) {
-                self.spare.insert(v, field);
-            }
+            self.keep_spare(v, field);
+        }
+    }
+
+    /// Keeps `field` (of the node on sample `v`) for the next update, unless a wider
+    /// one is kept already.
+    fn keep_spare(&mut self, v: u32, field: Ball) {
+        if self.spare.get(&v).is_none_or(|b| b.radius < field.radius) {
+            self.spare.insert(v, field);
         }
     }
 
@@ -574,7 +580,7 @@ impl Weights {
             if m != NONE {
                 self.balls.push(ball);
             } else if ball.radius >= 0.0 {
-                self.spare.insert(v, ball);
+                self.keep_spare(v, ball);
             }
         }
     }
