@@ -625,9 +625,6 @@ impl Rig {
                 }
             }
             let clock = Instant::now();
-            if !doomed.is_empty() {
-                partition.remove_nodes(domain, &doomed);
-            }
             for &k in doomed.iter().rev() {
                 nodes.remove(k);
                 map[k] = NONE;
@@ -635,22 +632,25 @@ impl Rig {
             for (next, m) in map.iter_mut().filter(|m| **m != NONE).enumerate() {
                 *m = next as u32;
             }
-            // Add the new real nodes, then give every real node its (possibly
-            // renumbered) kind from the target.
+            // Give every surviving real node its (possibly renumbered) kind from the
+            // target, and swap the doomed nodes for the new real ones in one pass.
             let present: HashMap<u32, usize> = nodes
                 .iter()
                 .enumerate()
                 .map(|(k, n)| (n.vertex, k))
                 .collect();
+            let mut joining = Vec::new();
             for n in &target {
                 match present.get(&n.vertex) {
                     Some(&k) => nodes[k].kind = n.kind,
-                    None => {
-                        partition.add_node(domain, n.vertex);
-                        nodes.push(*n);
-                    }
+                    None => joining.push(*n),
                 }
             }
+            let joining_vertices: Vec<u32> = joining.iter().map(|n| n.vertex).collect();
+            if !doomed.is_empty() || !joining.is_empty() {
+                partition.replace_nodes(domain, &doomed, &joining_vertices);
+            }
+            nodes.extend(joining);
             for (k, n) in nodes.iter().enumerate() {
                 let radius = support_radius(&partition.stats[k], alpha);
                 let old = cached.get(&n.vertex).copied();

@@ -293,66 +293,103 @@ impl Partition {
     /// Adds a node on sample `v` (which must not carry one) and returns the indices of
     /// the cells whose radii may have changed (the new one included).
     pub fn add_node(&mut self, domain: &Domain, v: u32) -> Vec<usize> {
-        let k = self.node_vertex.len();
-        let mut touched = match domain.metric() {
-            Metric::Intrinsic => {
-                self.node_vertex.push(v);
-                self.members.add_cell();
-                let mut changed = Vec::new();
-                let mut heap = BinaryHeap::new();
-                if less((0.0, v), (self.dist[v as usize], self.key_of(v))) {
-                    changed.push((v, self.owner[v as usize]));
-                    self.dist[v as usize] = 0.0;
-                    self.set_owner(v, k as u32);
-                    heap.push(Entry::new(0.0, v, v));
-                }
-                self.frontier.add_cell();
-                self.propagate(domain, &mut heap, Some(&mut changed));
-                let touched = self.settle(domain, &changed);
-                // Old cells only lost samples: their farthest member stands unless it
-                // was taken.
-                self.far.push(self.farthest(k));
-                for &j in touched.iter().filter(|&&j| j != k) {
-                    if self.owner[self.far[j].1 as usize] != j as u32 {
-                        self.far[j] = self.farthest(j);
-                    }
-                }
-                touched
-            }
+        match domain.metric() {
+            Metric::Intrinsic => self.replace_nodes(domain, &[], &[v]),
             Metric::Euclidean => self.add_node_euclidean(domain, v),
-        };
-        touched.push(k);
-        self.stats.push(CellStats {
-            r_d: 0.0,
-            farthest: NONE,
-            r_h: f64::INFINITY,
-        });
-        if domain.metric() == Metric::Intrinsic {
-            return self.refresh(domain, touched);
         }
-        // Euclidean: exact shortcuts. A cell that lost samples keeps its r_d unless its
-        // farthest sample was taken (then it is rescanned); r_h can only drop, to the
-        // distance from the new node (a minimum over one more element).
-        self.stats[k] = self.cell_stats(domain, k);
-        let p = domain.positions()[v as usize];
-        for j in 0..k {
-            let d = (domain.positions()[self.node_vertex[j] as usize] - p).length();
-            if d < self.stats[j].r_h {
-                self.stats[j].r_h = d;
-                touched.push(j);
+    }
+
+    /// Removes the nodes `doomed` (distinct indices, ascending; the others keep their
+    /// order) and appends nodes on the samples `added` (distinct, carrying no node once
+    /// the doomed ones are gone), and returns the cells whose radii may have changed,
+    /// the new ones included.
+    ///
+    /// With the intrinsic metric this is one Dijkstra: the freed samples and whatever
+    /// the new nodes take are settled together, so a sample a new node takes from a
+    /// removed one is visited once, not handed to a neighbour first and taken back.
+    pub fn replace_nodes(
+        &mut self,
+        domain: &Domain,
+        doomed: &[usize],
+        added: &[u32],
+    ) -> Vec<usize> {
+        if domain.metric() == Metric::Euclidean {
+            let mut touched = if doomed.is_empty() {
+                Vec::new()
+            } else {
+                self.remove_nodes_euclidean(domain, doomed)
+            };
+            for &v in added {
+                touched.extend(self.add_node_euclidean(domain, v));
+            }
+            touched.sort_unstable();
+            touched.dedup();
+            return touched;
+        }
+        // (The freed samples leave the frontier lists with their cells.)
+        let freed = self.drop_nodes(doomed);
+        let graph = domain.graph();
+        let mut heap = BinaryHeap::new();
+        // Samples next to the freed ones offer their (unchanged) distances to them.
+        for &v in &freed {
+            for e in graph.neighbors(v) {
+                let o = self.owner[e.to as usize];
+                if o != NONE {
+                    heap.push(Entry::new(
+                        self.dist[e.to as usize],
+                        self.node_vertex[o as usize],
+                        e.to,
+                    ));
+                }
             }
         }
-        touched.sort_unstable();
-        touched.dedup();
+        // Each changed sample with its previous owner.
+        let mut changed = Vec::new();
+        let first_new = self.node_vertex.len();
+        for &v in added {
+            let k = self.node_vertex.len() as u32;
+            self.node_vertex.push(v);
+            self.members.add_cell();
+            self.frontier.add_cell();
+            self.far.push((0.0, NONE));
+            self.stats.push(CellStats {
+                r_d: 0.0,
+                farthest: NONE,
+                r_h: f64::INFINITY,
+            });
+            if less((0.0, v), (self.dist[v as usize], self.key_of(v))) {
+                changed.push((v, self.owner[v as usize]));
+                self.dist[v as usize] = 0.0;
+                self.set_owner(v, k);
+                heap.push(Entry::new(0.0, v, v));
+            }
+        }
+        self.propagate(domain, &mut heap, Some(&mut changed));
+        // A surviving cell only gained freed samples and lost samples to the new
+        // nodes (a sample that stays keeps its distance): its farthest member is the
+        // old one, unless that was taken, or a gained one.
+        for &(v, _) in &changed {
+            let o = self.owner[v as usize];
+            if o != NONE && (o as usize) < first_new {
+                let (r, f) = self.far[o as usize];
+                let d = self.dist[v as usize];
+                if d > r || (d == r && v < f) {
+                    self.far[o as usize] = (d, v);
+                }
+            }
+        }
+        let mut touched = self.settle(domain, &changed);
         for &j in &touched {
-            let s = self.stats[j];
-            if j != k && s.farthest != NONE && self.owner[s.farthest as usize] != j as u32 {
-                let (r_d, farthest) = self.farthest(j);
-                self.stats[j].r_d = r_d;
-                self.stats[j].farthest = farthest;
+            let f = self.far[j].1;
+            if j < first_new && f != NONE && self.owner[f as usize] != j as u32 {
+                self.far[j] = self.farthest(j);
             }
         }
-        touched
+        for k in first_new..self.node_vertex.len() {
+            self.far[k] = self.farthest(k);
+            touched.push(k);
+        }
+        self.refresh(domain, touched)
     }
 
     /// Nearest node of every sample by straight-line distance, all nodes at once: each
@@ -417,13 +454,50 @@ impl Partition {
             .collect();
     }
 
-    /// Adds a node by straight-line distance: floods the vertex-grid cells from the
+    /// Adds a node by straight-line distance and returns the cells whose radii may have
+    /// changed (the new one included).
+    fn add_node_euclidean(&mut self, domain: &Domain, v: u32) -> Vec<usize> {
+        let mut touched = self.claim_euclidean(domain, v);
+        let k = self.node_vertex.len() - 1;
+        touched.push(k);
+        self.stats.push(CellStats {
+            r_d: 0.0,
+            farthest: NONE,
+            r_h: f64::INFINITY,
+        });
+        // Exact shortcuts. A cell that lost samples keeps its r_d unless its farthest
+        // sample was taken (then it is rescanned); r_h can only drop, to the distance
+        // from the new node (a minimum over one more element).
+        self.stats[k] = self.cell_stats(domain, k);
+        let p = domain.positions()[v as usize];
+        for j in 0..k {
+            let d = (domain.positions()[self.node_vertex[j] as usize] - p).length();
+            if d < self.stats[j].r_h {
+                self.stats[j].r_h = d;
+                touched.push(j);
+            }
+        }
+        touched.sort_unstable();
+        touched.dedup();
+        for &j in &touched {
+            let s = self.stats[j];
+            if j != k && s.farthest != NONE && self.owner[s.farthest as usize] != j as u32 {
+                let (r_d, farthest) = self.farthest(j);
+                self.stats[j].r_d = r_d;
+                self.stats[j].farthest = farthest;
+            }
+        }
+        touched
+    }
+
+    /// Appends a node on sample `v` and gives it the samples closer to it than to their
+    /// node; returns the cells that lost samples. Floods the vertex-grid cells from the
     /// node's own, entering a cell only if it may hold a sample closer to the new node
     /// than to its current one. The new cell is convex and distance to the old nodes is
     /// 1-Lipschitz, so every cell the new cell meets passes the test
     /// `box distance < largest distance in the cell + cell diagonal`, and those cells are
     /// connected.
-    fn add_node_euclidean(&mut self, domain: &Domain, v: u32) -> Vec<usize> {
+    fn claim_euclidean(&mut self, domain: &Domain, v: u32) -> Vec<usize> {
         let k = self.node_vertex.len() as u32;
         self.node_vertex.push(v);
         self.members.add_cell();
@@ -490,10 +564,24 @@ impl Partition {
         self.remove_nodes(domain, &[k])
     }
 
-    /// Removes the nodes `doomed` (distinct indices; the others keep their order),
-    /// hands their samples to the remaining nodes in one pass, and returns the cells
-    /// whose radii may have changed.
+    /// Removes the nodes `doomed` (distinct indices, ascending; the others keep their
+    /// order), hands their samples to the remaining nodes in one pass, and returns the
+    /// cells whose radii may have changed.
+    #[cfg(test)]
     pub fn remove_nodes(&mut self, domain: &Domain, doomed: &[usize]) -> Vec<usize> {
+        match domain.metric() {
+            Metric::Intrinsic => self.replace_nodes(domain, doomed, &[]),
+            Metric::Euclidean => self.remove_nodes_euclidean(domain, doomed),
+        }
+    }
+
+    /// Takes the nodes `doomed` out of the node list (renumbering the rest) and returns
+    /// their samples, now owned by no node.
+    fn drop_nodes(&mut self, doomed: &[usize]) -> Vec<u32> {
+        let mut freed = Vec::new();
+        if doomed.is_empty() {
+            return freed;
+        }
         let mut map = vec![0u32; self.node_vertex.len()];
         for &k in doomed {
             map[k] = NONE;
@@ -501,7 +589,6 @@ impl Partition {
         for (next, m) in map.iter_mut().filter(|m| **m != NONE).enumerate() {
             *m = next as u32;
         }
-        let mut freed = Vec::new();
         for &k in doomed {
             freed.append(&mut self.members.lists[k]);
         }
@@ -515,89 +602,55 @@ impl Partition {
         for o in self.owner.iter_mut().filter(|o| **o != NONE) {
             *o = map[*o as usize];
         }
-        if domain.metric() == Metric::Intrinsic {
-            for &k in doomed {
-                for &v in &self.frontier[k] {
-                    self.frontier_cell[v as usize] = NONE;
-                }
-            }
+        if !self.frontier.lists.is_empty() {
             retain_kept(&mut self.frontier.lists, &map);
             retain_kept(&mut self.far, &map);
             for c in self.frontier_cell.iter_mut().filter(|c| **c != NONE) {
                 *c = map[*c as usize];
             }
         }
-        let mut changed: Vec<(u32, u32)> = freed.iter().map(|&v| (v, NONE)).collect();
+        freed
+    }
+
+    /// [`Partition::remove_nodes`] by straight-line distance.
+    fn remove_nodes_euclidean(&mut self, domain: &Domain, doomed: &[usize]) -> Vec<usize> {
+        let freed = self.drop_nodes(doomed);
         let mut touched = Vec::new();
-        match domain.metric() {
-            Metric::Intrinsic => {
-                let graph = domain.graph();
-                let mut heap = BinaryHeap::new();
-                for &v in &freed {
-                    for e in graph.neighbors(v) {
-                        let o = self.owner[e.to as usize];
-                        if o != NONE {
-                            heap.push(Entry::new(
-                                self.dist[e.to as usize],
-                                self.node_vertex[o as usize],
-                                e.to,
-                            ));
-                        }
-                    }
+        let positions = domain.positions();
+        for &v in &freed {
+            let p = positions[v as usize];
+            let mut best = (f64::INFINITY, NONE, NONE);
+            for (j, &nv) in self.node_vertex.iter().enumerate() {
+                let d = (positions[nv as usize] - p).length();
+                if less((d, nv), (best.0, best.1)) {
+                    best = (d, nv, j as u32);
                 }
-                self.propagate(domain, &mut heap, Some(&mut changed));
-                // The cells only gained samples: their farthest member is the old one
-                // or a gained one.
-                for &(v, _) in &changed[freed.len()..] {
-                    let o = self.owner[v as usize];
-                    if o != NONE {
-                        let (r, f) = self.far[o as usize];
-                        let d = self.dist[v as usize];
-                        if d > r || (d == r && v < f) {
-                            self.far[o as usize] = (d, v);
-                        }
-                    }
-                }
-                touched.extend(self.settle(domain, &changed[freed.len()..]));
             }
-            Metric::Euclidean => {
-                let positions = domain.positions();
-                for &v in &freed {
-                    let p = positions[v as usize];
-                    let mut best = (f64::INFINITY, NONE, NONE);
-                    for (j, &nv) in self.node_vertex.iter().enumerate() {
-                        let d = (positions[nv as usize] - p).length();
-                        if less((d, nv), (best.0, best.1)) {
-                            best = (d, nv, j as u32);
-                        }
-                    }
-                    self.dist[v as usize] = best.0;
-                    self.set_owner(v, best.2);
-                    if best.2 != NONE {
-                        touched.push(best.2 as usize);
-                    }
-                }
-                let grid = domain.vertex_grid();
-                let mut cells: Vec<usize> = freed
-                    .iter()
-                    .map(|&v| {
-                        let (x, y) = grid.cell_of(positions[v as usize]);
-                        y * grid.nx + x
-                    })
-                    .collect();
-                cells.sort_unstable();
-                cells.dedup();
-                for c in cells {
-                    self.bin_max[c] = grid
-                        .items_of_cell(c)
-                        .iter()
-                        .map(|&w| self.dist[w as usize])
-                        .fold(0.0, f64::max);
-                }
-                // Any node may have had the removed one as its nearest.
-                touched.extend(0..self.node_vertex.len());
+            self.dist[v as usize] = best.0;
+            self.set_owner(v, best.2);
+            if best.2 != NONE {
+                touched.push(best.2 as usize);
             }
         }
+        let grid = domain.vertex_grid();
+        let mut cells: Vec<usize> = freed
+            .iter()
+            .map(|&v| {
+                let (x, y) = grid.cell_of(positions[v as usize]);
+                y * grid.nx + x
+            })
+            .collect();
+        cells.sort_unstable();
+        cells.dedup();
+        for c in cells {
+            self.bin_max[c] = grid
+                .items_of_cell(c)
+                .iter()
+                .map(|&w| self.dist[w as usize])
+                .fold(0.0, f64::max);
+        }
+        // Any node may have had the removed one as its nearest.
+        touched.extend(0..self.node_vertex.len());
         self.refresh(domain, touched)
     }
 
@@ -870,6 +923,21 @@ mod tests {
             p.add_node(&d, 401);
             p.add_node(&d, 3);
             p.remove_nodes(&d, &[0, 2, 5, 6]);
+            p.assert_matches_rebuild(&d);
+            // Removed and added in one pass: a new node on a removed node's sample,
+            // one elsewhere in a removed cell, one in a surviving cell.
+            let (a, b) = (p.node_vertex[0], p.node_vertex[1]);
+            let inside = p.members[1]
+                .iter()
+                .copied()
+                .find(|&v| v != b)
+                .expect("a member");
+            let elsewhere = p.members[2]
+                .iter()
+                .copied()
+                .find(|&v| !p.is_node(v))
+                .expect("one");
+            p.replace_nodes(&d, &[0, 1], &[a, inside, elsewhere]);
             p.assert_matches_rebuild(&d);
         }
     }
