@@ -662,12 +662,15 @@ impl Rig {
             }
             update_timings.partition_ms = ms(clock);
             let clock = Instant::now();
+            // A new virtual node's cell holds its field out to half its r_h already:
+            // the search goes on from there.
             let added = insert_virtual_handles(domain, partition, |partition, k| {
-                search(
-                    partition.node_vertex[k],
-                    support_radius(&partition.stats[k], alpha),
-                    None,
-                );
+                let v = partition.node_vertex[k];
+                let radius = support_radius(&partition.stats[k], alpha);
+                let inner = partition.inner_field(k);
+                search_aside(scope, searched, v, move || {
+                    Some(Ball::compute_from(domain, v, radius, inner))
+                });
             });
             nodes.extend(added.into_iter().map(|v| Node {
                 vertex: v,

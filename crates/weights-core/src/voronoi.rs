@@ -842,6 +842,26 @@ impl Partition {
         out
     }
 
+    /// The samples of cell `k` closer to its node than just under half its r_h, with
+    /// their distances, and that radius (intrinsic metric; `None` when r_h is
+    /// infinite). Any sample that close to the node is at least r_h − d > d from every
+    /// other node, so it lies in this cell, at the distance a search from the node alone
+    /// finds: the list is a complete distance field of that radius, for free. (The
+    /// radius is shortened by 10⁻⁹ of itself, far more than the rounding of any path
+    /// length, so that rounding cannot turn the strict inequality into a tie.)
+    pub fn inner_field(&self, k: usize) -> Option<(f64, Vec<(u32, f64)>)> {
+        let radius = self.stats[k].r_h / 2.0 * (1.0 - 1e-9);
+        if !radius.is_finite() || self.members.lists.is_empty() {
+            return None;
+        }
+        let entries = self.members[k]
+            .iter()
+            .map(|&v| (v, self.dist[v as usize]))
+            .filter(|&(_, d)| d < radius)
+            .collect();
+        Some((radius, entries))
+    }
+
     /// Samples no node reaches (other components of the graph), lowest first.
     pub fn unreached(&self) -> Vec<u32> {
         (0..self.owner.len() as u32)

@@ -181,6 +181,28 @@ impl Ball {
         }
     }
 
+    /// The field of a node on `source` to `radius`, searched on from `inner`: the
+    /// complete field of some smaller radius, with its entries (see
+    /// [`Partition::inner_field`]), or nothing.
+    pub fn compute_from(
+        domain: &Domain,
+        source: u32,
+        radius: f64,
+        inner: Option<(f64, Vec<(u32, f64)>)>,
+    ) -> Self {
+        match inner {
+            Some((r, entries)) if !entries.is_empty() => {
+                let known = Self { radius: r, entries };
+                if r >= radius {
+                    known
+                } else {
+                    known.extend(domain, source, radius)
+                }
+            }
+            _ => Self::compute(domain, source, radius),
+        }
+    }
+
     /// The field of a node on `source` searched to the nearest sample `is_node`
     /// accepts: it covers any support radius the node can have while those samples
     /// carry nodes. (Straight-line distance needs no search ahead: `None`.)
@@ -385,7 +407,10 @@ impl Weights {
         let n = domain.len();
         let balls: Vec<Ball> = (0..partition.len())
             .into_par_iter()
-            .map(|k| Ball::compute(domain, partition.node_vertex[k], radii[k]))
+            .map(|k| {
+                let inner = partition.inner_field(k);
+                Ball::compute_from(domain, partition.node_vertex[k], radii[k], inner)
+            })
             .collect();
         let supports: Vec<Vec<(u32, f32)>> = balls
             .par_iter()
@@ -893,5 +918,48 @@ mod tests {
         b.sort_by_key(|e| e.0);
         assert_eq!(a, b);
         assert!(a.len() > near.entries.len());
+    }
+
+    #[test]
+    fn a_cell_holds_its_nodes_field_out_to_half_its_r_h() {
+        // A regular grid (distances tie everywhere) and a jittered one, with nodes in
+        // clusters and apart; some at exactly even spacing.
+        let (p, t) = grid_mesh(40, 30, 1.0);
+        let regular = Domain::new(p.clone(), t.clone(), Metric::Intrinsic).expect("valid");
+        let mut s = 11u64;
+        let jittered: Vec<DVec2> = p
+            .iter()
+            .map(|&q| {
+                s = s
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                let inside = q.x > 0.0 && q.y > 0.0 && q.x < 40.0 && q.y < 30.0;
+                let a = ((s >> 33) as f64 / (1u64 << 31) as f64 - 0.5) * 0.3;
+                let b = ((s >> 13 & 0xfffff) as f64 / (1u64 << 20) as f64 - 0.5) * 0.3;
+                if inside { q + DVec2::new(a, b) } else { q }
+            })
+            .collect();
+        let jittered = Domain::new(jittered, t, Metric::Intrinsic).expect("valid");
+        for d in [&regular, &jittered] {
+            let part = Partition::new(d, vec![0, 2, 4, 300, 345, 606, 1000, 1234]);
+            for k in 0..part.len() {
+                let (r, inner) = part.inner_field(k).expect("finite r_h");
+                assert!(r > 0.0 && r < part.stats[k].r_h / 2.0);
+                let source = part.node_vertex[k];
+                let mut a = inner;
+                let mut b = ball(d, source, r);
+                a.sort_by_key(|e| e.0);
+                b.sort_by_key(|e| e.0);
+                assert_eq!(a, b, "node {k}");
+                // And searched on from there, the field a search from scratch finds.
+                let radius = part.stats[k].r_h * 1.5;
+                let from = Ball::compute_from(d, source, radius, part.inner_field(k));
+                let mut a = from.entries.clone();
+                let mut b = ball(d, source, radius);
+                a.sort_by_key(|e| e.0);
+                b.sort_by_key(|e| e.0);
+                assert_eq!(a, b, "node {k}");
+            }
+        }
     }
 }
