@@ -543,13 +543,18 @@ impl Rig {
             .collect();
         self.update_timings.plan_ms += ms(clock);
         let old_vertex: Vec<u32> = self.nodes.iter().map(|n| n.vertex).collect();
-        // The node samples once the removals and the real nodes are in, and the new
-        // real nodes among them.
-        let settled: std::collections::HashSet<u32> = (0..self.nodes.len())
+        // The node samples once the removals and the real nodes are in (a bit per
+        // sample: searches ask for every sample they reach), and the new real nodes
+        // among them.
+        let mut settled = vec![0u64; self.domain.len().div_ceil(64)];
+        for v in (0..self.nodes.len())
             .filter(|k| doomed.binary_search(k).is_err())
             .map(|k| self.nodes[k].vertex)
             .chain(target_vertices.iter().copied())
-            .collect();
+        {
+            settled[v as usize / 64] |= 1 << (v % 64);
+        }
+        let is_settled = |v: u32| settled[v as usize / 64] >> (v % 64) & 1 == 1;
         let arriving: Vec<u32> = target
             .iter()
             .map(|n| n.vertex)
@@ -609,17 +614,17 @@ impl Rig {
             // leaving, can be searched that far before the partition knows it.
             let mut ahead = std::collections::HashSet::new();
             if domain.metric() == Metric::Intrinsic {
-                let settled = &settled;
+                let is_settled = &is_settled;
                 for &q in &arriving {
                     ahead.insert(q);
                     search_aside(scope, searched, q, move || {
-                        Ball::to_nearest(domain, q, &|v| v != q && settled.contains(&v))
+                        Ball::to_nearest(domain, q, &|v| v != q && is_settled(v))
                     });
                 }
                 for &(q, old) in &growing {
                     ahead.insert(q);
                     search_aside(scope, searched, q, move || {
-                        let is_node = |v: u32| v != q && settled.contains(&v);
+                        let is_node = |v: u32| v != q && is_settled(v);
                         weights.field(old).extend_to_nearest(domain, q, &is_node)
                     });
                 }

@@ -13,6 +13,7 @@ use std::collections::BinaryHeap;
 
 use glam::{DAffine2, DVec2};
 use rayon::prelude::*;
+use std::sync::atomic::Ordering::Relaxed;
 
 use crate::basis::Basis;
 use crate::domain::{Domain, Metric};
@@ -373,17 +374,21 @@ pub(crate) struct Weights {
 /// Entries `(sample, node, φ)` of the samples `lo..hi` bucketed by row (a counting
 /// sort that keeps their order within a row): row `v` gets
 /// `by_row[start[v - lo]..start[v - lo + 1]]`.
-fn bucket_rows(lo: usize, hi: usize, entries: Vec<(u32, u32, f32)>) -> (Vec<u32>, Vec<(u32, f32)>) {
+fn bucket_rows<'a>(
+    lo: usize,
+    hi: usize,
+    parts: impl Iterator<Item = &'a [(u32, u32, f32)]> + Clone,
+) -> (Vec<u32>, Vec<(u32, f32)>) {
     let mut start = vec![0u32; hi - lo + 1];
-    for e in &entries {
+    for e in parts.clone().flatten() {
         start[e.0 as usize - lo + 1] += 1;
     }
     for i in 0..hi - lo {
         start[i + 1] += start[i];
     }
     let mut fill = start.clone();
-    let mut by_row = vec![(0u32, 0f32); entries.len()];
-    for (v, k, f) in entries {
+    let mut by_row = vec![(0u32, 0f32); start[hi - lo] as usize];
+    for &(v, k, f) in parts.flatten() {
         let at = &mut fill[v as usize - lo];
         by_row[*at as usize] = (k, f);
         *at += 1;
@@ -431,7 +436,7 @@ impl Weights {
             .enumerate()
             .map(|(c, entries)| {
                 let (lo, hi) = (c * CHUNK, ((c + 1) * CHUNK).min(n));
-                let (start, by_row) = bucket_rows(lo, hi, entries);
+                let (start, by_row) = bucket_rows(lo, hi, std::iter::once(&entries[..]));
                 let mut chunk = Chunk::new();
                 for i in 0..hi - lo {
                     chunk.push(
@@ -641,9 +646,25 @@ impl Weights {
             }
         }
         self.spare.clear();
-        /// A changed node, a fresh ball if the cached one was too small, the samples
-        /// whose rows it may change, and its new support entries.
-        type Reach = (usize, Option<Ball>, Vec<u32>, Vec<(u32, f32)>);
+        // Dirty samples (every sample a changed or removed node reaches or reached) as a
+        // bit set, marked by the parallel passes below.
+        let dirty_bits: Vec<std::sync::atomic::AtomicU64> = (0..n.div_ceil(64))
+            .map(|_| std::sync::atomic::AtomicU64::new(0))
+            .collect();
+        let mark = |v: u32| {
+            let bit = 1 << (v % 64);
+            let word = &dirty_bits[v as usize / 64];
+            if word.load(Relaxed) & bit == 0 {
+                word.fetch_or(bit, Relaxed);
+            }
+        };
+        dirty
+            .par_chunks(CHUNK)
+            .for_each(|vs| vs.iter().for_each(|&v| mark(v)));
+        /// A changed node, a fresh ball if the cached one was too small, and its new
+        /// support entries `(sample, node, φ)` bucketed by chunk.
+        type Reach = (usize, Option<Ball>, Vec<Vec<(u32, u32, f32)>>);
+        let chunk_count = n.div_ceil(CHUNK);
         let balls = &self.balls;
         let results: Vec<Reach> = changes
             .par_iter()
@@ -654,32 +675,25 @@ impl Weights {
                 let fresh = (!balls[c.node].covers(reach))
                     .then(|| balls[c.node].extend(domain, source, reach));
                 let ball = fresh.as_ref().unwrap_or(&balls[c.node]);
-                let touched = ball
-                    .entries
-                    .iter()
-                    .filter(|&&(_, d)| f64::from(d as f32) < reach)
-                    .map(|&(v, _)| v)
-                    .chain(std::iter::once(source))
-                    .collect();
-                let entries = ball.support(basis, r, partition, source);
-                (c.node, fresh, touched, entries)
+                // Every sample the node reaches or reached gets its row redone.
+                mark(source);
+                let mut by_chunk = vec![Vec::new(); chunk_count];
+                for &(v, d) in &ball.entries {
+                    let d = d as f32;
+                    if f64::from(d) < reach {
+                        mark(v);
+                    }
+                    if let Some(f) = support_entry(basis, partition, source, v, d, r) {
+                        by_chunk[v as usize / CHUNK].push((v, c.node as u32, f));
+                    }
+                }
+                (c.node, fresh, by_chunk)
             })
             .collect();
+        let dirty_bits: Vec<u64> = dirty_bits.into_iter().map(|w| w.into_inner()).collect();
         let mut changed_node = vec![false; partition.len()];
         for c in changes {
             changed_node[c.node] = true;
-        }
-        // Dirty samples (every sample a changed or removed node reaches or reached) as a
-        // bit set, and the changed nodes' new entries bucketed by chunk.
-        let mut dirty_bits = vec![0u64; n.div_ceil(64)];
-        for &v in dirty.iter().chain(results.iter().flat_map(|r| r.2.iter())) {
-            dirty_bits[v as usize / 64] |= 1 << (v % 64);
-        }
-        let mut fresh_by_chunk: Vec<Vec<(u32, u32, f32)>> = vec![Vec::new(); n.div_ceil(CHUNK)];
-        for (node, _, _, entries) in &results {
-            for &(v, f) in entries {
-                fresh_by_chunk[v as usize / CHUNK].push((v, *node as u32, f));
-            }
         }
         let renumbered = map.iter().enumerate().any(|(i, &m)| m != i as u32);
         let dirty_bits = &dirty_bits;
@@ -688,9 +702,8 @@ impl Weights {
             .chunks
             .par_iter_mut()
             .zip(self.sums.par_chunks_mut(CHUNK))
-            .zip(fresh_by_chunk)
             .enumerate()
-            .for_each(|(c, ((chunk, sums), fresh))| {
+            .for_each(|(c, (chunk, sums))| {
                 let (lo, hi) = (c * CHUNK, ((c + 1) * CHUNK).min(n));
                 let is_dirty = |v: usize| dirty_bits[v / 64] >> (v % 64) & 1 == 1;
                 if !(lo..hi).step_by(64).any(|v| dirty_bits[v / 64] != 0) {
@@ -701,6 +714,7 @@ impl Weights {
                     }
                     return;
                 }
+                let fresh = results.iter().map(|r| &r.2[c][..]);
                 let (start, by_row) = bucket_rows(lo, hi, fresh);
                 let mut rebuilt = Chunk::new();
                 rebuilt
@@ -753,7 +767,7 @@ impl Weights {
                 }
                 *chunk = rebuilt;
             });
-        for (node, ball, _, _) in results {
+        for (node, ball, _) in results {
             if let Some(ball) = ball {
                 self.balls[node] = ball;
             }
