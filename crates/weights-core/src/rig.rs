@@ -166,14 +166,17 @@ pub struct UpdateTimings {
     pub partition_ms: f64,
     /// Virtual handles inserted to restore r_d < r_h.
     pub virtual_ms: f64,
-    /// Supports of the changed nodes and the rows of the samples they reach.
+    /// Supports of the changed nodes and the rows of the samples they reach (with the
+    /// wait for the last distance fields).
     pub weights_ms: f64,
-    /// Dual graph, harmonic coordinates and node transforms.
+    /// Dual graph, harmonic coordinates and node transforms. The harmonic coordinates
+    /// are worked out on a free core while the last fields are searched, so this
+    /// overlaps `weights_ms`.
     pub transforms_ms: f64,
 }
 
 impl UpdateTimings {
-    /// Sum of the phases.
+    /// Sum of the phases (more than the wall-clock time where phases overlap).
     pub fn total_ms(&self) -> f64 {
         self.plan_ms + self.partition_ms + self.virtual_ms + self.weights_ms + self.transforms_ms
     }
@@ -582,6 +585,8 @@ impl Rig {
             .map(|(k, &v)| (v, k))
             .collect();
         let mut map: Vec<u32> = (0..self.nodes.len() as u32).collect();
+        let handle_count = self.handles.len();
+        let groups = handle_count + usize::from(self.options.fixed_boundary);
         let Self {
             domain,
             options,
@@ -597,6 +602,7 @@ impl Rig {
         // radii only shrink, and a field searched to a node's radius at that point
         // covers its final support.
         let searched = std::sync::Mutex::new(Vec::new());
+        let transforms = std::sync::Mutex::new(None);
         let mut weights_clock = Instant::now();
         rayon::scope(|scope| {
             let searched = &searched;
@@ -683,6 +689,16 @@ impl Rig {
             }));
             update_timings.virtual_ms = ms(clock);
             weights_clock = Instant::now();
+            // The virtual handles' harmonic coordinates depend on the finished partition
+            // only: worked out by whichever core is free while the last fields are
+            // searched.
+            let (partition, nodes): (&Partition, &Vec<Node>) = (&*partition, &*nodes);
+            let transforms = &transforms;
+            scope.spawn(move |_| {
+                let clock = Instant::now();
+                let harmonic = harmonic_of(domain, partition, nodes, handle_count, groups);
+                *transforms.lock().expect("not poisoned") = Some((harmonic, ms(clock)));
+            });
         });
         let clock = weights_clock;
         self.weights
@@ -702,37 +718,19 @@ impl Rig {
             })
             .collect();
         self.weights.renumber_fields(&map, &old_vertex);
-        // The weights and the virtual handles' harmonic coordinates depend on the new
-        // partition, not on each other: one core each.
-        let Self {
-            domain,
-            options,
-            handles,
-            nodes,
-            partition,
-            radii,
-            weights,
-            ..
-        } = &mut *self;
-        let ((), (harmonic, transforms_ms)) = rayon::join(
-            || {
-                weights.update(
-                    domain,
-                    partition,
-                    radii,
-                    &options.basis,
-                    &changes,
-                    &map,
-                    &dirty,
-                )
-            },
-            || {
-                let clock = Instant::now();
-                let groups = handles.len() + usize::from(options.fixed_boundary);
-                let harmonic = harmonic_of(domain, partition, nodes, handles.len(), groups);
-                (harmonic, ms(clock))
-            },
+        self.weights.update(
+            &self.domain,
+            &self.partition,
+            &self.radii,
+            &self.options.basis,
+            &changes,
+            &map,
+            &dirty,
         );
+        let (harmonic, transforms_ms) = transforms
+            .into_inner()
+            .expect("not poisoned")
+            .expect("computed in the scope");
         self.harmonic = harmonic;
         self.update_timings.weights_ms = ms(clock);
         self.update_timings.transforms_ms = transforms_ms;
