@@ -368,7 +368,7 @@ impl Partition {
         // A surviving cell only gained freed samples and lost samples to the new
         // nodes (a sample that stays keeps its distance): its farthest member is the
         // old one, unless that was taken, or a gained one.
-        for &(v, _) in &changed {
+        for &(v, _) in changed.iter().filter(|_| !freed.is_empty()) {
             let o = self.owner[v as usize];
             if o != NONE && (o as usize) < first_new {
                 let (r, f) = self.far[o as usize];
