@@ -378,7 +378,7 @@ impl Partition {
                 }
             }
         }
-        let mut touched = self.settle(domain, &changed);
+        let mut touched = self.settle(domain, &changed, first_new);
         for &j in &touched {
             let f = self.far[j].1;
             if j < first_new && f != NONE && self.owner[f as usize] != j as u32 {
@@ -690,8 +690,9 @@ impl Partition {
     /// Only the changed samples and their neighbours can enter or leave a frontier. A
     /// changed sample is checked in full; a neighbour in another cell is on a frontier
     /// now; a neighbour in the same cell may have lost its only foreign neighbour, which
-    /// matters only if it is on a frontier list.
-    fn settle(&mut self, domain: &Domain, changed: &[(u32, u32)]) -> Vec<usize> {
+    /// matters only if it is on a frontier list, and not at all in cells from `fresh`
+    /// on (new cells, whose samples all changed and are checked in full).
+    fn settle(&mut self, domain: &Domain, changed: &[(u32, u32)], fresh: usize) -> Vec<usize> {
         let graph = domain.graph();
         let mut seen = vec![false; self.node_vertex.len()];
         let mut cells = Vec::new();
@@ -717,7 +718,8 @@ impl Partition {
                     if self.frontier_cell[e.to as usize] != ow {
                         self.set_frontier(e.to, ow);
                     }
-                } else if self.frontier_cell[e.to as usize] != NONE
+                } else if (ow as usize) < fresh
+                    && self.frontier_cell[e.to as usize] != NONE
                     && !self.on_frontier(graph, e.to)
                 {
                     self.set_frontier(e.to, NONE);
