@@ -58,6 +58,19 @@ fn retain_kept<T>(list: &mut Vec<T>, map: &[u32]) {
     });
 }
 
+/// Renumbers cell indices after the cells `doomed` (ascending, none of them in
+/// `indices`) are removed: an index drops by one for every removed index below it;
+/// `NONE` stays. One branch-free (vectorised) pass per removed index, highest first,
+/// so that an index already shifted still compares as it did.
+fn shift_down(indices: &mut [u32], doomed: &[usize]) {
+    for &d in doomed.iter().rev() {
+        let d = d as u32;
+        for x in indices.iter_mut() {
+            *x -= u32::from(*x > d && *x != NONE);
+        }
+    }
+}
+
 /// One list of samples per cell, with each listed sample's position in its list, so
 /// that a sample moves between lists in constant time. Which list holds a sample is
 /// kept by the caller (the owner for members, `frontier_cell` for frontiers).
@@ -592,22 +605,23 @@ impl Partition {
         for &k in doomed {
             freed.append(&mut self.members.lists[k]);
         }
+        let intrinsic = !self.frontier.lists.is_empty();
         for &v in &freed {
             self.owner[v as usize] = NONE;
             self.dist[v as usize] = f64::INFINITY;
+            if intrinsic {
+                // (A cell's frontier samples are among its members.)
+                self.frontier_cell[v as usize] = NONE;
+            }
         }
         retain_kept(&mut self.members.lists, &map);
         retain_kept(&mut self.node_vertex, &map);
         retain_kept(&mut self.stats, &map);
-        for o in self.owner.iter_mut().filter(|o| **o != NONE) {
-            *o = map[*o as usize];
-        }
-        if !self.frontier.lists.is_empty() {
+        shift_down(&mut self.owner, doomed);
+        if intrinsic {
             retain_kept(&mut self.frontier.lists, &map);
             retain_kept(&mut self.far, &map);
-            for c in self.frontier_cell.iter_mut().filter(|c| **c != NONE) {
-                *c = map[*c as usize];
-            }
+            shift_down(&mut self.frontier_cell, doomed);
         }
         freed
     }
