@@ -626,7 +626,8 @@ impl Partition {
         freed
     }
 
-    /// [`Partition::remove_nodes`] by straight-line distance.
+    /// Removes the nodes `doomed` by straight-line distance (see
+    /// [`Partition::replace_nodes`]).
     fn remove_nodes_euclidean(&mut self, domain: &Domain, doomed: &[usize]) -> Vec<usize> {
         let freed = self.drop_nodes(doomed);
         let mut touched = Vec::new();
