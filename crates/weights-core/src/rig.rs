@@ -283,6 +283,11 @@ pub struct Rig {
     resolution: f64,
     timings: BuildTimings,
     update_timings: UpdateTimings,
+    /// The virtual handles placed while real nodes arrived, by sample, with the sample
+    /// of one of those real nodes: they go when it goes, so inserting and removing
+    /// handles does not leave ever more virtual handles behind. (Virtual handles from a
+    /// build, or placed while nodes only left, stay until crowded out.)
+    placed_for: HashMap<u32, u32>,
 }
 
 impl Rig {
@@ -358,6 +363,7 @@ impl Rig {
             resolution,
             timings,
             update_timings: UpdateTimings::default(),
+            placed_for: HashMap::new(),
         };
         rig.update_transforms();
         rig.timings.weights_ms = ms(clock);
@@ -381,7 +387,9 @@ impl Rig {
     }
 
     /// Removes handle `index` (later handles shift down by one) and brings everything
-    /// up to date locally.
+    /// up to date locally. The virtual handles placed when it was inserted go with it
+    /// (and Algorithm 1 adds what the remaining nodes need), so trying a handle at many
+    /// places does not pile up virtual handles.
     ///
     /// # Errors
     /// [`RigError::NoSuchHandle`]; the rig is unchanged on error.
@@ -522,15 +530,30 @@ impl Rig {
             })
             .map(|(_, n)| n.vertex)
             .collect();
+        // Real nodes that leave take the virtual handles placed for them along.
+        let leaving_real: std::collections::HashSet<u32> = self
+            .nodes
+            .iter()
+            .filter(|n| n.kind != NodeKind::Virtual && !target_vertices.contains(&n.vertex))
+            .map(|n| n.vertex)
+            .collect();
         let doomed: Vec<usize> = (0..self.nodes.len())
             .filter(|&k| {
                 let n = self.nodes[k];
-                let is_real = n.kind != NodeKind::Virtual;
-                (is_real && !target_vertices.contains(&n.vertex))
-                    || (!is_real
-                        && (target_vertices.contains(&n.vertex) || replaced.contains(&n.vertex)))
+                if n.kind != NodeKind::Virtual {
+                    return leaving_real.contains(&n.vertex);
+                }
+                target_vertices.contains(&n.vertex)
+                    || replaced.contains(&n.vertex)
+                    || self
+                        .placed_for
+                        .get(&n.vertex)
+                        .is_some_and(|r| leaving_real.contains(r))
             })
             .collect();
+        for &k in &doomed {
+            self.placed_for.remove(&self.nodes[k].vertex);
+        }
         // Radii of the surviving nodes, by sample (node numbers change below).
         let old_radius: HashMap<u32, f64> = (0..self.nodes.len())
             .filter(|k| doomed.binary_search(k).is_err())
@@ -594,6 +617,7 @@ impl Rig {
             partition,
             weights,
             update_timings,
+            placed_for,
             ..
         } = &mut *self;
         let (domain, weights, alpha) = (&*domain, &*weights, options.alpha);
@@ -683,6 +707,9 @@ impl Rig {
                     Some(Ball::compute_from(domain, v, radius, inner))
                 });
             });
+            if let Some(&first) = arriving.first() {
+                placed_for.extend(added.iter().map(|&v| (v, first)));
+            }
             nodes.extend(added.into_iter().map(|v| Node {
                 vertex: v,
                 kind: NodeKind::Virtual,
