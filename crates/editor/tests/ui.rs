@@ -312,7 +312,7 @@ fn bad_files_leave_the_work_untouched() {
     }
     h.state_mut()
         .request_open(dir.path().join("does-not-exist.png"));
-    h.run();
+    settle(&mut h);
     assert!(h.state().message.as_ref().is_some_and(|m| m.is_error));
     assert_eq!(handles(&h), before);
 }
