@@ -46,13 +46,12 @@ pub fn build(source: &Source, project: &Project) -> Result<Built> {
     project.validate(None)?;
     let file_vertices = mesh.vertices.len();
     let handles = pipeline::handles(project);
-    let spacing = weights_core::bar_spacing(&handles);
     let mut points: Vec<DVec2> = Vec::new();
-    for h in &handles {
+    for (i, h) in handles.iter().enumerate() {
         match h {
             Handle::Point { rest, .. } => points.push(*rest),
             Handle::Bar { rest, .. } => points.extend(
-                weights_core::bar_samples(*rest, spacing)
+                weights_core::bar_samples(*rest, weights_core::bar_spacing(&handles, i))
                     .into_iter()
                     .map(|(_, p)| p),
             ),

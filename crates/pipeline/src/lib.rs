@@ -94,14 +94,13 @@ pub fn metric(choice: MetricChoice, convex: bool) -> Metric {
 /// Points the mesh must have as vertices: point handles, then virtual handles; and one
 /// polyline of samples per bar.
 fn constraints(project: &Project, handles: &[Handle]) -> (Vec<DVec2>, Vec<Vec<DVec2>>) {
-    let spacing = weights_core::bar_spacing(handles);
     let mut points = Vec::new();
     let mut bars = Vec::new();
-    for h in handles {
+    for (i, h) in handles.iter().enumerate() {
         match h {
             Handle::Point { rest, .. } => points.push(*rest),
             Handle::Bar { rest, .. } => bars.push(
-                weights_core::bar_samples(*rest, spacing)
+                weights_core::bar_samples(*rest, weights_core::bar_spacing(handles, i))
                     .into_iter()
                     .map(|(_, p)| p)
                     .collect(),

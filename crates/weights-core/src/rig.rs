@@ -1169,7 +1169,7 @@ fn closest_pair(handles: &[Handle]) -> Option<(usize, usize, f64)> {
     best
 }
 
-/// The finest a bar is cut: the longest bar into this many pieces.
+/// The finest a bar is cut: into this many pieces.
 ///
 /// The paper samples bars at the smallest distance between two handles. A point placed
 /// a few pixels from a long bar would then cut it into a hundred samples, each with a
@@ -1177,11 +1177,30 @@ fn closest_pair(handles: &[Handle]) -> Option<(usize, usize, f64)> {
 /// of work and thousands of nodes). Sixteen pieces keep a bar straight in practice.
 pub const MAX_BAR_PIECES: f64 = 16.0;
 
-/// The sample spacing d of bar handles: the smallest distance between two handles
-/// (the paper's rule) but no finer than the longest bar over [`MAX_BAR_PIECES`], or an
-/// eighth of the longest bar when there is only one handle. A rig never samples finer
-/// than its mesh's mean edge length.
-pub fn bar_spacing(handles: &[Handle]) -> f64 {
+/// The sample spacing d of bar handle `bar`: its distance to the nearest other handle
+/// (the paper takes the smallest distance between any two handles; measured from each
+/// bar, a handle placed far from every bar leaves their samples alone, so inserting it
+/// stays local), but no finer than the bar over [`MAX_BAR_PIECES`], or an eighth of the
+/// bar when it is the only handle. A rig never samples finer than its mesh's mean edge
+/// length. (For a point handle: the distance to the nearest other handle.)
+pub fn bar_spacing(handles: &[Handle], bar: usize) -> f64 {
+    let own = segment_of(&handles[bar]);
+    let length = (own[1] - own[0]).length();
+    let nearest = (0..handles.len())
+        .filter(|&j| j != bar)
+        .map(|j| segment_distance(own, segment_of(&handles[j])))
+        .fold(f64::INFINITY, f64::min);
+    if nearest.is_finite() {
+        nearest.max(length / MAX_BAR_PIECES)
+    } else {
+        length / 8.0
+    }
+}
+
+/// The spacing of pinned border samples with a fixed boundary: the smallest distance
+/// between two handles, but no finer than the longest bar over [`MAX_BAR_PIECES`] (an
+/// eighth of it, or of nothing, with a single handle).
+fn boundary_spacing(handles: &[Handle]) -> f64 {
     let longest_bar = handles
         .iter()
         .map(|h| match h {
@@ -1220,7 +1239,7 @@ fn segment_of(h: &Handle) -> [DVec2; 2] {
 
 /// The nodes of the handles (and of the pinned border), each on a sample: a point on
 /// the nearest corner of the triangle containing it, bars split into ⌈L/d⌉ pieces with
-/// d the smallest distance between two handles (no smaller than the mean edge length).
+/// d from [`bar_spacing`] (no smaller than the mean edge length).
 fn real_nodes(
     domain: &Domain,
     handles: &[Handle],
@@ -1236,7 +1255,6 @@ fn real_nodes(
     {
         return Err(RigError::Coincident { a, b });
     }
-    let spacing = bar_spacing(handles).max(resolution);
     let snap = |i: usize, p: DVec2| -> Result<u32, RigError> {
         let (t, bary) = domain.locate(p).ok_or(RigError::OutsideDomain {
             handle: i,
@@ -1272,6 +1290,7 @@ fn real_nodes(
                         y: p.y,
                     });
                 }
+                let spacing = bar_spacing(handles, i).max(resolution);
                 for (t, p) in bar_samples(rest, spacing) {
                     let v = snap(i, p)?;
                     if own.iter().all(|n| n.vertex != v) {
@@ -1292,6 +1311,7 @@ fn real_nodes(
         }
     }
     if options.fixed_boundary {
+        let spacing = boundary_spacing(handles).max(resolution);
         let positions = domain.positions();
         for ring in domain.boundary_loops() {
             let mut since = f64::INFINITY;

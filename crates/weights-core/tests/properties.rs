@@ -7,7 +7,8 @@ use glam::DVec2;
 use proptest::prelude::*;
 use support::{Rng, Shape, grid_domain};
 use weights_core::{
-    Domain, Handle, Metric, NodeKind, Rig, RigError, RigOptions, Similarity, bar_spacing,
+    Domain, Handle, MAX_BAR_PIECES, Metric, NodeKind, Rig, RigError, RigOptions, Similarity,
+    bar_spacing,
 };
 
 /// Checks every invariant the weights promise; returns a description of the first
@@ -532,6 +533,26 @@ fn bars_are_sampled_and_follow_their_pose() {
     }
 }
 
+/// A bar is cut at its own distance to the nearest other handle: two points close
+/// together far from it leave it alone, a point near it cuts it finer.
+#[test]
+fn a_bar_is_cut_by_the_handles_near_it_only() {
+    let bar = Handle::bar(DVec2::new(5.0, 10.0), DVec2::new(25.0, 10.0));
+    let mut handles = vec![bar, Handle::point(DVec2::new(15.0, 2.0))];
+    assert_eq!(bar_spacing(&handles, 0), 8.0);
+    handles.push(Handle::point(DVec2::new(17.0, 1.0)));
+    assert_eq!(bar_spacing(&handles, 0), 8.0, "points far from the bar");
+    handles.push(Handle::point(DVec2::new(10.0, 13.0)));
+    assert_eq!(bar_spacing(&handles, 0), 3.0, "a point 3 from the bar");
+    handles.push(Handle::point(DVec2::new(20.0, 10.5)));
+    assert_eq!(
+        bar_spacing(&handles, 0),
+        20.0 / MAX_BAR_PIECES,
+        "no finer than 16 pieces"
+    );
+    assert_eq!(bar_spacing(&handles[..1], 0), 20.0 / 8.0, "alone");
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 12, .. ProptestConfig::default() })]
 
@@ -558,12 +579,12 @@ proptest! {
             })
             .expect("another sample");
         let before = rig.stats().virtual_nodes;
-        // (A point that lowers the bar sampling distance re-cuts the whole bar, which is
-        // not local by design; see `MAX_BAR_PIECES`.)
+        // (A point nearer a bar than anything else re-cuts that whole bar, which is not
+        // local by design; see `bar_spacing`.)
         let new_point = Handle::point(domain.positions()[beside]);
         let mut with_it = rig.handles().to_vec();
         with_it.push(new_point.clone());
-        prop_assume!(bar_spacing(&with_it) == bar_spacing(rig.handles()));
+        prop_assume!((0..rig.handles().len()).all(|i| bar_spacing(&with_it, i) == bar_spacing(rig.handles(), i)));
         if rig.insert_handle(new_point).is_ok() {
             let after = rig.stats().virtual_nodes;
             prop_assert!(after < before + domain.len() / 20, "{} virtual handles became {}", before, after);
