@@ -79,6 +79,17 @@ fn check_invariants(rig: &Rig) -> Result<(), String> {
 }
 
 /// A random rig of point and bar handles on sample positions.
+/// `rig` built from scratch with its handles and virtual handles (default options).
+fn rebuild_of(rig: &Rig) -> Rig {
+    Rig::with_virtual_handles(
+        rig.domain().clone(),
+        rig.handles().to_vec(),
+        &rig.virtual_vertices(),
+        RigOptions::default(),
+    )
+    .expect("valid")
+}
+
 fn random_handles(domain: &Domain, rng: &mut Rng, points: usize, bars: usize) -> Vec<Handle> {
     let p = domain.positions();
     let mut handles = Vec::new();
@@ -154,13 +165,7 @@ proptest! {
                 let i = rng.below(rig.handles().len());
                 rig.remove_handle(i).expect("exists");
             }
-            let rebuilt = Rig::with_virtual_handles(
-                domain.clone(),
-                rig.handles().to_vec(),
-                &rig.virtual_vertices(),
-                RigOptions::default(),
-            )
-            .expect("valid");
+            let rebuilt = rebuild_of(&rig);
             prop_assert_eq!(rig.stats(), rebuilt.stats());
             if let Err(e) = rig.same_weights_as(&rebuilt) {
                 prop_assert!(false, "step {}: {}", step, e);
@@ -844,13 +849,6 @@ fn inserting_and_removing_handles_does_not_pile_up_virtual_handles() {
             "{shape:?}: {fresh} virtual handles grew to {most}"
         );
         check_invariants(&rig).expect("invariants");
-        let rebuilt = Rig::with_virtual_handles(
-            domain.clone(),
-            rig.handles().to_vec(),
-            &rig.virtual_vertices(),
-            RigOptions::default(),
-        )
-        .expect("valid");
-        rig.same_weights_as(&rebuilt).expect("a rebuild");
+        rig.same_weights_as(&rebuild_of(&rig)).expect("a rebuild");
     }
 }
