@@ -1,6 +1,8 @@
 //! Prints where the time of a rig build, an insertion and a deformation goes, on the
 //! benchmark domains: `cargo run --release -p weights-core --example phases [samples] [holed]`
-//! (`INSERTS=N REPEAT=R`: N insertion positions, each timed R times).
+//! (`INSERTS=N REPEAT=R`: N insertion positions, each timed R times; `ONE_THREAD=1`: all
+//! work on the main thread, for counting instructions with
+//! `valgrind --tool=callgrind --toggle-collect='*Rig::insert_handle*'`).
 
 #[path = "../tests/support/mod.rs"]
 mod support;
@@ -12,6 +14,13 @@ use support::{Rng, Shape, grid_domain};
 use weights_core::{Handle, Rig, RigOptions};
 
 fn main() {
+    if std::env::var_os("ONE_THREAD").is_some() {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .use_current_thread()
+            .build_global()
+            .expect("the first pool");
+    }
     let args: Vec<String> = std::env::args().collect();
     let samples: usize = args
         .get(1)
