@@ -233,3 +233,35 @@ proptest! {
         }
     }
 }
+
+/// Vertices come in Z order, so mesh neighbours are near in memory too (graph searches
+/// over the mesh run from cache): most edges join vertices a few rows of the curve
+/// apart, far fewer than a random numbering would give.
+#[test]
+fn mesh_neighbours_are_numbered_close_together() {
+    let img = disc_with_hole_and_island_scaled(2);
+    let domain = domain_from_image(&img, &DomainOptions::default()).unwrap();
+    let opts = MeshOptions {
+        target_vertices: 20_000,
+        ..Default::default()
+    };
+    let t = triangulate(&domain, &Constraints::default(), &opts).unwrap();
+    let n = t.mesh.vertices.len();
+    let mut gaps: Vec<usize> = t
+        .mesh
+        .triangles
+        .iter()
+        .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+        .map(|(a, b)| (a as usize).abs_diff(b as usize))
+        .collect();
+    gaps.sort_unstable();
+    let median = gaps[gaps.len() / 2];
+    let ninth_decile = gaps[gaps.len() * 9 / 10];
+    // A numbering by rows would put a row's neighbours about √n apart.
+    let row = (n as f64).sqrt() as usize;
+    assert!(median < row / 4, "median gap {median} of {n} vertices");
+    assert!(
+        ninth_decile < 2 * row,
+        "90% of gaps under {ninth_decile} of {n} vertices"
+    );
+}
