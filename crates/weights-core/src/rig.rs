@@ -702,7 +702,7 @@ impl Rig {
             let added = insert_virtual_handles(domain, partition, |partition, k| {
                 let v = partition.node_vertex[k];
                 let radius = support_radius(&partition.stats[k], alpha);
-                let inner = partition.inner_field(k);
+                let inner = partition.inner_field(domain, k);
                 search_aside(scope, searched, v, move || {
                     Some(Ball::compute_from(domain, v, radius, inner))
                 });

@@ -381,13 +381,15 @@ impl Partition {
         // A surviving cell only gained freed samples and lost samples to the new
         // nodes (a sample that stays keeps its distance): its farthest member is the
         // old one, unless that was taken, or a gained one.
-        for &(v, _) in changed.iter().filter(|_| !freed.is_empty()) {
-            let o = self.owner[v as usize];
-            if o != NONE && (o as usize) < first_new {
-                let (r, f) = self.far[o as usize];
-                let d = self.dist[v as usize];
-                if d > r || (d == r && v < f) {
-                    self.far[o as usize] = (d, v);
+        if !freed.is_empty() {
+            for &(v, _) in &changed {
+                let o = self.owner[v as usize];
+                if o != NONE && (o as usize) < first_new {
+                    let (r, f) = self.far[o as usize];
+                    let d = self.dist[v as usize];
+                    if d > r || (d == r && v < f) {
+                        self.far[o as usize] = (d, v);
+                    }
                 }
             }
         }
@@ -605,7 +607,8 @@ impl Partition {
         for &k in doomed {
             freed.append(&mut self.members.lists[k]);
         }
-        let intrinsic = !self.frontier.lists.is_empty();
+        // (Frontiers are kept with the intrinsic metric only.)
+        let intrinsic = !self.frontier_cell.is_empty();
         for &v in &freed {
             self.owner[v as usize] = NONE;
             self.dist[v as usize] = f64::INFINITY;
@@ -860,15 +863,15 @@ impl Partition {
     }
 
     /// The samples of cell `k` closer to its node than just under half its r_h, with
-    /// their distances, and that radius (intrinsic metric; `None` when r_h is
-    /// infinite). Any sample that close to the node is at least r_h − d > d from every
+    /// their distances, and that radius (`None` with straight-line distances, whose
+    /// searches need no head start, or when r_h is infinite). Any sample that close to the node is at least r_h − d > d from every
     /// other node, so it lies in this cell, at the distance a search from the node alone
     /// finds: the list is a complete distance field of that radius, for free. (The
     /// radius is shortened by 10⁻⁹ of itself, far more than the rounding of any path
     /// length, so that rounding cannot turn the strict inequality into a tie.)
-    pub fn inner_field(&self, k: usize) -> Option<(f64, Vec<(u32, f64)>)> {
+    pub fn inner_field(&self, domain: &Domain, k: usize) -> Option<(f64, Vec<(u32, f64)>)> {
         let radius = self.stats[k].r_h / 2.0 * (1.0 - 1e-9);
-        if !radius.is_finite() || self.members.lists.is_empty() {
+        if domain.metric() != Metric::Intrinsic || !radius.is_finite() {
             return None;
         }
         let entries = self.members[k]

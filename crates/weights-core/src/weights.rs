@@ -413,7 +413,7 @@ impl Weights {
         let balls: Vec<Ball> = (0..partition.len())
             .into_par_iter()
             .map(|k| {
-                let inner = partition.inner_field(k);
+                let inner = partition.inner_field(domain, k);
                 Ball::compute_from(domain, partition.node_vertex[k], radii[k], inner)
             })
             .collect();
@@ -957,7 +957,7 @@ mod tests {
         for d in [&regular, &jittered] {
             let part = Partition::new(d, vec![0, 2, 4, 300, 345, 606, 1000, 1234]);
             for k in 0..part.len() {
-                let (r, inner) = part.inner_field(k).expect("finite r_h");
+                let (r, inner) = part.inner_field(d, k).expect("finite r_h");
                 assert!(r > 0.0 && r < part.stats[k].r_h / 2.0);
                 let source = part.node_vertex[k];
                 let mut a = inner;
@@ -967,7 +967,7 @@ mod tests {
                 assert_eq!(a, b, "node {k}");
                 // And searched on from there, the field a search from scratch finds.
                 let radius = part.stats[k].r_h * 1.5;
-                let from = Ball::compute_from(d, source, radius, part.inner_field(k));
+                let from = Ball::compute_from(d, source, radius, part.inner_field(d, k));
                 let mut a = from.entries.clone();
                 let mut b = ball(d, source, radius);
                 a.sort_by_key(|e| e.0);
