@@ -554,10 +554,13 @@ impl Partition {
                 continue;
             }
             let mut max = 0.0f64;
+            let positions = domain.positions();
             for &w in grid.items_of_cell(c) {
-                let d = (domain.positions()[w as usize] - p).length();
+                let d = (positions[w as usize] - p).length();
                 let wi = w as usize;
-                if less((d, v), (self.dist[wi], self.key_of(w))) {
+                let dw = self.dist[wi];
+                // (The tie-break key is looked up only on a tie.)
+                if d < dw || (d == dw && v < self.key_of(w)) {
                     let old = self.owner[wi];
                     if old != NONE && touched.last() != Some(&(old as usize)) {
                         touched.push(old as usize);
@@ -979,6 +982,24 @@ mod tests {
                 .expect("one");
             p.replace_nodes(&d, &[0, 1], &[a, inside, elsewhere]);
             p.assert_matches_rebuild(&d);
+        }
+    }
+
+    #[test]
+    fn the_farthest_member_of_a_cell_breaks_ties_by_sample() {
+        // One node in the middle of a regular grid: with straight-line distance the four
+        // corners tie, and the first in sample order is the farthest member.
+        let (p, t) = grid_mesh(250, 200, 1.0);
+        for metric in [Metric::Euclidean, Metric::Intrinsic] {
+            let d = Domain::new(p.clone(), t.clone(), metric).expect("valid");
+            let part = Partition::new(&d, vec![100 * 251 + 125]);
+            let mut expected = (0.0, NONE);
+            for (v, &dv) in part.dist.iter().enumerate() {
+                if dv > expected.0 {
+                    expected = (dv, v as u32);
+                }
+            }
+            assert_eq!(part.farthest(0), expected, "{metric:?}");
         }
     }
 
