@@ -31,6 +31,8 @@ pub(crate) struct Graph {
     edges: Vec<Edge>,
     /// The longest edge.
     max_len: f32,
+    /// The shortest edge.
+    min_len: f32,
 }
 
 impl Graph {
@@ -77,16 +79,23 @@ impl Graph {
         }
         new_offsets.push(edges.len() as u32);
         let max_len = edges.iter().map(|e| e.len).fold(0.0, f32::max);
+        let min_len = edges.iter().map(|e| e.len).fold(f32::INFINITY, f32::min);
         Self {
             offsets: new_offsets,
             edges,
             max_len,
+            min_len,
         }
     }
 
     /// The length of the longest edge.
     pub fn max_edge_length(&self) -> f64 {
         f64::from(self.max_len)
+    }
+
+    /// The length of the shortest edge (∞ without edges).
+    pub fn min_edge_length(&self) -> f64 {
+        f64::from(self.min_len)
     }
 
     #[inline]

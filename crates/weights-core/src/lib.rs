@@ -20,6 +20,7 @@ mod basis;
 mod domain;
 mod error;
 mod harmonic;
+mod queue;
 mod rig;
 mod transform;
 mod virtual_handles;

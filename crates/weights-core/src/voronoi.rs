@@ -9,17 +9,31 @@
 //! Ties between nodes at equal distance go to the node on the lower sample index, so
 //! the partition depends on the set of nodes, not on the order they were added in.
 
-use std::collections::BinaryHeap;
-
 use glam::DVec2;
 
 use crate::domain::{Domain, Metric};
+use crate::queue::Queue;
+
+thread_local! {
+    /// The queue of the partition's searches, kept between them.
+    static QUEUE: std::cell::RefCell<Queue> = const { std::cell::RefCell::new(Queue::new()) };
+}
+
+/// Runs `f` with this thread's search queue, empty and set up for `domain`'s graph.
+fn with_queue<R>(domain: &Domain, f: impl FnOnce(&mut Queue) -> R) -> R {
+    QUEUE.with(|q| {
+        let mut q = q.borrow_mut();
+        let graph = domain.graph();
+        q.prepare(graph.min_edge_length(), graph.max_edge_length());
+        f(&mut q)
+    })
+}
 
 /// "No node": an unreachable sample, or a removed node.
 pub(crate) const NONE: u32 = u32::MAX;
 
-/// A heap entry: tentative distance, the tie-break key of its node, the sample, packed
-/// into one integer so that the heap compares them in one instruction. Distances are
+/// A queue entry: tentative distance, the tie-break key of its node, the sample, packed
+/// into one integer so that a heap compares them in one instruction. Distances are
 /// never negative, so their IEEE bit patterns order like the numbers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub(crate) struct Entry(std::cmp::Reverse<u128>);
@@ -59,10 +73,18 @@ fn retain_kept<T>(list: &mut Vec<T>, map: &[u32]) {
 }
 
 /// Renumbers cell indices after the cells `doomed` (ascending, none of them in
-/// `indices`) are removed: an index drops by one for every removed index below it;
-/// `NONE` stays. One branch-free (vectorised) pass per removed index, highest first,
-/// so that an index already shifted still compares as it did.
-fn shift_down(indices: &mut [u32], doomed: &[usize]) {
+/// `indices`) are removed: an index drops by one for every removed index below it
+/// (`map` holds the new index of every old one); `NONE` stays. For a few removed cells,
+/// one branch-free (vectorised) pass per removed index, highest first, so that an index
+/// already shifted still compares as it did; for many, one pass through `map`.
+fn shift_down(indices: &mut [u32], doomed: &[usize], map: &[u32]) {
+    const PASSES: usize = 8;
+    if doomed.len() > PASSES {
+        for x in indices.iter_mut().filter(|x| **x != NONE) {
+            *x = map[*x as usize];
+        }
+        return;
+    }
     for &d in doomed.iter().rev() {
         let d = d as u32;
         for x in indices.iter_mut() {
@@ -193,16 +215,17 @@ impl Partition {
             Metric::Intrinsic => {
                 p.node_vertex = node_vertex;
                 p.members = CellLists::new(p.node_vertex.len(), n);
-                let mut heap = BinaryHeap::new();
-                for (k, &v) in p.node_vertex.iter().enumerate() {
-                    let entry = Entry::new(0.0, v, v);
-                    if less((0.0, v), (p.dist[v as usize], p.key_of(v))) {
-                        p.dist[v as usize] = 0.0;
-                        p.owner[v as usize] = k as u32;
-                        heap.push(entry);
+                with_queue(domain, |queue| {
+                    for (k, &v) in p.node_vertex.iter().enumerate() {
+                        let entry = Entry::new(0.0, v, v);
+                        if less((0.0, v), (p.dist[v as usize], p.key_of(v))) {
+                            p.dist[v as usize] = 0.0;
+                            p.owner[v as usize] = k as u32;
+                            queue.push(entry);
+                        }
                     }
-                }
-                p.propagate(domain, &mut heap, None);
+                    p.propagate(domain, queue, None);
+                });
                 for v in 0..n {
                     let o = p.owner[v];
                     if o != NONE {
@@ -264,18 +287,18 @@ impl Partition {
         self.owner[v as usize] = k;
     }
 
-    /// Multi-source Dijkstra from the entries in `heap`, claiming samples for the
+    /// Multi-source Dijkstra from the entries in `queue`, claiming samples for the
     /// popped entry's owner wherever that is lexicographically closer. With `changed`,
     /// member lists are kept current and each sample whose owner changed is recorded
     /// with its previous owner.
     fn propagate(
         &mut self,
         domain: &Domain,
-        heap: &mut BinaryHeap<Entry>,
+        queue: &mut Queue,
         mut changed: Option<&mut Vec<(u32, u32)>>,
     ) {
         let graph = domain.graph();
-        while let Some(entry) = heap.pop() {
+        while let Some(entry) = queue.pop() {
             let (d, key, v) = (entry.d(), entry.key(), entry.v());
             if d != self.dist[v as usize] || key != self.key_of(v) {
                 continue;
@@ -297,7 +320,7 @@ impl Partition {
                     } else {
                         self.owner[w] = k;
                     }
-                    heap.push(Entry::new(nd, key, e.to));
+                    queue.push(Entry::new(nd, key, e.to));
                 }
             }
         }
@@ -342,13 +365,13 @@ impl Partition {
         // (The freed samples leave the frontier lists with their cells.)
         let freed = self.drop_nodes(doomed);
         let graph = domain.graph();
-        let mut heap = BinaryHeap::new();
+        let mut seeds = Vec::new();
         // Samples next to the freed ones offer their (unchanged) distances to them.
         for &v in &freed {
             for e in graph.neighbors(v) {
                 let o = self.owner[e.to as usize];
                 if o != NONE {
-                    heap.push(Entry::new(
+                    seeds.push(Entry::new(
                         self.dist[e.to as usize],
                         self.node_vertex[o as usize],
                         e.to,
@@ -374,10 +397,13 @@ impl Partition {
                 changed.push((v, self.owner[v as usize]));
                 self.dist[v as usize] = 0.0;
                 self.set_owner(v, k);
-                heap.push(Entry::new(0.0, v, v));
+                seeds.push(Entry::new(0.0, v, v));
             }
         }
-        self.propagate(domain, &mut heap, Some(&mut changed));
+        with_queue(domain, |queue| {
+            seeds.into_iter().for_each(|e| queue.push(e));
+            self.propagate(domain, queue, Some(&mut changed));
+        });
         // A surviving cell only gained freed samples and lost samples to the new
         // nodes (a sample that stays keeps its distance): its farthest member is the
         // old one, unless that was taken, or a gained one.
@@ -623,11 +649,11 @@ impl Partition {
         retain_kept(&mut self.members.lists, &map);
         retain_kept(&mut self.node_vertex, &map);
         retain_kept(&mut self.stats, &map);
-        shift_down(&mut self.owner, doomed);
+        shift_down(&mut self.owner, doomed, &map);
         if intrinsic {
             retain_kept(&mut self.frontier.lists, &map);
             retain_kept(&mut self.far, &map);
-            shift_down(&mut self.frontier_cell, doomed);
+            shift_down(&mut self.frontier_cell, doomed, &map);
         }
         freed
     }
@@ -931,6 +957,7 @@ impl Partition {
 mod tests {
     use super::*;
     use crate::domain::tests::grid_mesh;
+    use std::collections::BinaryHeap;
 
     fn jittered(nx: usize, ny: usize, seed: u64, metric: Metric) -> Domain {
         let (mut p, t) = grid_mesh(nx, ny, 1.0);
@@ -946,6 +973,29 @@ mod tests {
             }
         }
         Domain::new(p, t, metric).expect("valid")
+    }
+
+    #[test]
+    fn removing_cells_renumbers_the_rest() {
+        // Both ways of renumbering (a pass per removed cell, and a table for many).
+        for doomed in [vec![1usize, 4], (0..40).filter(|k| k % 3 == 0).collect()] {
+            let cells = 60u32;
+            let mut map = vec![0u32; cells as usize];
+            let mut next = 0;
+            for (k, m) in map.iter_mut().enumerate() {
+                if doomed.contains(&k) {
+                    *m = NONE;
+                } else {
+                    *m = next;
+                    next += 1;
+                }
+            }
+            let kept: Vec<u32> = (0..cells).filter(|&k| map[k as usize] != NONE).collect();
+            let mut indices: Vec<u32> = kept.iter().rev().copied().chain([NONE]).collect();
+            shift_down(&mut indices, &doomed, &map);
+            let expected: Vec<u32> = (0..kept.len() as u32).rev().chain([NONE]).collect();
+            assert_eq!(indices, expected, "{} removed", doomed.len());
+        }
     }
 
     #[test]

@@ -9,14 +9,13 @@
 //! possible exactly on a support boundary) has an empty row and takes its own cell's
 //! node with weight 1.
 
-use std::collections::BinaryHeap;
-
 use glam::{DAffine2, DVec2};
 use rayon::prelude::*;
 use std::sync::atomic::Ordering::Relaxed;
 
 use crate::basis::Basis;
 use crate::domain::{Domain, Metric};
+use crate::queue::Queue;
 use crate::voronoi::{Entry, NONE, Partition};
 
 /// Reusable buffers for bounded Dijkstra searches, one set per thread. `dist` is all
@@ -24,14 +23,14 @@ use crate::voronoi::{Entry, NONE, Partition};
 /// and those it reached beyond a radius that shrank).
 struct Scratch {
     dist: Vec<f64>,
-    heap: BinaryHeap<Entry>,
+    queue: Queue,
 }
 
 thread_local! {
     static SCRATCH: std::cell::RefCell<Scratch> = const {
         std::cell::RefCell::new(Scratch {
             dist: Vec::new(),
-            heap: BinaryHeap::new(),
+            queue: Queue::new(),
         })
     };
 }
@@ -63,11 +62,12 @@ fn search(
     match domain.metric() {
         Metric::Intrinsic => SCRATCH.with(|scratch| {
             let mut scratch = scratch.borrow_mut();
-            let Scratch { dist, heap } = &mut *scratch;
+            let Scratch { dist, queue } = &mut *scratch;
             if dist.len() != domain.len() {
                 *dist = vec![f64::INFINITY; domain.len()];
             }
             let graph = domain.graph();
+            queue.prepare(graph.min_edge_length(), graph.max_edge_length());
             // Samples closer than this are known and final.
             let mut known_radius = f64::NEG_INFINITY;
             match known {
@@ -92,17 +92,17 @@ fn search(
                     for &(v, d) in entries {
                         dist[v as usize] = d;
                         if d >= rim {
-                            heap.push(Entry::new(d, 0, v));
+                            queue.push(Entry::new(d, 0, v));
                         }
                     }
                     out.extend_from_slice(entries);
                 }
                 None => {
                     dist[source as usize] = 0.0;
-                    heap.push(Entry::new(0.0, 0, source));
+                    queue.push(Entry::new(0.0, 0, source));
                 }
             }
-            while let Some(entry) = heap.pop() {
+            while let Some(entry) = queue.pop() {
                 let (d, v) = (entry.d(), entry.v());
                 if d > dist[v as usize] {
                     continue;
@@ -113,10 +113,13 @@ fn search(
                     continue;
                 }
                 if let Some(accept) = nearest
-                    && radius.is_infinite()
+                    && d * (1.0 + 1e-6) < radius
                     && v != source
                     && accept(v)
                 {
+                    // (Samples come out of the queue in order only to within a bucket:
+                    // a nearer accepted one may still follow, and farther ones already
+                    // out are dropped below.)
                     radius = d * (1.0 + 1e-6);
                 }
                 if d >= known_radius && v != source || known.is_none() {
@@ -127,13 +130,16 @@ fn search(
                     let w = e.to as usize;
                     if nd < dist[w] && nd < radius {
                         dist[w] = nd;
-                        heap.push(Entry::new(nd, 0, e.to));
+                        queue.push(Entry::new(nd, 0, e.to));
                     }
                 }
             }
-            heap.clear();
+            queue.clear();
             for &(v, _) in &out {
                 dist[v as usize] = f64::INFINITY;
+            }
+            if nearest.is_some() {
+                out.retain(|&(v, d)| d < radius || v == source);
             }
         }),
         Metric::Euclidean => {
