@@ -10,6 +10,11 @@ cargo build --release --quiet
 display=:97
 Xvfb "$display" -screen 0 1280x820x24 >/dev/null 2>&1 &
 xvfb=$!
+# Wait for the server's socket before anything connects to it.
+for _ in $(seq 100); do
+  [ -S "/tmp/.X11-unix/X${display#:}" ] && break
+  sleep 0.1
+done
 export DISPLAY=$display WGPU_BACKEND=vulkan
 XDG_RUNTIME_DIR=$(mktemp -d)
 export XDG_RUNTIME_DIR
