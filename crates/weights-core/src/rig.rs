@@ -514,7 +514,7 @@ impl Rig {
         // its r_d stays valid as it is: its cell only shrinks, and its new nearest
         // neighbour is no nearer than the cell reaches. (Replacing every virtual node
         // within its r_h instead gives about 4% fewer virtual handles, but re-places
-        // three or four of them on a typical insertion, about a third of its time.)
+        // three or four of them on a typical insertion, a quarter of the median one.)
         let present: std::collections::HashSet<u32> = self.nodes.iter().map(|n| n.vertex).collect();
         let positions = self.domain.positions();
         let arrivals: Vec<DVec2> = target

@@ -36,7 +36,8 @@ thread_local! {
 }
 
 /// The samples within `radius` of node sample `source` (and the source itself), with
-/// their distances, in order of distance for the intrinsic metric.
+/// their distances (for the intrinsic metric in order of distance to within a bucket of
+/// the search queue: half the shortest edge).
 pub(crate) fn ball(domain: &Domain, source: u32, radius: f64) -> Vec<(u32, f64)> {
     search(domain, source, radius, None, None).0
 }
