@@ -9,17 +9,21 @@ use anyhow::{Context as _, Result};
 use glam::DVec2;
 use project::HandleSpec;
 
-use crate::dialogs::{Dialogs, NativeDialogs};
+use crate::dialogs::{Answer, BuiltinDialog, Dialogs, FileAction, NativeDialogs, Shown};
 use crate::document::{Document, Edit, posed};
 use crate::history::History;
-use crate::jobs::{Job, Outcome};
+use crate::jobs::{CancelFlag, Job, Outcome, Rebuild};
 use crate::scene::{GpuFrame, MeshData, SceneResources, Versioned};
 use crate::viewport::Viewport;
 
 /// What a primary click or drag on the canvas does.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Tool {
-    /// Select, move, rotate (Alt or the ring) and scale (Shift) handles.
+    /// The Puppet Warp convention: a click on the picture adds a point handle, a click
+    /// on a handle selects it, dragging a handle moves it (Alt-drag rotates, Shift-drag
+    /// scales), Alt-click on a handle deletes it, dragging empty canvas pans.
+    Puppet,
+    /// As [`Tool::Puppet`], but a click on the picture only deselects.
     Select,
     /// Click to add a point handle.
     AddPoint,
@@ -60,6 +64,9 @@ impl Default for Show {
     }
 }
 
+/// Messages the log keeps before the oldest is forgotten.
+pub const LOG_LIMIT: usize = 200;
+
 /// A message in the status bar.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Message {
@@ -76,6 +83,8 @@ pub enum Pending {
     Open(PathBuf),
     /// Close the window.
     Close,
+    /// Write over this existing file (chosen in the built-in dialog).
+    Replace(FileAction, PathBuf),
 }
 
 /// A drag of a handle in progress.
@@ -112,6 +121,8 @@ pub struct EditorApp {
     /// The view: pan and zoom.
     pub viewport: Viewport,
     pub(crate) needs_fit: bool,
+    /// The view is as the last fit left it (no pan or zoom since).
+    pub(crate) view_fitted: bool,
     /// The active tool.
     pub tool: Tool,
     /// The selected handle.
@@ -127,14 +138,22 @@ pub struct EditorApp {
     pub hover_readout: Option<String>,
     /// Point handles turn with their neighbours' motion.
     pub auto_rotate: bool,
-    /// The status line.
+    /// The status line: the latest message.
     pub message: Option<Message>,
+    /// Every message so far (the newest last, at most [`LOG_LIMIT`]), for the messages
+    /// window.
+    pub log: Vec<Message>,
+    /// The messages window is open.
+    pub log_open: bool,
     /// A question waiting for an answer.
     pub pending: Option<Pending>,
     pub(crate) allow_close: bool,
     /// The keyboard shortcuts window is open.
     pub help_open: bool,
     pub(crate) dialogs: Box<dyn Dialogs>,
+    /// Use the built-in file dialog (the desktop has none, or the user prefers it).
+    pub builtin_dialogs: bool,
+    pub(crate) file_dialog: Option<BuiltinDialog>,
     pub(crate) gpu: GpuFrame,
     pub(crate) has_gpu: bool,
     next_version: u64,
@@ -206,7 +225,8 @@ impl EditorApp {
             dirty: false,
             viewport: Viewport::default(),
             needs_fit: true,
-            tool: Tool::Select,
+            view_fitted: false,
+            tool: Tool::Puppet,
             selected: None,
             drag: None,
             bar_start: None,
@@ -215,11 +235,15 @@ impl EditorApp {
             show: Show::default(),
             hover_readout: None,
             auto_rotate: false,
+            log: message.iter().cloned().collect(),
             message,
+            log_open: false,
             pending: None,
             allow_close: false,
             help_open: false,
-            dialogs: Box::new(NativeDialogs),
+            dialogs: Box::new(NativeDialogs::new()),
+            builtin_dialogs: false,
+            file_dialog: None,
             gpu: GpuFrame::default(),
             has_gpu,
             next_version: 0,
@@ -249,23 +273,82 @@ impl EditorApp {
         self.doc.as_mut()
     }
 
+    /// Checks the editor's invariants — the document's ([`Document::sanity_check`]),
+    /// and that every index the editor holds (the selection, the handle being dragged)
+    /// points at a handle that exists, that a bar is drawn only with the bar tool, and
+    /// that the GPU frame, once brought up to date, matches the mesh. Used by tests
+    /// after every step of a session.
+    ///
+    /// # Errors
+    /// The first broken invariant, in words.
+    pub fn sanity_check(&self) -> Result<()> {
+        let Some(doc) = &self.doc else {
+            if self.selected.is_some() || self.drag.is_some() {
+                anyhow::bail!("a selection or drag without a document");
+            }
+            return Ok(());
+        };
+        doc.sanity_check()?;
+        let handles = &doc.project().handles;
+        if let Some(s) = self.selected
+            && s >= handles.len()
+        {
+            anyhow::bail!("handle {s} is selected, but there are {}", handles.len());
+        }
+        if let Some(drag) = &self.drag {
+            match handles.get(drag.index) {
+                Some(h) if crate::document::same_rest(h, &drag.start) => {}
+                _ => anyhow::bail!("the drag holds handle {}, which is gone", drag.index),
+            }
+        }
+        if self.bar_start.is_some() && self.tool != Tool::AddBar {
+            anyhow::bail!("a bar is being drawn with the {:?} tool", self.tool);
+        }
+        if self.seen.weights == doc.weights_version && self.gpu.mesh.version != 0 {
+            let mesh = &self.gpu.mesh.value;
+            let samples = doc.rig().domain().len();
+            if mesh.rest.len() != samples || mesh.rows.len() != samples + 1 {
+                anyhow::bail!(
+                    "the GPU mesh has {} vertices, the rig {samples}",
+                    mesh.rest.len()
+                );
+            }
+        }
+        if self.log.len() > LOG_LIMIT {
+            anyhow::bail!("the message log outgrew its limit");
+        }
+        if !self.viewport.zoom.is_finite() || !self.viewport.origin.is_finite() {
+            anyhow::bail!("the view is not finite: {:?}", self.viewport);
+        }
+        Ok(())
+    }
+
     /// Whether there are changes not saved to a project file.
     pub fn is_dirty(&self) -> bool {
         self.dirty
     }
 
     pub(crate) fn info(&mut self, text: impl Into<String>) {
-        self.message = Some(Message {
+        self.say(Message {
             text: text.into(),
             is_error: false,
         });
     }
 
     pub(crate) fn error(&mut self, error: &anyhow::Error) {
-        self.message = Some(Message {
+        self.say(Message {
             text: format!("{error:#}"),
             is_error: true,
         });
+    }
+
+    /// Shows `message` in the status line and keeps it in the log.
+    fn say(&mut self, message: Message) {
+        if self.log.len() >= LOG_LIMIT {
+            self.log.remove(0);
+        }
+        self.log.push(message.clone());
+        self.message = Some(message);
     }
 
     /// Applies an edit as one undo step. Errors go to the status line; the document is
@@ -273,9 +356,16 @@ impl EditorApp {
     /// applied on a worker thread (see [`EditorApp::is_busy`]).
     #[must_use = "false when the edit was refused (the status line says why)"]
     pub fn edit(&mut self, edit: Edit) -> bool {
-        if self.job.is_some() {
+        if let Some(job) = &self.job {
+            let label = job.label.clone();
+            self.error(&anyhow::anyhow!(
+                "not now: {label}… is running (wait for it, or cancel it with Escape)"
+            ));
             return false;
         }
+        // The document changes under any gesture in progress: a drag ends here (as
+        // its own undo step), so its handle index cannot go stale.
+        self.end_gesture();
         if let (Edit::Settings(settings), Some(doc)) = (&edit, &self.doc)
             && settings.density != doc.settings().density
         {
@@ -365,6 +455,12 @@ impl EditorApp {
         }
     }
 
+    /// Switches tools; a bar being drawn is dropped.
+    pub fn set_tool(&mut self, tool: Tool) {
+        self.tool = tool;
+        self.bar_start = None;
+    }
+
     /// Deletes the selected handle.
     pub fn delete_selected(&mut self) {
         if let Some(i) = self.selected
@@ -383,8 +479,15 @@ impl EditorApp {
         let Some(doc) = &mut self.doc else { return };
         let mut project = doc.project().clone();
         let Some(slot) = project.handles.get_mut(index) else {
+            debug_assert!(false, "the dragged handle {index} is gone");
             return;
         };
+        // A drag poses its own handle; one at another rest means the index went stale.
+        let own = crate::document::same_rest(slot, &handle);
+        debug_assert!(own, "a drag may not move handle {index} at rest");
+        if !own {
+            return;
+        }
         *slot = handle;
         if self.auto_rotate {
             auto_rotate(&mut project.handles);
@@ -392,6 +495,14 @@ impl EditorApp {
         if let Err(e) = doc.restore(project) {
             self.error(&e);
         }
+    }
+
+    /// Ends whatever pointer gesture is in progress — a handle drag (one undo step if
+    /// it changed anything) or a bar being drawn — because the document is about to
+    /// change under it.
+    pub(crate) fn end_gesture(&mut self) {
+        self.finish_drag();
+        self.bar_start = None;
     }
 
     /// Ends a handle drag: one undo step if it changed anything.
@@ -415,8 +526,20 @@ impl EditorApp {
     }
 
     fn step_history(&mut self, back: bool) {
-        self.finish_drag();
+        if self.job.is_some() {
+            return;
+        }
+        self.end_gesture();
         let Some(doc) = &mut self.doc else { return };
+        let Some(target) = self.history.peek(back) else {
+            return;
+        };
+        if crate::document::Settings::of(target).density != doc.settings().density {
+            // A new mesh: built on the worker, like the same change from the slider.
+            let target = target.clone();
+            self.restore_in_background(back, target);
+            return;
+        }
         let current = doc.snapshot();
         let taken = if back {
             self.history.undo(current)
@@ -462,41 +585,59 @@ impl EditorApp {
     /// Opens a picture or project on a worker thread; the editor shows progress and
     /// takes no edits until it is in.
     pub fn open_in_background(&mut self, path: PathBuf) {
-        if self.job.is_some() {
+        let label = format!("Opening {}", file_name(&path));
+        self.start_job(label, CancelFlag::default(), move || open_outcome(path));
+    }
+
+    /// Starts `work` on a worker thread unless a job is running (then says so). Any
+    /// gesture in progress ends first: the document may change when the job is in.
+    fn start_job(
+        &mut self,
+        label: String,
+        cancel: CancelFlag,
+        work: impl FnOnce() -> Outcome + Send + 'static,
+    ) {
+        if let Some(job) = &self.job {
+            let running = job.label.clone();
+            self.error(&anyhow::anyhow!(
+                "{label} waits: {running}… is still running (cancel it with Escape)"
+            ));
             return;
         }
-        let name = path.file_name().map_or_else(
-            || path.display().to_string(),
-            |n| n.to_string_lossy().into_owned(),
-        );
-        self.job = Some(Job::spawn(
-            format!("Opening {name}"),
+        self.end_gesture();
+        self.job = Some(Job::spawn_cancellable(
+            label,
             self.wake.clone(),
-            move || open_outcome(path),
+            cancel,
+            work,
         ));
     }
 
     /// Re-meshes and re-weights the picture for `settings` on a worker thread.
     fn rebuild_in_background(&mut self, settings: crate::document::Settings) {
         let Some(doc) = &self.doc else { return };
-        if self.job.is_some() {
-            return;
-        }
         let before = doc.snapshot();
         let mut project = doc.project().clone();
         settings.write_to(&mut project);
-        let image = doc.image.clone();
-        let image_path = doc.image_path.clone();
         let label = format!("Meshing at {} vertices", settings.density);
-        self.job = Some(Job::spawn(label, self.wake.clone(), move || {
-            Outcome::Rebuilt {
-                before,
-                document: Document::with_image(image, image_path, project),
-            }
-        }));
+        let work = remesh(doc, project, Rebuild::Edit { before });
+        self.start_job(label, CancelFlag::default(), work);
     }
 
-    /// Whether a job (opening, re-meshing) is running.
+    /// Steps through the history to `target`, whose density differs from the
+    /// document's, on a worker thread. The history moves when the new mesh is in.
+    fn restore_in_background(&mut self, back: bool, target: project::Project) {
+        let Some(doc) = &self.doc else { return };
+        let density = crate::document::Settings::of(&target).density;
+        let label = format!(
+            "{} a density change: meshing at {density} vertices",
+            if back { "Undoing" } else { "Redoing" }
+        );
+        let work = remesh(doc, target, Rebuild::History { back });
+        self.start_job(label, CancelFlag::default(), work);
+    }
+
+    /// Whether a job (opening, re-meshing, exporting) is running.
     pub fn is_busy(&self) -> bool {
         self.job.is_some()
     }
@@ -506,6 +647,16 @@ impl EditorApp {
         self.job
             .as_ref()
             .map(|j| (j.label.as_str(), j.started.elapsed().as_secs_f64()))
+    }
+
+    /// Gives up on the running job, if any: the document stays as it was, and an
+    /// export writes nothing (unless it was already writing).
+    pub fn cancel_job(&mut self) {
+        if let Some(job) = self.job.take() {
+            let label = job.label.clone();
+            job.cancel();
+            self.info(format!("cancelled: {label}"));
+        }
     }
 
     /// Takes in the running job's result if it is done.
@@ -532,11 +683,11 @@ impl EditorApp {
             } => {
                 let stats = doc.rig().stats();
                 let what = if is_project { "project" } else { "image" };
+                self.end_gesture();
                 self.doc = Some(doc);
                 self.history.clear();
                 self.dirty = false;
                 self.selected = None;
-                self.drag = None;
                 self.needs_fit = true;
                 self.settings_draft = None;
                 self.info(format!(
@@ -551,18 +702,32 @@ impl EditorApp {
                 ..
             } => self.error(&e.context(format!("cannot open {}", path.display()))),
             Outcome::Rebuilt {
-                before,
+                cause,
                 document: Ok(mut doc),
             } => {
+                self.end_gesture();
                 if let Some(old) = &self.doc {
                     doc.project_path.clone_from(&old.project_path);
                     doc.weights_version = old.weights_version + 1;
                     doc.pose_version = old.pose_version + 1;
+                    let current = old.snapshot();
+                    match cause {
+                        Rebuild::Edit { before } => self.history.push(before),
+                        Rebuild::History { back: true } => {
+                            self.history.undo(current);
+                        }
+                        Rebuild::History { back: false } => {
+                            self.history.redo(current);
+                        }
+                    }
                 }
                 let stats = doc.rig().stats();
                 let ms = doc.last_update_ms;
+                let handles = doc.project().handles.len();
                 self.doc = Some(doc);
-                self.history.push(before);
+                if self.selected.is_some_and(|s| s >= handles) {
+                    self.selected = None;
+                }
                 self.dirty = true;
                 self.settings_draft = None;
                 self.info(format!(
@@ -570,38 +735,107 @@ impl EditorApp {
                     stats.samples
                 ));
             }
-            Outcome::Exported {
-                path,
-                result: Ok(()),
-                ms,
-            } => self.info(format!("exported {} in {ms:.0} ms", path.display())),
-            Outcome::Exported { result: Err(e), .. } => self.error(&e),
             Outcome::Rebuilt {
                 document: Err(e), ..
             } => {
                 self.settings_draft = None;
                 self.error(&e.context("cannot re-mesh"));
             }
+            Outcome::Exported {
+                path,
+                result: Ok(()),
+                ms,
+            } => self.info(format!("exported {} in {ms:.0} ms", path.display())),
+            Outcome::Exported { result: Err(e), .. } => self.error(&e),
         }
+    }
+
+    /// Asks for a file for `action` — with the desktop's dialog where there is one,
+    /// else with the built-in one — and acts on it when chosen.
+    pub fn ask_file(&mut self, action: FileAction) {
+        if self.file_dialog.is_some() {
+            return;
+        }
+        let suggested = match action {
+            FileAction::SaveProject => self.suggested_name("json"),
+            FileAction::ExportPng => self.suggested_name("warped.png"),
+            FileAction::OpenImage | FileAction::OpenProject => String::new(),
+        };
+        if !self.builtin_dialogs {
+            match self.dialogs.ask(action, &suggested) {
+                Answer::Chosen(path) => return self.file_chosen(action, path),
+                Answer::Cancelled => return,
+                Answer::Unavailable => {
+                    self.builtin_dialogs = true;
+                    self.info("the desktop offers no file dialog here: using the built-in one");
+                }
+            }
+        }
+        let folder = self.working_folder();
+        self.file_dialog = Some(BuiltinDialog::open(action, &folder, &suggested));
+    }
+
+    /// Whether the built-in file dialog is open.
+    pub fn file_dialog_open(&self) -> bool {
+        self.file_dialog.is_some()
+    }
+
+    /// Shows the built-in file dialog, if open, and acts on its answer.
+    pub(crate) fn file_dialog_ui(&mut self, ctx: &egui::Context) {
+        let Some(dialog) = &mut self.file_dialog else {
+            return;
+        };
+        let action = dialog.action;
+        match dialog.show(ctx) {
+            Shown::Open => {}
+            Shown::Cancelled => self.file_dialog = None,
+            Shown::Chosen(path) => {
+                self.file_dialog = None;
+                if action.writes() && path.exists() {
+                    // The desktop's dialogs ask before replacing a file; so does this one.
+                    self.pending = Some(Pending::Replace(action, path));
+                } else {
+                    self.file_chosen(action, path);
+                }
+            }
+        }
+    }
+
+    /// Acts on a file the user chose for `action`.
+    pub(crate) fn file_chosen(&mut self, action: FileAction, path: PathBuf) {
+        match action {
+            FileAction::OpenImage | FileAction::OpenProject => self.request_open(path),
+            FileAction::SaveProject => self.save_to(&path),
+            FileAction::ExportPng => self.export_in_background(path),
+        }
+    }
+
+    /// The folder dialogs start in: the project's or the picture's, else the current one.
+    fn working_folder(&self) -> PathBuf {
+        let from_doc = self.doc.as_ref().and_then(|d| {
+            d.project_path
+                .as_deref()
+                .or(d.image_path.as_deref())
+                .and_then(Path::parent)
+                .filter(|p| !p.as_os_str().is_empty())
+                .map(Path::to_path_buf)
+        });
+        from_doc
+            .or_else(|| std::env::current_dir().ok())
+            .unwrap_or_else(|| PathBuf::from("."))
     }
 
     /// Saves the project where it was last saved, or asks where.
     pub fn save(&mut self) {
-        let path = self
-            .doc
-            .as_ref()
-            .and_then(|d| d.project_path.clone())
-            .or_else(|| self.dialogs.save_project(&self.suggested_name("json")));
-        if let Some(path) = path {
-            self.save_to(&path);
+        match self.doc.as_ref().and_then(|d| d.project_path.clone()) {
+            Some(path) => self.save_to(&path),
+            None => self.ask_file(FileAction::SaveProject),
         }
     }
 
     /// Asks where to save the project, then saves it.
     pub fn save_as(&mut self) {
-        if let Some(path) = self.dialogs.save_project(&self.suggested_name("json")) {
-            self.save_to(&path);
-        }
+        self.ask_file(FileAction::SaveProject);
     }
 
     /// Writes the project to `path` atomically (a failure leaves any old file intact).
@@ -620,15 +854,13 @@ impl EditorApp {
 
     /// Asks where to export, then writes the warped PNG.
     pub fn export(&mut self) {
-        if let Some(path) = self.dialogs.export_png(&self.suggested_name("warped.png")) {
-            self.export_in_background(path);
-        }
+        self.ask_file(FileAction::ExportPng);
     }
 
     /// Writes the warped picture at full resolution to `path` atomically, now: the
     /// same pixels as `c2warp render` of the saved project.
     pub fn export_to(&mut self, path: &Path) {
-        let Some(work) = self.export_work(path.to_path_buf()) else {
+        let Some(work) = self.export_work(path.to_path_buf(), CancelFlag::default()) else {
             return;
         };
         self.finish(work());
@@ -636,25 +868,20 @@ impl EditorApp {
 
     /// As [`EditorApp::export_to`], on a worker thread (the editor shows progress).
     pub fn export_in_background(&mut self, path: PathBuf) {
-        if self.job.is_some() {
-            return;
-        }
-        let Some(work) = self.export_work(path.clone()) else {
+        let cancel = CancelFlag::default();
+        let Some(work) = self.export_work(path.clone(), cancel.clone()) else {
             return;
         };
-        let name = path.file_name().map_or_else(
-            || path.display().to_string(),
-            |n| n.to_string_lossy().into_owned(),
-        );
-        self.job = Some(Job::spawn(
-            format!("Exporting {name}"),
-            self.wake.clone(),
-            work,
-        ));
+        self.start_job(format!("Exporting {}", file_name(&path)), cancel, work);
     }
 
-    /// The export of the current document to `path`, ready to run anywhere.
-    fn export_work(&self, path: PathBuf) -> Option<impl FnOnce() -> Outcome + Send + 'static> {
+    /// The export of the current document to `path`, ready to run anywhere; it writes
+    /// nothing once `cancel` is set.
+    fn export_work(
+        &self,
+        path: PathBuf,
+        cancel: CancelFlag,
+    ) -> Option<impl FnOnce() -> Outcome + Send + 'static> {
         let doc = self.doc.as_ref()?;
         let project = doc.project_for_saving(None);
         let image = doc.image.clone();
@@ -663,6 +890,9 @@ impl EditorApp {
             let result = (|| -> Result<()> {
                 let prepared = pipeline::prepare(&image, &project, None)?;
                 let warped = pipeline::warp(&image, &prepared.rig)?;
+                if cancel.is_set() {
+                    anyhow::bail!("cancelled");
+                }
                 render::save_png_atomic(&path, &warped)?;
                 Ok(())
             })()
@@ -754,10 +984,16 @@ impl EditorApp {
         }
         if self.show.cells && seen.cells != weights {
             let rig = doc.rig();
+            // A sample that no node reaches (a rig without nodes, or a piece of the
+            // shape without a handle) has no cell: grey.
             let colors = rig
                 .cells()
                 .iter()
-                .map(|&k| cell_color(rig.nodes()[k as usize].vertex))
+                .map(|&k| {
+                    rig.nodes()
+                        .get(k as usize)
+                        .map_or(NO_CELL, |node| cell_color(node.vertex))
+                })
                 .collect();
             gpu.cells = Versioned {
                 version: bump(),
@@ -770,6 +1006,29 @@ impl EditorApp {
         }
         seen.weights = weights;
         seen.pose = doc.pose_version;
+    }
+}
+
+/// A path's file name, for messages.
+fn file_name(path: &Path) -> String {
+    path.file_name().map_or_else(
+        || path.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    )
+}
+
+/// The re-mesh of `doc`'s picture for `project` (with its virtual handles, so a step
+/// through the history gets exactly that state's weights), ready to run anywhere.
+fn remesh(
+    doc: &Document,
+    project: project::Project,
+    cause: Rebuild,
+) -> impl FnOnce() -> Outcome + Send + 'static {
+    let image = doc.image.clone();
+    let image_path = doc.image_path.clone();
+    move || Outcome::Rebuilt {
+        cause,
+        document: Document::with_image(image, image_path, project),
     }
 }
 
@@ -797,6 +1056,9 @@ fn without_virtuals(project: &project::Project) -> project::Project {
         ..project.clone()
     }
 }
+
+/// The colour of samples in no node's cell.
+const NO_CELL: [u8; 4] = [128, 128, 128, 255];
 
 /// A stable, well-spread colour for a node (keyed by its sample, so it survives
 /// renumbering).

@@ -30,12 +30,16 @@ impl EditorApp {
     pub(crate) fn canvas_ui(&mut self, ui: &mut Ui) {
         let (rect, response) = ui.allocate_exact_size(ui.available_size(), Sense::click_and_drag());
         response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "Canvas"));
+        let resized = self.viewport.canvas.size() != rect.size();
         self.viewport.canvas = rect;
-        if self.needs_fit
+        // A fitted view stays fitted when the window changes size (the first frames of
+        // a new window, a maximise), until the user pans or zooms.
+        if (self.needs_fit || (resized && self.view_fitted))
             && let Some(doc) = &self.doc
         {
             self.viewport.fit([doc.image.width(), doc.image.height()]);
             self.needs_fit = false;
+            self.view_fitted = true;
         }
         if !self.is_busy() {
             self.canvas_input(ui, &response);
@@ -110,7 +114,7 @@ impl EditorApp {
             );
         }
         self.paint_overlays(&painter);
-        if let (Some(a), Some(b)) = (self.bar_start, response.interact_pointer_pos()) {
+        if let (Some(a), Some(b)) = (self.bar_start, ui.input(|i| i.pointer.latest_pos())) {
             let a = self.viewport.to_screen(a);
             painter.line_segment([a, b], Stroke::new(4.0, SELECTED));
         }
@@ -126,6 +130,44 @@ impl EditorApp {
         } else {
             self.hover_weights(ui, &response);
         }
+    }
+
+    /// The bar tool, from the pointer's own press and release rather than egui's drag
+    /// detection: a quick stroke (press, a big move and release within a frame or
+    /// two) is a bar too, not a click that does nothing.
+    fn bar_input(&mut self, ui: &Ui, response: &egui::Response) {
+        let (pressed, released, origin, latest) = ui.input(|i| {
+            (
+                i.pointer.primary_pressed(),
+                i.pointer.primary_released(),
+                i.pointer.press_origin(),
+                i.pointer.latest_pos(),
+            )
+        });
+        let space = ui.input(|i| i.key_down(Key::Space));
+        if pressed
+            && !space
+            && let Some(origin) = origin
+            && response.rect.contains(origin)
+            && (response.contains_pointer() || response.is_pointer_button_down_on())
+        {
+            self.bar_start = Some(self.viewport.to_image(origin));
+        }
+        if released && let Some(a) = self.bar_start.take() {
+            let Some(end) = latest else { return };
+            if self.viewport.to_screen(a).distance(end) > 4.0 {
+                self.add_bar(a, self.viewport.to_image(end));
+            } else {
+                self.info("to add a bar, drag from one end of it to the other");
+            }
+        }
+    }
+
+    /// Whether image point `at` (in the current pose) shows the picture.
+    fn on_picture(&mut self, at: DVec2) -> bool {
+        self.doc
+            .as_mut()
+            .is_some_and(|doc| doc.unwarp(at).is_some())
     }
 
     /// The handle under `pos` (screen), and which grip.
@@ -171,29 +213,32 @@ impl EditorApp {
             let factor = zoom * (scroll * 0.0015).exp();
             if (factor - 1.0).abs() > 1e-4 {
                 self.viewport.zoom_about(hover, factor);
+                self.view_fitted = false;
             }
         }
         let press = ui
             .input(|i| i.pointer.press_origin())
             .or(response.interact_pointer_pos());
+        if self.tool == Tool::AddBar {
+            self.bar_input(ui, response);
+        }
         if response.drag_started_by(PointerButton::Middle)
             || (response.drag_started_by(PointerButton::Primary) && space)
         {
             self.panning = true;
         } else if response.drag_started_by(PointerButton::Primary)
+            && self.tool != Tool::AddBar
             && let Some(pos) = press
         {
-            match self.tool {
-                Tool::AddBar => self.bar_start = Some(self.viewport.to_image(pos)),
-                Tool::Select | Tool::AddPoint => match self.hit(pos) {
-                    Some((index, grip)) => self.start_drag(index, grip, pos, modifiers),
-                    None => self.panning = self.tool == Tool::Select,
-                },
+            match self.hit(pos) {
+                Some((index, grip)) => self.start_drag(index, grip, pos, modifiers),
+                None => self.panning = matches!(self.tool, Tool::Puppet | Tool::Select),
             }
         }
         if response.dragged() {
             if self.panning {
                 self.viewport.origin += response.drag_delta();
+                self.view_fitted = false;
             } else if let Some(pos) = response.interact_pointer_pos() {
                 self.drag_to(self.viewport.to_image(pos));
             }
@@ -201,21 +246,29 @@ impl EditorApp {
         if response.drag_stopped() {
             self.panning = false;
             self.finish_drag();
-            if let (Some(a), Some(pos)) = (self.bar_start.take(), response.interact_pointer_pos())
-                && self.viewport.to_screen(a).distance(pos) > 4.0
-            {
-                self.add_bar(a, self.viewport.to_image(pos));
-            }
         }
         if response.clicked_by(PointerButton::Primary)
             && let Some(pos) = response.interact_pointer_pos()
         {
             let hit = self.hit(pos).map(|(i, _)| i);
             match (self.tool, hit) {
+                (Tool::AddBar, _) => {}
+                (_, Some(i)) if modifiers.alt => {
+                    // The Puppet Warp convention: Alt-click deletes a handle.
+                    self.selected = Some(i);
+                    self.delete_selected();
+                }
                 (_, Some(i)) => self.selected = Some(i),
+                (Tool::Puppet, None) => {
+                    let at = self.viewport.to_image(pos);
+                    if self.on_picture(at) {
+                        self.add_point(at);
+                    } else {
+                        self.selected = None;
+                    }
+                }
                 (Tool::Select, None) => self.selected = None,
                 (Tool::AddPoint, None) => self.add_point(self.viewport.to_image(pos)),
-                (Tool::AddBar, None) => {}
             }
         }
         if response.secondary_clicked()
@@ -229,7 +282,7 @@ impl EditorApp {
             Some(CursorIcon::Grabbing)
         } else if response.hover_pos().and_then(|p| self.hit(p)).is_some() {
             Some(CursorIcon::Grab)
-        } else if self.tool != Tool::Select && response.hovered() {
+        } else if matches!(self.tool, Tool::AddPoint | Tool::AddBar) && response.hovered() {
             Some(CursorIcon::Crosshair)
         } else {
             None

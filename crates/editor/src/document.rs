@@ -31,7 +31,8 @@ pub struct Settings {
 }
 
 impl Settings {
-    fn of(project: &Project) -> Self {
+    /// The parameters `project` asks for (the default density where it names none).
+    pub fn of(project: &Project) -> Self {
         Self {
             alpha: project.alpha,
             degree: project.degree,
@@ -346,6 +347,59 @@ impl Document {
         self.weights_version += 1;
         self.pose_version += 1;
         self.last_update_ms = ms(clock);
+        Ok(())
+    }
+
+    /// Checks the document's invariants: the rig file is valid for the picture, the
+    /// rig has exactly its handles, nodes sit on samples, weights are non-negative and
+    /// sum to one wherever a node reaches, and the pose deforms every sample to a
+    /// finite point. Used by tests after every step of a session.
+    ///
+    /// # Errors
+    /// The first broken invariant, in words.
+    pub fn sanity_check(&self) -> Result<()> {
+        let (width, height) = self.image.dimensions();
+        self.project
+            .validate(Some((width, height)))
+            .context("the rig file")?;
+        if !self.project.virtual_handles.is_empty() {
+            bail!("virtual handles belong to the rig while editing, not to the rig file");
+        }
+        let expected = pipeline::handles(&self.project);
+        if self.rig.handles() != expected.as_slice() {
+            bail!(
+                "the rig's {} handles are not the rig file's {}",
+                self.rig.handles().len(),
+                expected.len()
+            );
+        }
+        let samples = self.rig.domain().len();
+        let nodes = self.rig.nodes();
+        if let Some(node) = nodes.iter().find(|n| n.vertex as usize >= samples) {
+            bail!("a node sits on sample {} of {samples}", node.vertex);
+        }
+        // Every sample on small pictures; a spread of them on large ones.
+        let stride = (samples / 4000).max(1);
+        for v in (0..samples).step_by(stride) {
+            let mut sum = 0.0;
+            let mut any = false;
+            for (k, w) in self.rig.weights(v) {
+                if k >= nodes.len() || !w.is_finite() || w < 0.0 {
+                    bail!("sample {v} has weight {w} on node {k} of {}", nodes.len());
+                }
+                sum += w;
+                any = true;
+            }
+            if any && (sum - 1.0).abs() > 1e-9 {
+                bail!("the weights of sample {v} sum to {sum}");
+            }
+        }
+        if let Some(v) = self.rig.deform().iter().position(|p| !p.is_finite()) {
+            bail!("sample {v} deforms to a non-finite point");
+        }
+        if self.weights_version == 0 || self.pose_version == 0 {
+            bail!("versions start at 1");
+        }
         Ok(())
     }
 

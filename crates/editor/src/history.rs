@@ -40,6 +40,16 @@ impl History {
         Some(next)
     }
 
+    /// The state [`History::undo`] (`back`) or [`History::redo`] would go to, without
+    /// going there.
+    pub fn peek(&self, back: bool) -> Option<&Project> {
+        if back {
+            self.undo.last()
+        } else {
+            self.redo.last()
+        }
+    }
+
     /// Puts back a state taken by [`History::undo`] or [`History::redo`] that could not
     /// be applied, so neither stack loses it.
     pub fn unpop(&mut self, undone: bool, taken: Project) {
@@ -85,7 +95,10 @@ mod tests {
         let mut h = History::default();
         h.push(state(0.1));
         h.push(state(0.2));
+        assert_eq!(h.peek(true), Some(&state(0.2)));
+        assert_eq!(h.peek(false), None);
         assert_eq!(h.undo(state(0.3)), Some(state(0.2)));
+        assert_eq!(h.peek(false), Some(&state(0.3)));
         assert_eq!(h.undo(state(0.2)), Some(state(0.1)));
         assert_eq!(h.undo(state(0.1)), None);
         assert_eq!(h.redo(state(0.1)), Some(state(0.2)));

@@ -20,8 +20,8 @@ mod viewport;
 use std::path::PathBuf;
 
 pub use app::{EditorApp, Message, Pending, Show, Tool};
-pub use dialogs::{Dialogs, NativeDialogs};
-pub use document::{Document, Edit, Settings};
+pub use dialogs::{Answer, Dialogs, FileAction, IMAGES, NativeDialogs, desktop_has_dialogs};
+pub use document::{Document, Edit, Settings, posed};
 pub use panels::SHORTCUTS;
 pub use scene::SceneResources;
 pub use viewport::Viewport;

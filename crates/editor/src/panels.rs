@@ -7,19 +7,26 @@ use egui::{Key, KeyboardShortcut, Modifiers, Ui};
 use project::{MetricChoice, Middle};
 
 use crate::app::{EditorApp, Pending, Tool};
+use crate::dialogs::FileAction;
 use crate::document::Edit;
 
 /// Every shortcut, as the help window lists them.
 pub const SHORTCUTS: &[(&str, &str)] = &[
-    ("V", "Select / move tool"),
+    (
+        "W",
+        "Puppet tool: click the picture to add a handle, click a handle to select it",
+    ),
+    ("V", "Select tool: like Puppet, but a click only selects"),
     ("P", "Add point handle tool"),
-    ("B", "Add bar handle tool"),
+    ("B", "Add bar handle tool (drag from end to end)"),
     (
         "Drag a handle",
         "Move it (a bar's end: turn and stretch the bar)",
     ),
     ("Alt + drag, or drag the ring", "Rotate the handle"),
     ("Shift + drag", "Scale the handle"),
+    ("Alt + click a handle", "Delete it"),
+    ("Drag empty canvas", "Pan (Puppet and Select tools)"),
     ("Right click", "Handle menu: delete, reset pose"),
     ("Delete / Backspace", "Delete the selected handle"),
     ("Middle drag, Space + drag", "Pan"),
@@ -37,7 +44,10 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("Ctrl + S", "Save the project"),
     ("Ctrl + Shift + S", "Save the project as"),
     ("Ctrl + E", "Export the warped PNG"),
-    ("Escape", "Deselect, cancel"),
+    (
+        "Escape",
+        "Deselect; cancel a bar, a question or a running job",
+    ),
     ("F1", "This window"),
 ];
 
@@ -46,13 +56,22 @@ impl eframe::App for EditorApp {
         let clock = Instant::now();
         let ctx = ui.ctx().clone();
         self.poll_job();
+        self.dropped_files(&ctx);
         let idle = !self.is_busy();
-        if idle {
-            self.dropped_files(&ctx);
-            self.shortcuts(&ctx);
-        } else {
+        if !idle {
+            if ctx.input_mut(|i| i.consume_key(Modifiers::NONE, Key::Escape)) {
+                self.cancel_job();
+            }
             // Keep the elapsed time and the spinner moving.
             ctx.request_repaint_after(std::time::Duration::from_millis(100));
+        } else if self.pending.is_none() && self.file_dialog.is_none() {
+            // A question or a dialog takes the keys: nothing acts on the document
+            // behind it.
+            self.shortcuts(&ctx);
+        } else if self.pending.is_some()
+            && ctx.input_mut(|i| i.consume_key(Modifiers::NONE, Key::Escape))
+        {
+            self.pending = None;
         }
         self.close_request(&ctx);
         egui::Panel::top("menu").show(ui, |ui| {
@@ -71,6 +90,8 @@ impl eframe::App for EditorApp {
             .frame(egui::Frame::NONE)
             .show(ui, |ui| self.canvas_ui(ui));
         self.help_window(&ctx);
+        self.log_window(&ctx);
+        self.file_dialog_ui(&ctx);
         self.pending_modal(&ctx);
         self.frame_ms = clock.elapsed().as_secs_f64() * 1e3;
     }
@@ -78,14 +99,37 @@ impl eframe::App for EditorApp {
 
 impl EditorApp {
     fn dropped_files(&mut self, ctx: &egui::Context) {
-        let dropped = ctx.input(|i| {
+        let dropped: Vec<_> = ctx.input(|i| {
             i.raw
                 .dropped_files
-                .first()
+                .iter()
                 .map(|f| f.path().to_path_buf())
                 .filter(|p| !p.as_os_str().is_empty())
+                .collect()
         });
-        if let Some(path) = dropped {
+        let Some(path) = dropped.first().cloned() else {
+            return;
+        };
+        if dropped.len() > 1 {
+            self.info(format!(
+                "{} files dropped: opening the first, {}",
+                dropped.len(),
+                path.display()
+            ));
+        }
+        if let Some((what, _)) = self.busy_with() {
+            let what = what.to_owned();
+            self.error(&anyhow::anyhow!(
+                "{} was not opened: {what}… is still running (wait for it, or press \
+                 Escape to cancel it, then drop the file again)",
+                path.display()
+            ));
+        } else if self.pending.is_some() || self.file_dialog.is_some() {
+            self.error(&anyhow::anyhow!(
+                "{} was not opened: answer the open question or dialog first",
+                path.display()
+            ));
+        } else {
             self.request_open(path);
         }
     }
@@ -118,13 +162,9 @@ impl EditorApp {
             self.save();
         }
         if pressed(ctrl_shift, Key::O) {
-            if let Some(path) = self.dialogs.open_project() {
-                self.request_open(path);
-            }
-        } else if pressed(ctrl, Key::O)
-            && let Some(path) = self.dialogs.open_image()
-        {
-            self.request_open(path);
+            self.ask_file(FileAction::OpenProject);
+        } else if pressed(ctrl, Key::O) {
+            self.ask_file(FileAction::OpenImage);
         }
         if pressed(ctrl, Key::E) {
             self.export();
@@ -133,14 +173,17 @@ impl EditorApp {
         if pressed(none, Key::Delete) || pressed(none, Key::Backspace) {
             self.delete_selected();
         }
+        if pressed(none, Key::W) {
+            self.set_tool(Tool::Puppet);
+        }
         if pressed(none, Key::V) {
-            self.tool = Tool::Select;
+            self.set_tool(Tool::Select);
         }
         if pressed(none, Key::P) {
-            self.tool = Tool::AddPoint;
+            self.set_tool(Tool::AddPoint);
         }
         if pressed(none, Key::B) {
-            self.tool = Tool::AddBar;
+            self.set_tool(Tool::AddBar);
         }
         if pressed(none, Key::F) {
             self.needs_fit = true;
@@ -180,15 +223,11 @@ impl EditorApp {
             ui.menu_button("File", |ui| {
                 if ui.button("Open image…").clicked() {
                     ui.close();
-                    if let Some(path) = self.dialogs.open_image() {
-                        self.request_open(path);
-                    }
+                    self.ask_file(FileAction::OpenImage);
                 }
                 if ui.button("Open project…").clicked() {
                     ui.close();
-                    if let Some(path) = self.dialogs.open_project() {
-                        self.request_open(path);
-                    }
+                    self.ask_file(FileAction::OpenProject);
                 }
                 ui.separator();
                 if ui.button("Save project").clicked() {
@@ -203,6 +242,12 @@ impl EditorApp {
                     ui.close();
                     self.export();
                 }
+                ui.separator();
+                ui.checkbox(&mut self.builtin_dialogs, "Built-in file dialogs")
+                    .on_hover_text(
+                        "Choose files in the editor's own dialog instead of the desktop's \
+                         (used anyway where the desktop has none)",
+                    );
                 ui.separator();
                 if ui.button("Quit").clicked() {
                     ui.close();
@@ -224,6 +269,10 @@ impl EditorApp {
             ui.menu_button("Help", |ui| {
                 if ui.button("Keyboard shortcuts").clicked() {
                     self.help_open = true;
+                    ui.close();
+                }
+                if ui.button("Messages").clicked() {
+                    self.log_open = true;
                     ui.close();
                 }
             });
@@ -271,9 +320,20 @@ impl EditorApp {
     fn side_panel(&mut self, ui: &mut Ui) {
         ui.heading("Tools");
         ui.horizontal_wrapped(|ui| {
-            ui.selectable_value(&mut self.tool, Tool::Select, "Select");
-            ui.selectable_value(&mut self.tool, Tool::AddPoint, "Add point");
-            ui.selectable_value(&mut self.tool, Tool::AddBar, "Add bar");
+            let mut tool = self.tool;
+            ui.selectable_value(&mut tool, Tool::Puppet, "Puppet")
+                .on_hover_text(
+                    "Click the picture to add a handle; drag a handle to move it; \
+                 Alt-click a handle to delete it; drag empty canvas to pan",
+                );
+            ui.selectable_value(&mut tool, Tool::Select, "Select")
+                .on_hover_text("Like Puppet, but a click on the picture adds nothing");
+            ui.selectable_value(&mut tool, Tool::AddPoint, "Add point");
+            ui.selectable_value(&mut tool, Tool::AddBar, "Add bar")
+                .on_hover_text("Drag from one end of the bar to the other");
+            if tool != self.tool {
+                self.set_tool(tool);
+            }
         });
         ui.horizontal_wrapped(|ui| self.edit_buttons(ui));
         ui.horizontal(|ui| {
@@ -396,6 +456,9 @@ impl EditorApp {
                 ui.separator();
                 ui.spinner();
                 ui.label(format!("{what}… {seconds:.1} s"));
+                if ui.button("Cancel").on_hover_text("Escape").clicked() {
+                    self.cancel_job();
+                }
             }
             if let Some(message) = &self.message {
                 ui.separator();
@@ -404,9 +467,48 @@ impl EditorApp {
                 } else {
                     ui.visuals().text_color()
                 };
-                ui.colored_label(color, &message.text);
+                // One line, cut at the window's edge: the whole message is in the
+                // tooltip and in the messages window (a click opens it).
+                let label = egui::Label::new(egui::RichText::new(&message.text).color(color))
+                    .truncate()
+                    .sense(egui::Sense::click());
+                let text = message.text.clone();
+                if ui
+                    .add(label)
+                    .on_hover_text(format!("{text}\n\n(click for all messages)"))
+                    .clicked()
+                {
+                    self.log_open = true;
+                }
             }
         });
+    }
+
+    fn log_window(&mut self, ctx: &egui::Context) {
+        let mut open = self.log_open;
+        egui::Window::new("Messages")
+            .open(&mut open)
+            .default_size([560.0, 260.0])
+            .show(ctx, |ui| {
+                egui::ScrollArea::vertical()
+                    .stick_to_bottom(true)
+                    .show(ui, |ui| {
+                        for message in &self.log {
+                            let color = if message.is_error {
+                                ui.visuals().error_fg_color
+                            } else {
+                                ui.visuals().text_color()
+                            };
+                            ui.add(
+                                egui::Label::new(egui::RichText::new(&message.text).color(color))
+                                    .wrap()
+                                    .selectable(true),
+                            );
+                            ui.separator();
+                        }
+                    });
+            });
+        self.log_open = open;
     }
 
     fn help_window(&mut self, ctx: &egui::Context) {
@@ -431,11 +533,23 @@ impl EditorApp {
             return;
         };
         let mut answer = None;
-        egui::Modal::new(egui::Id::unique("unsaved changes")).show(ctx, |ui| {
-            ui.heading("Unsaved changes");
-            ui.label("The current project has changes that are not saved. Discard them?");
+        let (heading, question, yes) = match &pending {
+            Pending::Replace(_, path) => (
+                "Replace file?",
+                format!("{} exists. Replace it?", path.display()),
+                "Replace",
+            ),
+            Pending::Open(_) | Pending::Close => (
+                "Unsaved changes",
+                "The current project has changes that are not saved. Discard them?".to_owned(),
+                "Discard changes",
+            ),
+        };
+        egui::Modal::new(egui::Id::unique("question")).show(ctx, |ui| {
+            ui.heading(heading);
+            ui.label(question);
             ui.horizontal(|ui| {
-                if ui.button("Discard changes").clicked() {
+                if ui.button(yes).clicked() {
                     answer = Some(true);
                 }
                 if ui.button("Cancel").clicked() {
@@ -448,6 +562,7 @@ impl EditorApp {
                 self.pending = None;
                 match pending {
                     Pending::Open(path) => self.open_in_background(path),
+                    Pending::Replace(action, path) => self.file_chosen(action, path),
                     Pending::Close => {
                         self.allow_close = true;
                         ctx.send_viewport_cmd(egui::ViewportCommand::Close);

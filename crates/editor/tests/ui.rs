@@ -2,134 +2,22 @@
 //! pointer and keys simulated, the canvas drawn by the real wgpu paint callback on the
 //! software adapter (snapshots in `tests/snapshots`, tolerances in `kittest.toml`).
 //!
-//! File dialogs are answered by [`Scripted`] with paths in a temporary folder.
+//! File dialogs are answered by `support::Scripted` with paths in a temporary folder.
 
-use std::path::{Path, PathBuf};
+mod support;
 
-use egui::{Key, Modifiers, Pos2, Vec2};
+use std::path::Path;
+
+use egui::{Key, Modifiers, Vec2};
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use glam::DVec2;
 use project::{HandleSpec, Project};
 
-use editor::{Dialogs, EditorApp, Tool};
-
-/// Answers every file dialog with a fixed file in `dir`.
-struct Scripted {
-    dir: PathBuf,
-}
-
-impl Dialogs for Scripted {
-    fn open_image(&mut self) -> Option<PathBuf> {
-        Some(self.dir.join("lizard.png"))
-    }
-    fn open_project(&mut self) -> Option<PathBuf> {
-        Some(self.dir.join("project.json"))
-    }
-    fn save_project(&mut self, _suggested: &str) -> Option<PathBuf> {
-        Some(self.dir.join("project.json"))
-    }
-    fn export_png(&mut self, _suggested: &str) -> Option<PathBuf> {
-        Some(self.dir.join("warped.png"))
-    }
-}
-
-fn editor(dir: &Path) -> Harness<'static, EditorApp> {
-    let dir = dir.to_path_buf();
-    let mut harness = Harness::builder()
-        .with_size(Vec2::new(1200.0, 800.0))
-        .wgpu()
-        .build_eframe(move |cc| {
-            let mut app = EditorApp::new(cc, None);
-            app.set_dialogs(Box::new(Scripted { dir }));
-            app
-        });
-    harness.run();
-    harness
-}
-
-/// Where image pixel (x, y) is on screen.
-fn at(h: &Harness<'_, EditorApp>, x: f64, y: f64) -> Pos2 {
-    h.state().viewport.to_screen(DVec2::new(x, y))
-}
-
-fn click_at(h: &mut Harness<'_, EditorApp>, pos: Pos2) {
-    h.hover_at(pos);
-    h.run();
-    h.drag_at(pos);
-    h.run();
-    h.drop_at(pos);
-    h.run();
-}
-
-fn drag(h: &mut Harness<'_, EditorApp>, from: Pos2, to: Pos2, modifiers: Modifiers) {
-    h.event(egui::Event::ModifiersChanged(modifiers));
-    h.hover_at(from);
-    h.run();
-    h.event(egui::Event::PointerButton {
-        pos: from,
-        button: egui::PointerButton::Primary,
-        pressed: true,
-        modifiers,
-    });
-    h.run();
-    for i in 1..=8 {
-        h.hover_at(from + (to - from) * (i as f32 / 8.0));
-        h.run();
-    }
-    h.event(egui::Event::PointerButton {
-        pos: to,
-        button: egui::PointerButton::Primary,
-        pressed: false,
-        modifiers,
-    });
-    h.run();
-    h.remove_cursor();
-    h.event(egui::Event::ModifiersChanged(Modifiers::NONE));
-    h.run();
-}
-
-/// Steps the UI until the background job (opening, re-meshing) is in.
-fn settle(h: &mut Harness<'_, EditorApp>) {
-    let start = std::time::Instant::now();
-    while h.state().is_busy() {
-        assert!(start.elapsed().as_secs() < 120, "the job never finished");
-        h.step();
-        std::thread::sleep(std::time::Duration::from_millis(10));
-    }
-    h.run();
-}
-
-fn click_label(h: &mut Harness<'_, EditorApp>, label: &str) {
-    h.get_by_label(label).click();
-    h.step();
-    if h.state().is_busy() {
-        // The click started a job; the test waits for it where it needs to.
-        return;
-    }
-    h.run();
-}
-
-fn handles(h: &Harness<'_, EditorApp>) -> Vec<HandleSpec> {
-    h.state()
-        .document()
-        .map(|d| d.project().handles.clone())
-        .unwrap_or_default()
-}
-
-fn translate(h: &HandleSpec) -> DVec2 {
-    match h {
-        HandleSpec::Point { translate, .. } => DVec2::from(*translate),
-        HandleSpec::Bar { .. } => panic!("a point handle"),
-    }
-}
-
-/// Writes the built-in picture to `dir/lizard.png`.
-fn write_lizard(dir: &Path) -> PathBuf {
-    let path = dir.join("lizard.png");
-    std::fs::write(&path, pipeline::DEFAULT_IMAGE).expect("write the picture");
-    path
-}
+use editor::{EditorApp, Tool};
+use support::{
+    Dropped, at, click_at, click_label, drag, editor, handles, settle, translate, write_lizard,
+};
 
 #[test]
 fn the_editor_opens_on_the_built_in_picture() {
@@ -347,13 +235,19 @@ fn re_meshing_runs_in_the_background_and_undoes() {
     // While it runs, edits are refused and the canvas says what is going on.
     assert!(!h.state_mut().edit(editor::Edit::Clear));
     h.step();
-    h.get_by_label_contains("Meshing at 5000 vertices");
+    assert!(
+        h.query_all_by_label_contains("Meshing at 5000 vertices")
+            .next()
+            .is_some()
+    );
     settle(&mut h);
     let after = vertices(&h);
     assert!((4500..5500).contains(&after), "{after} vertices");
     assert_eq!(handles(&h).len(), 7);
     h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
-    h.run();
+    h.step();
+    assert!(h.state().is_busy(), "the undo re-meshes on the worker too");
+    settle(&mut h);
     assert_eq!(vertices(&h), before, "undo brings the old mesh back");
 }
 
@@ -387,19 +281,6 @@ fn auto_rotation_turns_the_other_points_during_a_drag() {
     h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
     h.run();
     assert!(rotations(&h).iter().all(|r| *r == 0.0));
-}
-
-/// A file dropped on the window, as the windowing layer reports it.
-#[derive(Debug)]
-struct Dropped(PathBuf);
-
-impl egui::DroppedFile for Dropped {
-    fn path(&self) -> &Path {
-        &self.0
-    }
-    fn bytes(&self) -> Result<Vec<u8>, String> {
-        std::fs::read(&self.0).map_err(|e| e.to_string())
-    }
 }
 
 #[test]

@@ -1,0 +1,479 @@
+//! The monkey: the real editor driven by a seeded random sequence of everything a user
+//! can do — every shortcut, toolbar button and checkbox, clicks, drags (plain, Alt,
+//! Shift, middle), Delete or undo in the middle of a drag, new parameters and
+//! densities, opening, saving, exporting, dropped files, cancelled jobs — in every
+//! state (no handles, one, many, after Clear, during a background job). After every
+//! action the editor must not have panicked and [`EditorApp::sanity_check`] must
+//! hold.
+//!
+//! CI runs a short walk. A long one:
+//! `MONKEY_ACTIONS=5000 MONKEY_SEEDS=1,2,3,4,5,6,7,8 cargo test --release -p editor
+//! --test monkey -- --nocapture` (a failing walk prints its seed and last actions;
+//! `MONKEY_SEEDS=<seed>` replays it).
+
+mod support;
+
+use std::panic::AssertUnwindSafe;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use egui::{Key, Modifiers, Pos2, Vec2};
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use glam::DVec2;
+use project::MetricChoice;
+
+use editor::{Answer, Dialogs, Edit, EditorApp, FileAction};
+use support::{Dropped, build};
+
+/// A small, seedable generator (xorshift64*), so a walk replays exactly.
+struct Rng(u64);
+
+impl Rng {
+    fn new(seed: u64) -> Self {
+        Self(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1)
+    }
+
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
+    }
+
+    /// Uniform in `0..n`.
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n as u64) as usize
+    }
+
+    /// Uniform in `[0, 1)`.
+    fn unit(&mut self) -> f32 {
+        (self.next() >> 40) as f32 / (1u64 << 24) as f32
+    }
+
+    fn chance(&mut self, p: f32) -> bool {
+        self.unit() < p
+    }
+
+    fn pick<'a, T>(&mut self, items: &'a [T]) -> &'a T {
+        &items[self.below(items.len())]
+    }
+}
+
+/// Answers file dialogs with files in a folder (some missing, some broken), or, for
+/// some walks, as a desktop without dialogs (the built-in one opens).
+struct MonkeyDialogs {
+    dir: PathBuf,
+    rng: Rng,
+    desktop: bool,
+}
+
+impl Dialogs for MonkeyDialogs {
+    fn ask(&mut self, action: FileAction, _suggested: &str) -> Answer {
+        if !self.desktop {
+            return Answer::Unavailable;
+        }
+        if self.rng.chance(0.15) {
+            return Answer::Cancelled;
+        }
+        let names: &[&str] = match action {
+            FileAction::OpenImage => &["small.png", "lizard.png", "corrupt.png", "missing.png"],
+            FileAction::OpenProject => &["project.json", "broken.json", "missing.json"],
+            FileAction::SaveProject => &["project.json", "project.json", "no-folder/p.json"],
+            FileAction::ExportPng => &["warped.png", "no-folder/w.png"],
+        };
+        Answer::Chosen(self.dir.join(self.rng.pick(names)))
+    }
+}
+
+/// The files the walk opens and drops.
+fn write_files(dir: &Path) {
+    std::fs::write(dir.join("lizard.png"), pipeline::DEFAULT_IMAGE).expect("write");
+    std::fs::write(dir.join("corrupt.png"), b"\x89PNG but not really").expect("write");
+    std::fs::write(dir.join("broken.json"), b"{\"version\": 1, \"handles\": [").expect("write");
+    // A small cut-out: a disc with a hole and a stray speck.
+    let small = image::RgbaImage::from_fn(120, 90, |x, y| {
+        let d = (x as f32 - 60.0).hypot(y as f32 - 45.0);
+        let inside = (d < 40.0 && d > 8.0) || (x == 5 && y == 5);
+        image::Rgba([
+            200,
+            (x * 2) as u8,
+            (y * 2) as u8,
+            if inside { 255 } else { 0 },
+        ])
+    });
+    small.save(dir.join("small.png")).expect("write");
+}
+
+struct Monkey {
+    h: Harness<'static, EditorApp>,
+    rng: Rng,
+    dir: PathBuf,
+    trail: Vec<String>,
+}
+
+const LABELS: &[&str] = &[
+    "Puppet",
+    "Select",
+    "Add point",
+    "Add bar",
+    "Delete handle",
+    "Clear all handles",
+    "Reset pose",
+    "Undo",
+    "Redo",
+    "Fit to window",
+    "Auto-rotate points",
+    "Fixed boundary",
+    "Show mesh",
+    "Virtual handles",
+    "Voronoi cells",
+    "Dual graph",
+    "Weight heat map",
+    "Fold-overs",
+    "Weights under cursor",
+    "Cancel",
+    "Discard changes",
+    "Replace",
+    "Save",
+    "Open",
+];
+
+const KEYS: &[(Modifiers, Key)] = &[
+    (Modifiers::NONE, Key::W),
+    (Modifiers::NONE, Key::V),
+    (Modifiers::NONE, Key::P),
+    (Modifiers::NONE, Key::B),
+    (Modifiers::NONE, Key::F),
+    (Modifiers::NONE, Key::M),
+    (Modifiers::NONE, Key::H),
+    (Modifiers::NONE, Key::C),
+    (Modifiers::NONE, Key::G),
+    (Modifiers::NONE, Key::N),
+    (Modifiers::SHIFT, Key::N),
+    (Modifiers::NONE, Key::Delete),
+    (Modifiers::NONE, Key::Backspace),
+    (Modifiers::NONE, Key::Escape),
+    (Modifiers::NONE, Key::F1),
+    (Modifiers::COMMAND, Key::Z),
+    (Modifiers::COMMAND, Key::Y),
+    (Modifiers::COMMAND.plus(Modifiers::SHIFT), Key::Z),
+    (Modifiers::COMMAND, Key::S),
+    (Modifiers::COMMAND.plus(Modifiers::SHIFT), Key::S),
+    (Modifiers::COMMAND, Key::E),
+    (Modifiers::COMMAND, Key::O),
+    (Modifiers::COMMAND.plus(Modifiers::SHIFT), Key::O),
+];
+
+impl Monkey {
+    fn frames(&mut self, n: usize) {
+        for _ in 0..n {
+            self.h.step();
+        }
+    }
+
+    /// A point on the canvas: often on or near a handle, else anywhere.
+    fn somewhere(&mut self) -> Pos2 {
+        let app = self.h.state();
+        let canvas = app.viewport.canvas;
+        let handles: Vec<DVec2> = app
+            .document()
+            .map(|d| d.project().handles.iter().flat_map(editor::posed).collect())
+            .unwrap_or_default();
+        if !handles.is_empty() && self.rng.chance(0.5) {
+            let p = *self.rng.pick(&handles);
+            let jitter = Vec2::new(self.rng.unit() - 0.5, self.rng.unit() - 0.5) * 8.0;
+            return app.viewport.to_screen(p) + jitter;
+        }
+        // Slightly beyond the canvas now and then.
+        let r = canvas.expand(20.0);
+        Pos2::new(
+            r.min.x + self.rng.unit() * r.width(),
+            r.min.y + self.rng.unit() * r.height(),
+        )
+    }
+
+    fn modifiers(&mut self) -> Modifiers {
+        *self.rng.pick(&[
+            Modifiers::NONE,
+            Modifiers::NONE,
+            Modifiers::NONE,
+            Modifiers::ALT,
+            Modifiers::SHIFT,
+        ])
+    }
+
+    fn button(&self, pos: Pos2, button: egui::PointerButton, pressed: bool, modifiers: Modifiers) {
+        self.h.event(egui::Event::PointerButton {
+            pos,
+            button,
+            pressed,
+            modifiers,
+        });
+    }
+
+    /// One random action; returns what it did.
+    fn act(&mut self) -> String {
+        match self.rng.below(100) {
+            0..=24 => {
+                let (modifiers, key) = *self.rng.pick(KEYS);
+                self.h.key_press_modifiers(modifiers, key);
+                self.frames(2);
+                format!("key {modifiers:?} {key:?}")
+            }
+            25..=39 => {
+                let label = *self.rng.pick(LABELS);
+                // A label can show twice (the Edit menu and the side panel).
+                let count = self.h.query_all_by_label(label).count();
+                let found = count > 0;
+                if found {
+                    let which = self.rng.below(count);
+                    if let Some(node) = self.h.query_all_by_label(label).nth(which) {
+                        node.click();
+                    }
+                }
+                self.frames(2);
+                format!("click {label:?}{}", if found { "" } else { " (absent)" })
+            }
+            40..=54 => {
+                let pos = self.somewhere();
+                let modifiers = self.modifiers();
+                self.h.event(egui::Event::ModifiersChanged(modifiers));
+                self.h.hover_at(pos);
+                self.frames(1);
+                self.button(pos, egui::PointerButton::Primary, true, modifiers);
+                self.frames(1);
+                self.button(pos, egui::PointerButton::Primary, false, modifiers);
+                self.h.event(egui::Event::ModifiersChanged(Modifiers::NONE));
+                self.frames(2);
+                format!("click {pos:?} {modifiers:?}")
+            }
+            55..=79 => self.drag(),
+            80..=84 => {
+                let pos = self.somewhere();
+                self.h.hover_at(pos);
+                self.h.event(egui::Event::MouseWheel {
+                    unit: egui::MouseWheelUnit::Point,
+                    delta: Vec2::new(0.0, (self.rng.unit() - 0.5) * 400.0),
+                    phase: egui::TouchPhase::Move,
+                    modifiers: Modifiers::NONE,
+                    source: egui::MouseWheelSource::Wheel,
+                });
+                self.frames(2);
+                format!("wheel at {pos:?}")
+            }
+            85..=89 => self.settings(),
+            90..=92 => {
+                let name = *self
+                    .rng
+                    .pick(&["small.png", "lizard.png", "corrupt.png", "nope.png"]);
+                let path = self.dir.join(name);
+                self.h
+                    .input_mut()
+                    .dropped_files
+                    .push(std::sync::Arc::new(Dropped(path)));
+                self.frames(2);
+                format!("drop {name}")
+            }
+            93..=96 => {
+                // Let a running job finish (or not start anything).
+                let start = Instant::now();
+                while self.h.state().is_busy() && start.elapsed().as_secs() < 60 {
+                    self.h.step();
+                    std::thread::sleep(std::time::Duration::from_millis(5));
+                }
+                self.frames(1);
+                "wait for the job".to_owned()
+            }
+            _ => {
+                let size = *self.rng.pick(&[
+                    Vec2::new(1200.0, 800.0),
+                    Vec2::new(700.0, 500.0),
+                    Vec2::new(1500.0, 950.0),
+                ]);
+                self.h.set_size(size);
+                self.frames(2);
+                format!("window {size:?}")
+            }
+        }
+    }
+
+    /// A drag with a random button, modifiers and length; sometimes Delete, undo or a
+    /// tool switch arrives in the middle, sometimes it ends off the canvas.
+    fn drag(&mut self) -> String {
+        let from = self.somewhere();
+        let to = if self.rng.chance(0.8) {
+            from + Vec2::new(self.rng.unit() - 0.5, self.rng.unit() - 0.5) * 300.0
+        } else {
+            self.somewhere()
+        };
+        let button = if self.rng.chance(0.1) {
+            egui::PointerButton::Middle
+        } else {
+            egui::PointerButton::Primary
+        };
+        let modifiers = self.modifiers();
+        let steps = 2 + self.rng.below(8);
+        let interrupt = if self.rng.chance(0.4) {
+            Some(*self.rng.pick(&[
+                (Modifiers::NONE, Key::Delete),
+                (Modifiers::NONE, Key::Delete),
+                (Modifiers::COMMAND, Key::Z),
+                (Modifiers::COMMAND.plus(Modifiers::SHIFT), Key::Z),
+                (Modifiers::NONE, Key::B),
+                (Modifiers::NONE, Key::Escape),
+                (Modifiers::NONE, Key::C),
+                (Modifiers::COMMAND, Key::O),
+            ]))
+        } else {
+            None
+        };
+        let at_step = self.rng.below(steps - 1);
+        // Several events in one frame now and then: a quick gesture.
+        let quick = self.rng.chance(0.2);
+        self.h.event(egui::Event::ModifiersChanged(modifiers));
+        self.h.hover_at(from);
+        if !quick {
+            self.frames(1);
+        }
+        self.button(from, button, true, modifiers);
+        for i in 1..=steps {
+            self.h
+                .hover_at(from + (to - from) * (i as f32 / steps as f32));
+            if !quick {
+                self.frames(1);
+            }
+            if i - 1 == at_step
+                && let Some((m, k)) = interrupt
+            {
+                self.h.key_press_modifiers(m, k);
+                self.frames(1);
+            }
+        }
+        self.button(to, button, false, modifiers);
+        self.h.event(egui::Event::ModifiersChanged(Modifiers::NONE));
+        self.frames(2);
+        format!(
+            "drag {button:?} {from:?} -> {to:?} {modifiers:?} in {steps} quick={quick} interrupt={interrupt:?}"
+        )
+    }
+
+    /// New weighting parameters, as the side panel applies them.
+    fn settings(&mut self) -> String {
+        let Some(doc) = self.h.state().document() else {
+            return "settings (no document)".to_owned();
+        };
+        let mut s = doc.settings();
+        match self.rng.below(6) {
+            0 => s.alpha = f64::from(self.rng.unit()),
+            1 => s.degree = 5 + self.rng.below(21) as u32,
+            2 => s.fixed_boundary = !s.fixed_boundary,
+            3 => {
+                s.metric = *self.rng.pick(&[
+                    MetricChoice::Auto,
+                    MetricChoice::Euclidean,
+                    MetricChoice::Intrinsic,
+                ])
+            }
+            _ => s.density = *self.rng.pick(&[500, 1500, 3000, 6000]),
+        }
+        let applied = self.h.state_mut().edit(Edit::Settings(s));
+        self.frames(2);
+        format!("settings {s:?} applied={applied}")
+    }
+}
+
+fn walk(seed: u64, actions: usize) {
+    let dir = tempfile::tempdir().expect("temp dir");
+    write_files(dir.path());
+    let mut rng = Rng::new(seed);
+    let dialogs = MonkeyDialogs {
+        dir: dir.path().to_path_buf(),
+        rng: Rng::new(seed ^ 0xd1a1),
+        desktop: !rng.chance(0.3),
+    };
+    let gpu = seed.is_multiple_of(4);
+    // The built-in dialog's text fields carry no accessible names.
+    let builder = Harness::builder()
+        .with_accessibility_check(false)
+        .with_max_steps(10_000);
+    let h = build(builder, Box::new(dialogs), gpu);
+    let mut monkey = Monkey {
+        h,
+        rng,
+        dir: dir.path().to_path_buf(),
+        trail: Vec::new(),
+    };
+    // Start smaller than the built-in 20k vertices now and then, to walk faster.
+    if monkey.rng.chance(0.5) {
+        let mut s = monkey.h.state().document().expect("built-in").settings();
+        s.density = 3000;
+        assert!(monkey.h.state_mut().edit(Edit::Settings(s)));
+    }
+    let clock = Instant::now();
+    for step in 0..actions {
+        let result = std::panic::catch_unwind(AssertUnwindSafe(|| {
+            let what = monkey.act();
+            monkey.trail.push(what);
+            monkey.h.state().sanity_check()
+        }));
+        let failure = match result {
+            Ok(Ok(())) => None,
+            Ok(Err(e)) => Some(format!("{e:#}")),
+            Err(panic) => Some(
+                panic
+                    .downcast_ref::<String>()
+                    .cloned()
+                    .or_else(|| panic.downcast_ref::<&str>().map(|s| (*s).to_owned()))
+                    .unwrap_or_else(|| "a panic".to_owned()),
+            ),
+        };
+        if let Some(failure) = failure {
+            let from = monkey.trail.len().saturating_sub(25);
+            panic!(
+                "seed {seed}, action {step}: {failure}\nlast actions:\n  {}",
+                monkey.trail[from..].join("\n  ")
+            );
+        }
+    }
+    // Walk the whole history back and forth.
+    let walk_history = |monkey: &mut Monkey, back: bool| {
+        for _ in 0..600 {
+            while monkey.h.state().is_busy() {
+                monkey.h.step();
+                std::thread::sleep(std::time::Duration::from_millis(5));
+            }
+            if back {
+                monkey.h.state_mut().undo();
+            } else {
+                monkey.h.state_mut().redo();
+            }
+            monkey.frames(1);
+            if let Err(e) = monkey.h.state().sanity_check() {
+                panic!("seed {seed}, walking the history: {e:#}");
+            }
+        }
+    };
+    walk_history(&mut monkey, true);
+    walk_history(&mut monkey, false);
+    let seconds = clock.elapsed().as_secs_f64();
+    println!(
+        "monkey seed {seed}: {actions} actions in {seconds:.1} s ({:.0} actions/s), gpu={gpu}",
+        actions as f64 / seconds
+    );
+}
+
+fn env_list(name: &str, default: &[u64]) -> Vec<u64> {
+    std::env::var(name).map_or_else(
+        |_| default.to_vec(),
+        |v| v.split(',').filter_map(|s| s.trim().parse().ok()).collect(),
+    )
+}
+
+#[test]
+fn the_monkey_finds_nothing() {
+    let actions = env_list("MONKEY_ACTIONS", &[250])[0] as usize;
+    for seed in env_list("MONKEY_SEEDS", &[1, 2, 4]) {
+        walk(seed, actions);
+    }
+}
