@@ -130,6 +130,8 @@ pub struct EditorApp {
     pub(crate) drag: Option<HandleDrag>,
     pub(crate) bar_start: Option<DVec2>,
     pub(crate) context_point: Option<DVec2>,
+    /// The handle the right-click menu was opened on, and its index then.
+    pub(crate) context_handle: Option<(usize, HandleSpec)>,
     pub(crate) panning: bool,
     /// Overlays.
     pub show: Show,
@@ -151,6 +153,9 @@ pub struct EditorApp {
     /// The keyboard shortcuts window is open.
     pub help_open: bool,
     pub(crate) dialogs: Box<dyn Dialogs>,
+    /// Rigs with more samples than this are rebuilt on the worker thread (new
+    /// parameters, an undo that rebuilds), so the window keeps answering.
+    pub large_mesh: usize,
     /// Use the built-in file dialog (the desktop has none, or the user prefers it).
     pub builtin_dialogs: bool,
     pub(crate) file_dialog: Option<BuiltinDialog>,
@@ -231,6 +236,7 @@ impl EditorApp {
             drag: None,
             bar_start: None,
             context_point: None,
+            context_handle: None,
             panning: false,
             show: Show::default(),
             hover_readout: None,
@@ -242,6 +248,7 @@ impl EditorApp {
             allow_close: false,
             help_open: false,
             dialogs: Box::new(NativeDialogs::new()),
+            large_mesh: 100_000,
             builtin_dialogs: false,
             file_dialog: None,
             gpu: GpuFrame::default(),
@@ -366,11 +373,25 @@ impl EditorApp {
         // The document changes under any gesture in progress: a drag ends here (as
         // its own undo step), so its handle index cannot go stale.
         self.end_gesture();
-        if let (Edit::Settings(settings), Some(doc)) = (&edit, &self.doc)
-            && settings.density != doc.settings().density
-        {
-            self.rebuild_in_background(*settings);
-            return true;
+        if let (Edit::Settings(settings), Some(doc)) = (&edit, &self.doc) {
+            if settings.density != doc.settings().density {
+                self.rebuild_in_background(*settings);
+                return true;
+            }
+            if *settings != doc.settings() && doc.rig().domain().len() > self.large_mesh {
+                // A rebuild of a large rig would stall the window: on the worker.
+                let before = doc.snapshot();
+                let mut copy = doc.clone();
+                let label = "Re-weighting".to_owned();
+                self.start_job(label, CancelFlag::default(), move || {
+                    let document = copy.apply(edit).map(|()| copy);
+                    Outcome::Rebuilt {
+                        cause: Rebuild::Edit { before },
+                        document,
+                    }
+                });
+                return true;
+            }
         }
         let Some(doc) = &mut self.doc else {
             return false;
@@ -538,6 +559,20 @@ impl EditorApp {
             // A new mesh: built on the worker, like the same change from the slider.
             let target = target.clone();
             self.restore_in_background(back, target);
+            return;
+        }
+        if doc.rig().domain().len() > self.large_mesh && doc.rebuilds_for(target, true) {
+            // A rebuild of a large rig: on the worker, on a copy.
+            let target = target.clone();
+            let mut copy = doc.clone();
+            let label = if back { "Undoing" } else { "Redoing" }.to_owned();
+            self.start_job(label, CancelFlag::default(), move || {
+                let document = copy.undo_to(target).map(|()| copy);
+                Outcome::Rebuilt {
+                    cause: Rebuild::History { back },
+                    document,
+                }
+            });
             return;
         }
         let current = doc.snapshot();
@@ -724,14 +759,19 @@ impl EditorApp {
                 let stats = doc.rig().stats();
                 let ms = doc.last_update_ms;
                 let handles = doc.project().handles.len();
+                let remeshed = self
+                    .doc
+                    .as_ref()
+                    .is_none_or(|old| old.settings().density != doc.settings().density);
                 self.doc = Some(doc);
                 if self.selected.is_some_and(|s| s >= handles) {
                     self.selected = None;
                 }
                 self.dirty = true;
                 self.settings_draft = None;
+                let what = if remeshed { "re-meshed" } else { "rebuilt" };
                 self.info(format!(
-                    "re-meshed: {} vertices, weights in {ms:.0} ms",
+                    "{what}: {} vertices, weights in {ms:.0} ms",
                     stats.samples
                 ));
             }
@@ -739,7 +779,7 @@ impl EditorApp {
                 document: Err(e), ..
             } => {
                 self.settings_draft = None;
-                self.error(&e.context("cannot re-mesh"));
+                self.error(&e.context("cannot rebuild the weights"));
             }
             Outcome::Exported {
                 path,
@@ -1001,8 +1041,10 @@ impl EditorApp {
             };
             seen.cells = weights;
         }
-        if self.show.dual_graph && self.dual_graph.0 != weights {
-            self.dual_graph = (weights, Arc::new(doc.rig().dual_graph()));
+        // Keyed by the GPU mesh's version, which no other document shares.
+        let mesh_version = gpu.mesh.version;
+        if self.show.dual_graph && self.dual_graph.0 != mesh_version {
+            self.dual_graph = (mesh_version, Arc::new(doc.rig().dual_graph()));
         }
         seen.weights = weights;
         seen.pose = doc.pose_version;

@@ -276,6 +276,10 @@ impl EditorApp {
         {
             self.selected = self.hit(pos).map(|(i, _)| i);
             self.context_point = Some(self.viewport.to_image(pos));
+            self.context_handle = self.selected.and_then(|i| {
+                let handle = self.doc.as_ref()?.project().handles.get(i)?.clone();
+                Some((i, handle))
+            });
         }
         response.context_menu(|ui| self.context_menu(ui));
         let cursor = if self.panning || self.drag.is_some() {
@@ -292,18 +296,28 @@ impl EditorApp {
         }
     }
 
+    /// The right-click menu. It stays open across frames, so it acts on the handle it
+    /// was opened on only if that handle is still where it was (an undo or a new
+    /// document may have changed the list since).
     fn context_menu(&mut self, ui: &mut Ui) {
-        if let Some(i) = self.selected {
+        if let Some((i, opened_on)) = self.context_handle.clone() {
+            let still_there = self
+                .doc
+                .as_ref()
+                .and_then(|d| d.project().handles.get(i))
+                .is_some_and(|h| crate::document::same_rest(h, &opened_on));
+            if !still_there {
+                ui.label("(this handle is gone)");
+                return;
+            }
             if ui.button("Delete handle").clicked() {
                 self.selected = Some(i);
                 self.delete_selected();
                 ui.close();
             }
             if ui.button("Reset handle pose").clicked() {
-                if let Some(h) = self.doc.as_ref().and_then(|d| d.project().handles.get(i)) {
-                    let rest = crate::document::at_rest(h);
-                    let _ = self.edit(crate::document::Edit::Pose(i, rest));
-                }
+                let rest = crate::document::at_rest(&opened_on);
+                let _ = self.edit(crate::document::Edit::Pose(i, rest));
                 ui.close();
             }
         } else if let Some(at) = self.context_point

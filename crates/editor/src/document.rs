@@ -71,7 +71,9 @@ pub enum Edit {
     Settings(Settings),
 }
 
-/// An open picture with its rig.
+/// An open picture with its rig. Cloning copies the rig (tens of megabytes at a
+/// million vertices): the editor does it to rebuild a large rig on a worker thread.
+#[derive(Clone)]
 pub struct Document {
     /// The rig file as it would be saved (virtual handles are filled in on save).
     project: Project,
@@ -186,6 +188,23 @@ impl Document {
     /// The weighting parameters.
     pub fn settings(&self) -> Settings {
         Settings::of(&self.project)
+    }
+
+    /// Whether going to `project` (same picture and density) rebuilds the rig rather
+    /// than updating it: new weighting parameters, or — for a step through the
+    /// history, `exact` — another set of handles.
+    pub fn rebuilds_for(&self, project: &Project, exact: bool) -> bool {
+        let new = Settings::of(project);
+        if new != self.settings() {
+            return true;
+        }
+        exact
+            && (project.handles.len() != self.project.handles.len()
+                || project
+                    .handles
+                    .iter()
+                    .zip(&self.project.handles)
+                    .any(|(a, b)| !same_rest(a, b)))
     }
 
     /// The rig file to save next to `path`: the picture's path relative to the file's

@@ -151,6 +151,37 @@ fn undo_across_a_density_change_re_meshes_on_the_worker() {
 }
 
 #[test]
+fn rebuilding_a_large_rig_runs_on_the_worker() {
+    let mut h = editor_with(Box::new(NoDesktop), false);
+    // Treat the built-in 20k-vertex rig as large.
+    h.state_mut().large_mesh = 1000;
+    let alpha = |h: &Harness<'_, EditorApp>| h.state().document().map(|d| d.settings().alpha);
+    let mut settings = h.state().document().expect("a document").settings();
+    settings.alpha = 0.25;
+    assert!(h.state_mut().edit(Edit::Settings(settings)));
+    assert!(h.state().is_busy(), "new parameters rebuild on the worker");
+    assert_eq!(alpha(&h), Some(1.0));
+    settle(&mut h);
+    assert_eq!(alpha(&h), Some(0.25));
+    h.state_mut().undo();
+    assert!(h.state().is_busy(), "so does their undo");
+    settle(&mut h);
+    assert_eq!(alpha(&h), Some(1.0));
+    // Undoing a removal rebuilds with the old virtual handles: on the worker too.
+    let before = h.state().document().expect("doc").rig().virtual_vertices();
+    assert!(h.state_mut().edit(Edit::Remove(0)));
+    h.state_mut().undo();
+    assert!(h.state().is_busy());
+    settle(&mut h);
+    assert_eq!(handles(&h).len(), 7);
+    assert_eq!(
+        h.state().document().expect("doc").rig().virtual_vertices(),
+        before
+    );
+    h.state().sanity_check().expect("sane");
+}
+
+#[test]
 fn a_quick_bar_stroke_makes_a_bar() {
     let mut h = editor_with(Box::new(NoDesktop), false);
     // The first stroke right after choosing the tool, its press, moves and release
