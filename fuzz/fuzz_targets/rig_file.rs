@@ -1,0 +1,4 @@
+//! Fuzz target: see `fuzzing::rig_file` for what it checks.
+#![no_main]
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| fuzzing::rig_file(data));
