@@ -8,7 +8,9 @@ use std::fs;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use support::{c2warp, data, difference, fails, fails_within, load, mkfifo, ok, render_args};
+use support::{
+    c2warp, c2warp_within, data, difference, fails, fails_within, load, mkfifo, ok, render_args,
+};
 
 fn os(s: &str) -> &OsStr {
     OsStr::new(s)
@@ -758,6 +760,24 @@ fn outputs_that_are_not_regular_files_are_written_through() {
             .expect("stat")
             .file_type()
             .is_char_device()
+    );
+}
+
+#[test]
+fn a_good_gpu_run_prints_no_error_without_xdg_runtime_dir() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("gpu.png");
+    let (image, rig) = (data("dino.png"), data("dino-rig.json"));
+    let args = render_args(&image, &rig, &out, &["--gpu"]);
+    let run = c2warp_within(&args, Duration::from_secs(300), |command| {
+        command.env_remove("XDG_RUNTIME_DIR");
+    });
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{stderr}");
+    assert!(!stderr.to_lowercase().contains("error"), "{stderr}");
+    assert_eq!(
+        load(&out).dimensions(),
+        load(&data("dino.png")).dimensions()
     );
 }
 

@@ -3,6 +3,7 @@
 mod bench;
 mod export;
 mod progress;
+mod runtime_dir;
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -106,6 +107,12 @@ struct Source {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // Before any thread starts: the GPU path's Vulkan layer complains on stderr
+    // without it (see runtime_dir.rs).
+    let _runtime_dir = match &cli.command {
+        Some(Command::Render { gpu: true, .. }) => runtime_dir::ensure(),
+        _ => None,
+    };
     let result = match cli.command {
         None => editor::run(cli.file),
         Some(command) => run(command),
