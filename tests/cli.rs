@@ -5,8 +5,12 @@ mod support;
 
 use std::ffi::OsStr;
 use std::fs;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
-use support::{c2warp, data, difference, fails, load, ok, render_args};
+use support::{
+    c2warp, c2warp_within, data, difference, fails, fails_within, load, mkfifo, ok, render_args,
+};
 
 fn os(s: &str) -> &OsStr {
     OsStr::new(s)
@@ -381,4 +385,473 @@ fn the_editor_exports_what_the_command_renders() {
     let rendered = dir.path().join("rendered.png");
     ok(&render_args(&picture, &project, &rendered, &[]));
     assert!(load(&exported) == load(&rendered), "identical pixels");
+}
+
+/// How long a refusal may take at most (a hang or a 2 GB read takes far longer).
+const PROMPT: Duration = Duration::from_secs(20);
+
+/// The arguments of `c2warp weights --mesh MESH --rig RIG -o OUT`.
+fn weights_mesh_args<'a>(mesh: &'a Path, rig: &'a Path, out: &'a Path) -> Vec<&'a OsStr> {
+    vec![
+        os("weights"),
+        os("--mesh"),
+        mesh.as_os_str(),
+        os("--rig"),
+        rig.as_os_str(),
+        os("-o"),
+        out.as_os_str(),
+    ]
+}
+
+/// `dino.png` re-encoded as a JPEG in `dir`.
+fn dino_jpeg(dir: &Path) -> (PathBuf, Vec<u8>) {
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    image::DynamicImage::ImageRgb8(
+        image::DynamicImage::ImageRgba8(load(&data("dino.png"))).to_rgb8(),
+    )
+    .write_to(&mut bytes, image::ImageFormat::Jpeg)
+    .expect("encode a JPEG");
+    let path = dir.join("dino.jpg");
+    fs::write(&path, bytes.get_ref()).expect("write");
+    (path, bytes.into_inner())
+}
+
+#[test]
+fn inputs_that_are_not_regular_files_are_refused_at_once() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    let out = d.join("out.png");
+    fs::write(&out, b"precious").expect("write");
+    let (dino, rig) = (data("dino.png"), data("dino-rig.json"));
+    let fifo = d.join("fifo");
+    mkfifo(&fifo);
+    // A rig file of 52.4 MB (sparse: nothing is written).
+    let big = d.join("big.json");
+    fs::File::create(&big)
+        .and_then(|f| f.set_len(52_400_000))
+        .expect("a sparse file");
+    let zero = PathBuf::from("/dev/zero");
+    let cases = [
+        (
+            &fifo,
+            &rig,
+            format!("image {} is not a regular file (a FIFO)", fifo.display()),
+        ),
+        (
+            &dino,
+            &fifo,
+            format!("rig file {} is not a regular file (a FIFO)", fifo.display()),
+        ),
+        (
+            &zero,
+            &rig,
+            "image /dev/zero is not a regular file (a character device)".into(),
+        ),
+        (
+            &dino,
+            &zero,
+            "rig file /dev/zero is not a regular file (a character device)".into(),
+        ),
+        (
+            &dino,
+            &big,
+            format!(
+                "rig file {} is 52.4 MB; rig files over 8 MiB are refused",
+                big.display()
+            ),
+        ),
+    ];
+    for (image, rig, expected) in cases {
+        let start = Instant::now();
+        let line = fails_within(&render_args(image, rig, &out, &[]), PROMPT);
+        assert_eq!(line, format!("error: {expected}"));
+        assert!(
+            start.elapsed() < Duration::from_secs(5),
+            "{:?}",
+            start.elapsed()
+        );
+        assert_eq!(
+            fs::read(&out).expect("read"),
+            b"precious",
+            "output was touched"
+        );
+    }
+    // The mesh of `weights` and `bench` too.
+    for mesh in [&fifo, &zero] {
+        let line = fails_within(&weights_mesh_args(mesh, &rig, &out), PROMPT);
+        assert!(line.contains("is not a regular file"), "{line}");
+        let line = fails_within(
+            &[
+                os("bench"),
+                os("--mesh"),
+                mesh.as_os_str(),
+                os("--rig"),
+                rig.as_os_str(),
+            ],
+            PROMPT,
+        );
+        assert!(line.contains("is not a regular file"), "{line}");
+    }
+}
+
+#[test]
+fn a_rig_file_may_start_with_a_byte_order_mark() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let rig = dir.path().join("bom.json");
+    let mut text = "\u{feff}".as_bytes().to_vec();
+    text.extend(fs::read(data("opaque-identity-rig.json")).expect("read"));
+    fs::write(&rig, text).expect("write");
+    let out = dir.path().join("same.png");
+    ok(&render_args(&data("opaque.png"), &rig, &out, &[]));
+    assert_eq!(load(&out), load(&data("opaque.png")));
+}
+
+#[test]
+fn density_zero_is_refused_alike_from_the_rig_and_the_command_line() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("out.png");
+    let rig = dir.path().join("zero.json");
+    fs::write(
+        &rig,
+        r#"{"version":1,"density":0,"handles":[{"type":"point","rest":[60,60]}]}"#,
+    )
+    .expect("write rig");
+    let from_rig = fails(&render_args(&data("dino.png"), &rig, &out, &[]));
+    let rule = "density must be between 16 and 4000000 vertices, got 0";
+    assert_eq!(
+        from_rig,
+        format!("error: rig file {}: {rule}", rig.display())
+    );
+    let good = data("dino-rig.json");
+    for density in ["0", "4000001"] {
+        let line = fails(&render_args(
+            &data("dino.png"),
+            &good,
+            &out,
+            &["--density", density],
+        ));
+        let rule = rule.replace("got 0", &format!("got {density}"));
+        assert_eq!(line, format!("error: {rule}"));
+        let line = fails(&[
+            os("weights"),
+            os("--image"),
+            data("dino.png").as_os_str(),
+            os("--density"),
+            os(density),
+            os("--rig"),
+            good.as_os_str(),
+            os("-o"),
+            out.as_os_str(),
+        ]);
+        assert_eq!(line, format!("error: {rule}"));
+    }
+    assert!(!out.exists());
+}
+
+#[test]
+fn a_mesh_that_is_not_obj_says_so() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    let out = d.join("weights.json");
+    let rig = data("dino-rig.json");
+    let write = |name: &str, bytes: &[u8]| {
+        let p = d.join(name);
+        fs::write(&p, bytes).expect("write");
+        p
+    };
+    let empty = write("empty.obj", b"");
+    let text = write("notes.obj", b"hello\nworld\n");
+    let no_faces = write("points.obj", b"v 0 0\nv 10 0\nv 0 10\n");
+    let cases = [
+        (
+            empty.clone(),
+            format!("{} is not an OBJ mesh (it is empty)", empty.display()),
+        ),
+        (
+            data("dino.png"),
+            format!(
+                "{} is not an OBJ mesh (it is not text)",
+                data("dino.png").display()
+            ),
+        ),
+        (
+            text.clone(),
+            format!(
+                "{} is not an OBJ mesh (it has no `v` vertex lines)",
+                text.display()
+            ),
+        ),
+        (
+            no_faces.clone(),
+            format!(
+                "mesh {} has no triangles (no `f` face lines)",
+                no_faces.display()
+            ),
+        ),
+    ];
+    for (mesh, expected) in cases {
+        let line = fails(&weights_mesh_args(&mesh, &rig, &out));
+        assert_eq!(line, format!("error: {expected}"));
+        let line = fails(&[
+            os("bench"),
+            os("--mesh"),
+            mesh.as_os_str(),
+            os("--rig"),
+            rig.as_os_str(),
+        ]);
+        assert_eq!(line, format!("error: {expected}"));
+    }
+    assert!(!out.exists());
+}
+
+#[test]
+fn a_truncated_jpeg_is_refused_and_keeps_the_old_output() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    let (jpeg, bytes) = dino_jpeg(d);
+    let rig = data("dino-rig.json");
+    let out = d.join("out.png");
+    // The whole JPEG renders.
+    ok(&render_args(&jpeg, &rig, &out, &[]));
+    let good = fs::read(&out).expect("read");
+    let cut = d.join("cut.jpg");
+    fs::write(&cut, &bytes[..bytes.len() / 2]).expect("write");
+    let line = fails(&render_args(&cut, &rig, &out, &[]));
+    assert_eq!(
+        line,
+        format!(
+            "error: {}: truncated or corrupt image data (truncated: the JPEG ends before its end-of-image marker)",
+            cut.display()
+        )
+    );
+    assert_eq!(fs::read(&out).expect("read"), good, "output was touched");
+}
+
+#[test]
+fn a_tiny_jpeg_claiming_16000_squared_pixels_is_refused_fast() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    image::RgbImage::from_fn(64, 64, |x, y| {
+        image::Rgb([(x * 4) as u8, (y * 4) as u8, 90])
+    })
+    .write_to(&mut bytes, image::ImageFormat::Jpeg)
+    .expect("encode");
+    let mut forged = bytes.into_inner();
+    let sof = forged
+        .windows(2)
+        .position(|w| w == [0xFF, 0xC0])
+        .expect("a baseline frame header");
+    forged[sof + 5..sof + 7].copy_from_slice(&16000u16.to_be_bytes());
+    forged[sof + 7..sof + 9].copy_from_slice(&16000u16.to_be_bytes());
+    assert!(forged.len() < 3000, "{} bytes", forged.len());
+    let jpeg = d.join("forged.jpg");
+    fs::write(&jpeg, &forged).expect("write");
+    let rig = d.join("rig.json");
+    fs::write(
+        &rig,
+        r#"{"version":1,"handles":[{"type":"point","rest":[60,60]}]}"#,
+    )
+    .expect("write");
+    let out = d.join("out.png");
+    fs::write(&out, b"precious").expect("write");
+    let start = Instant::now();
+    let line = fails_within(&render_args(&jpeg, &rig, &out, &[]), PROMPT);
+    let took = start.elapsed();
+    assert_eq!(
+        line,
+        format!(
+            "error: {}: truncated or corrupt image data (its data is too short for 16000×16000 pixels)",
+            jpeg.display()
+        )
+    );
+    assert!(took < Duration::from_secs(2), "took {took:?}");
+    assert_eq!(fs::read(&out).expect("read"), b"precious");
+}
+
+#[cfg(unix)]
+#[test]
+fn outputs_that_are_not_regular_files_are_written_through() {
+    use std::os::unix::fs::FileTypeExt;
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    let (image, rig) = (data("opaque.png"), data("opaque-identity-rig.json"));
+    let expected = load(&image);
+
+    // /dev/null takes the PNG and stays a device.
+    let null = Path::new("/dev/null");
+    ok(&render_args(&image, &rig, null, &[]));
+    assert!(
+        fs::metadata(null)
+            .expect("stat")
+            .file_type()
+            .is_char_device()
+    );
+
+    // A symbolic link stays a link; its target gets the PNG.
+    let target = d.join("target.png");
+    fs::write(&target, b"old").expect("write");
+    let link = d.join("link.png");
+    std::os::unix::fs::symlink(&target, &link).expect("symlink");
+    ok(&render_args(&image, &rig, &link, &[]));
+    assert!(
+        fs::symlink_metadata(&link)
+            .expect("lstat")
+            .file_type()
+            .is_symlink()
+    );
+    assert_eq!(load(&target), expected);
+
+    // A FIFO reaches its reader.
+    let fifo = d.join("pipe.png");
+    mkfifo(&fifo);
+    let reader = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || fs::read(&fifo).expect("read the FIFO"))
+    };
+    ok(&render_args(&image, &rig, &fifo, &[]));
+    let bytes = reader.join().expect("reader");
+    let got = image::load_from_memory(&bytes).expect("a PNG").to_rgba8();
+    assert_eq!(got, expected);
+    assert!(fs::metadata(&fifo).expect("stat").file_type().is_fifo());
+
+    // `-` is standard output.
+    let run = ok(&render_args(&image, &rig, Path::new("-"), &[]));
+    assert!(run.stdout.starts_with(b"\x89PNG\r\n\x1a\n"));
+    let got = image::load_from_memory(&run.stdout)
+        .expect("a PNG")
+        .to_rgba8();
+    assert_eq!(got, expected);
+    assert!(!d.join("-").exists());
+
+    // The weights JSON too.
+    let mut obj = String::new();
+    for (x, y) in [(0, 0), (10, 0), (10, 10), (0, 10)] {
+        obj += &format!("v {x} {y}\n");
+    }
+    obj += "f 1 2 3\nf 1 3 4\n";
+    let mesh = d.join("square.obj");
+    fs::write(&mesh, obj).expect("write");
+    let square_rig = d.join("square.json");
+    fs::write(
+        &square_rig,
+        r#"{"version":1,"handles":[{"type":"point","rest":[0,0]}]}"#,
+    )
+    .expect("write");
+    let run = ok(&weights_mesh_args(&mesh, &square_rig, Path::new("-")));
+    let json: serde_json::Value = serde_json::from_slice(&run.stdout).expect("JSON on stdout");
+    assert_eq!(json["samples"], 4);
+    let json_link = d.join("weights.json");
+    std::os::unix::fs::symlink("weights-target.json", &json_link).expect("symlink");
+    ok(&weights_mesh_args(&mesh, &square_rig, &json_link));
+    assert!(
+        fs::symlink_metadata(&json_link)
+            .expect("lstat")
+            .file_type()
+            .is_symlink()
+    );
+    let json: serde_json::Value =
+        serde_json::from_slice(&fs::read(d.join("weights-target.json")).expect("read"))
+            .expect("json");
+    assert_eq!(json["samples"], 4);
+    ok(&weights_mesh_args(&mesh, &square_rig, null));
+    assert!(
+        fs::metadata(null)
+            .expect("stat")
+            .file_type()
+            .is_char_device()
+    );
+}
+
+#[test]
+fn a_good_gpu_run_prints_no_error_without_xdg_runtime_dir() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("gpu.png");
+    let (image, rig) = (data("dino.png"), data("dino-rig.json"));
+    let args = render_args(&image, &rig, &out, &["--gpu"]);
+    let run = c2warp_within(&args, Duration::from_secs(300), |command| {
+        command.env_remove("XDG_RUNTIME_DIR");
+    });
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{stderr}");
+    assert!(!stderr.to_lowercase().contains("error"), "{stderr}");
+    assert_eq!(
+        load(&out).dimensions(),
+        load(&data("dino.png")).dimensions()
+    );
+}
+
+#[test]
+fn a_sixteen_bit_png_renders_to_a_sixteen_bit_png() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    let narrow = load(&data("dino.png"));
+    // Widened with low bits 8 bits cannot hold.
+    let wide = image::ImageBuffer::<image::Rgba<u16>, Vec<u16>>::from_fn(
+        narrow.width(),
+        narrow.height(),
+        |x, y| {
+            let p = narrow.get_pixel(x, y).0;
+            let low = ((x + y) % 64) as u16;
+            image::Rgba(p.map(|c| (u16::from(c) * 257).saturating_sub(low)))
+        },
+    );
+    let source = d.join("wide.png");
+    wide.save(&source).expect("save a 16-bit PNG");
+    let rig = data("dino-rig.json");
+    let (out16, out8) = (d.join("out16.png"), d.join("out8.png"));
+    ok(&render_args(&source, &rig, &out16, &[]));
+    ok(&render_args(&data("dino.png"), &rig, &out8, &[]));
+    let got = image::open(&out16).expect("open");
+    assert_eq!(got.color(), image::ColorType::Rgba16);
+    let got = got.into_rgba16();
+    // Low bits survive: some output channels are no multiple of 257.
+    assert!(got.as_raw().iter().any(|&c| c % 257 != 0));
+    // And it is the 8-bit render, up to rounding.
+    let (worst, share) = difference(
+        &image::DynamicImage::ImageRgba16(got).to_rgba8(),
+        &load(&out8),
+        2,
+    );
+    assert!(
+        share < 0.002,
+        "{:.3}% differ by more than 2 (largest {worst})",
+        share * 100.0
+    );
+    // --gpu draws in 8 bits.
+    let gpu = d.join("gpu.png");
+    ok(&render_args(&source, &rig, &gpu, &["--gpu"]));
+    assert_eq!(
+        image::open(&gpu).expect("open").color(),
+        image::ColorType::Rgba8
+    );
+}
+
+#[test]
+fn webp_tiff_bmp_and_gif_pictures_render() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let picture = load(&data("opaque.png"));
+    for (format, name) in [
+        (image::ImageFormat::WebP, "opaque.webp"),
+        (image::ImageFormat::Tiff, "opaque.tiff"),
+        (image::ImageFormat::Bmp, "opaque.bmp"),
+        (image::ImageFormat::Gif, "opaque.gif"),
+    ] {
+        // Named .png on purpose: the format is found from the content.
+        let path = dir.path().join(format!("{name}.png"));
+        image::DynamicImage::ImageRgba8(picture.clone())
+            .save_with_format(&path, format)
+            .expect("encode");
+        let out = dir.path().join(format!("{name}-out.png"));
+        ok(&render_args(
+            &path,
+            &data("opaque-identity-rig.json"),
+            &out,
+            &[],
+        ));
+        let expected = image::load_from_memory(&fs::read(&path).expect("read"))
+            .expect("decode")
+            .to_rgba8();
+        assert_eq!(load(&out), expected, "{name}");
+    }
 }

@@ -88,3 +88,59 @@ pub fn load(path: &Path) -> image::RgbaImage {
         .unwrap_or_else(|e| panic!("cannot open {}: {e}", path.display()))
         .to_rgba8()
 }
+
+/// Runs `c2warp` with `configure` applied to the command, killing it if it has not
+/// finished within `limit` (so a run that would hang fails the test instead).
+pub fn c2warp_within(
+    args: &[&std::ffi::OsStr],
+    limit: std::time::Duration,
+    configure: impl FnOnce(&mut Command),
+) -> Output {
+    use std::process::Stdio;
+    let mut command = Command::new(env!("CARGO_BIN_EXE_c2warp"));
+    command
+        .args(args)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    configure(&mut command);
+    let child = command.spawn().expect("the c2warp binary runs");
+    let id = child.id();
+    let (done, wait) = std::sync::mpsc::channel();
+    let waiter = std::thread::spawn(move || {
+        let out = child.wait_with_output().expect("wait for c2warp");
+        let _ = done.send(());
+        out
+    });
+    if wait.recv_timeout(limit).is_err() {
+        // Kill only the child this test started, by its id.
+        let _ = Command::new("kill").arg("-9").arg(id.to_string()).status();
+        let _ = waiter.join();
+        panic!("c2warp {args:?} did not finish within {limit:?}");
+    }
+    waiter.join().expect("waiter thread")
+}
+
+/// As [`fails`], but the run must end within `limit`.
+pub fn fails_within(args: &[&std::ffi::OsStr], limit: std::time::Duration) -> String {
+    let out = c2warp_within(args, limit, |_| {});
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(!out.status.success(), "c2warp {args:?} should fail");
+    assert!(
+        !stderr.contains("panicked"),
+        "c2warp {args:?} panicked: {stderr}"
+    );
+    let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "one line of error expected, got: {stderr}");
+    assert!(lines[0].starts_with("error: "), "{stderr}");
+    lines[0].to_string()
+}
+
+/// Creates a FIFO at `path`.
+pub fn mkfifo(path: &Path) {
+    let status = Command::new("mkfifo")
+        .arg(path)
+        .status()
+        .expect("mkfifo runs");
+    assert!(status.success(), "mkfifo {}", path.display());
+}

@@ -1,6 +1,6 @@
 //! `c2warp weights`: the nodes and sparse weights of a rig, as JSON.
 
-use std::io::BufReader;
+use std::io::Write;
 use std::path::Path;
 
 use anyhow::{Context, Result};
@@ -27,6 +27,9 @@ pub struct Built {
 /// as a new vertex, splitting the triangle (or edge) it lies on. Inserted vertices come
 /// after the file's.
 pub fn build(source: &Source, project: &Project) -> Result<Built> {
+    if let Some(density) = source.density {
+        project::validate_density(density)?;
+    }
     if let Some(path) = &source.image {
         let picture = load_image(path)?;
         let prepared = pipeline::prepare(&picture, project, source.density)?;
@@ -37,10 +40,7 @@ pub fn build(source: &Source, project: &Project) -> Result<Built> {
         });
     }
     let path = source.mesh.as_deref().context("give --mesh or --image")?;
-    let file = std::fs::File::open(path)
-        .with_context(|| format!("cannot open mesh {}", path.display()))?;
-    let mut mesh = mesh::Mesh::read_obj(BufReader::new(file))
-        .with_context(|| format!("mesh {}", path.display()))?;
+    let mut mesh = pipeline::load_obj(path)?;
     mesh.sanity_check()
         .with_context(|| format!("mesh {}", path.display()))?;
     project.validate(None)?;
@@ -157,7 +157,15 @@ pub fn weights(source: &Source, rig_path: &Path, output: &Path) -> Result<()> {
             .collect(),
     };
     let text = serde_json::to_string(&out)?;
-    render::write_atomic(output, text.as_bytes())?;
+    if crate::is_stdout(output) {
+        let mut stdout = std::io::stdout().lock();
+        stdout
+            .write_all(text.as_bytes())
+            .and_then(|()| stdout.flush())
+            .context("cannot write to standard output")?;
+    } else {
+        render::write_atomic(output, text.as_bytes())?;
+    }
     progress.finish();
     Ok(())
 }

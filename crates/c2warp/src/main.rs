@@ -3,14 +3,17 @@
 mod bench;
 mod export;
 mod progress;
+mod runtime_dir;
 
+use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand};
-use pipeline::{DEFAULT_IMAGE, DEFAULT_RIG, load_image, load_project};
+use pipeline::{DEFAULT_IMAGE, DEFAULT_RIG, load_picture, load_project};
 use project::Project;
+use render::Picture;
 
 #[derive(Parser)]
 #[command(
@@ -24,32 +27,36 @@ use project::Project;
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
-    /// A picture (PNG, JPEG) or a project (.json) to open in the editor.
+    /// A picture (PNG, JPEG, WebP, TIFF, BMP, GIF) or a project (.json) to open in the editor.
     file: Option<PathBuf>,
 }
 
 #[derive(Subcommand)]
 enum Command {
-    /// Open the editor on a picture (PNG, JPEG) or a project (.json).
+    /// Open the editor on a picture (PNG, JPEG, WebP, TIFF, BMP, GIF) or a project (.json).
     Open {
         /// The file to open.
         file: PathBuf,
     },
-    /// Warp an image by a rig and write a PNG of the same size (alpha kept).
+    /// Warp an image by a rig and write a PNG of the same size (alpha kept; 16 bits
+    /// per channel for a 16-bit source).
     Render {
-        /// The image (PNG or JPEG).
+        /// The image (PNG, JPEG, WebP, TIFF, BMP, or a GIF's first frame).
         image: PathBuf,
         /// The rig file (RIG.json).
         #[arg(long)]
         rig: PathBuf,
-        /// Where to write the PNG.
+        /// Where to write the PNG (`-`: standard output). A file is replaced
+        /// atomically; a device or FIFO is written to; a symbolic link's target is
+        /// written.
         #[arg(short, long)]
         output: PathBuf,
         /// Target number of mesh vertices (overrides the rig's `density`).
         #[arg(long)]
         density: Option<usize>,
         /// Draw with the GPU (a software Vulkan driver works too), blending the handle
-        /// transforms in the vertex shader, instead of on the CPU.
+        /// transforms in the vertex shader, instead of on the CPU. The GPU draws in 8
+        /// bits per channel: a 16-bit source gives an 8-bit PNG.
         #[arg(long)]
         gpu: bool,
     },
@@ -60,7 +67,7 @@ enum Command {
         /// The rig file (RIG.json).
         #[arg(long)]
         rig: PathBuf,
-        /// Where to write the JSON.
+        /// Where to write the JSON (`-`: standard output).
         #[arg(short, long)]
         output: PathBuf,
     },
@@ -77,7 +84,7 @@ enum Command {
     },
     /// Render the sample rig on the built-in image and say where the PNG went.
     Demo {
-        /// Where to write the PNG.
+        /// Where to write the PNG (`-`: standard output).
         #[arg(short, long, default_value = "c2warp-demo.png")]
         output: PathBuf,
     },
@@ -100,6 +107,12 @@ struct Source {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // Before any thread starts: the GPU path's Vulkan layer complains on stderr
+    // without it (see runtime_dir.rs).
+    let _runtime_dir = match &cli.command {
+        Some(Command::Render { gpu: true, .. }) => runtime_dir::ensure(),
+        _ => None,
+    };
     let result = match cli.command {
         None => editor::run(cli.file),
         Some(command) => run(command),
@@ -144,16 +157,23 @@ fn render(
     density: Option<usize>,
     gpu: bool,
 ) -> Result<()> {
+    if let Some(density) = density {
+        // Before the slow part: the rule and the message of a rig file's density.
+        project::validate_density(density)?;
+    }
     let project = load_project(rig)?;
-    let picture = load_image(image)?;
+    let picture = load_picture(image)?;
     warp_and_save(&picture, &project, density, output, gpu)?;
     Ok(())
 }
 
 /// Meshes, weights, warps and writes `picture` by `project`, with a progress counter;
 /// returns the rig.
+///
+/// The CPU draws in the picture's depth (a 16-bit picture gives a 16-bit PNG); the
+/// GPU draws in 8 bits per channel, so with `gpu` the PNG has 8.
 fn warp_and_save(
-    picture: &image::RgbaImage,
+    picture: &Picture,
     project: &Project,
     density: Option<usize>,
     output: &Path,
@@ -161,28 +181,57 @@ fn warp_and_save(
 ) -> Result<weights_core::Rig> {
     let progress = progress::Steps::new(3);
     progress.step("meshing and weighting");
-    let prepared = pipeline::prepare(picture, project, density)?;
+    let rgba8 = picture.to_rgba8();
+    let prepared = pipeline::prepare(&rgba8, project, density)?;
     progress.step("rendering");
     let warped = if gpu {
-        pipeline::warp_gpu(picture, &prepared.rig)?
+        Picture::Rgba8(pipeline::warp_gpu(&rgba8, &prepared.rig)?)
     } else {
-        pipeline::warp(picture, &prepared.rig)?
+        drop(rgba8);
+        pipeline::warp_picture(picture, &prepared.rig)?
     };
     progress.step("writing");
-    render::save_png_atomic(output, &warped)?;
+    write_png(output, &warped)?;
     progress.finish();
     Ok(prepared.rig)
 }
 
+/// Whether `output` names standard output (`-`).
+pub(crate) fn is_stdout(output: &Path) -> bool {
+    output.as_os_str() == "-"
+}
+
+/// Writes `picture` as a PNG to `output`: standard output for `-` (unless it is a
+/// terminal), else through [`render::save_png_atomic`] (atomic for a regular file,
+/// through to a device or FIFO, to a symbolic link's target).
+fn write_png(output: &Path, picture: &Picture) -> Result<()> {
+    if is_stdout(output) {
+        let stdout = std::io::stdout();
+        if stdout.is_terminal() {
+            bail!(
+                "refusing to write a PNG to a terminal: redirect standard output, or name a file with -o"
+            );
+        }
+        render::write_png(stdout.lock(), picture, Path::new("<standard output>"))?;
+    } else {
+        render::save_png_atomic(output, picture)?;
+    }
+    Ok(())
+}
+
 fn demo(output: &Path) -> Result<()> {
-    let picture = render::decode_image(DEFAULT_IMAGE, &render::ImageLimits::default())?;
+    let picture = render::decode_picture(DEFAULT_IMAGE, &render::ImageLimits::default())?;
     let project = Project::from_json(DEFAULT_RIG).context("built-in rig")?;
     let rig = warp_and_save(&picture, &project, None, output, false)?;
     let stats = rig.stats();
+    if is_stdout(output) {
+        return Ok(());
+    }
+    let (width, height) = picture.dimensions();
     println!(
         "Warped the built-in lizard ({} × {} px, {} mesh vertices, {} handles + {} virtual) into {}",
-        picture.width(),
-        picture.height(),
+        width,
+        height,
         stats.samples,
         stats.real_handles,
         stats.virtual_nodes,

@@ -1,11 +1,15 @@
 //! Image + project → mesh → rig → warped image: the path the `c2warp` command line and
 //! the editor share, so an export from either gives the same pixels.
 
-use anyhow::{Context, Result, bail};
+use std::io::{BufReader, Read};
+use std::path::Path;
+
+use anyhow::{Context, Result, anyhow, bail};
 use glam::{DVec2, Vec2};
 use image::RgbaImage;
-use mesh::{Constraints, DomainOptions, MeshOptions};
+use mesh::{Constraints, DomainOptions, Mesh, MeshError, MeshOptions};
 use project::{HandleSpec, MetricChoice, Middle, Project};
+use render::Picture;
 use weights_core::{Basis, Domain, Handle, Metric, MiddleControls, Rig, RigOptions, Similarity};
 
 /// The picture the editor opens with and the demo warps (public domain, see
@@ -14,22 +18,107 @@ pub const DEFAULT_IMAGE: &[u8] = include_bytes!("../../../assets/lizard.png");
 /// The sample rig on [`DEFAULT_IMAGE`].
 pub const DEFAULT_RIG: &str = include_str!("../../../assets/lizard-rig.json");
 
+/// The largest rig file read: a rig is a few kilobytes, even with thousands of
+/// handles.
+pub const MAX_RIG_BYTES: u64 = 8 << 20;
+
+/// The largest OBJ mesh read (about 25 million vertices with their triangles).
+pub const MAX_OBJ_BYTES: u64 = 1 << 30;
+
+/// The error for an input file that could not be read, naming it as `what`.
+fn read_error(error: render::RenderError, what: &str) -> anyhow::Error {
+    match error {
+        render::RenderError::NotFound { path } => {
+            anyhow!("cannot read {what} {}: no such file", path.display())
+        }
+        render::RenderError::Io { path, source, .. } => {
+            anyhow!("cannot read {what} {}: {source}", path.display())
+        }
+        // These name the file already.
+        other => other.into(),
+    }
+}
+
 /// Reads and parses a rig file.
 ///
+/// Only a regular file of at most [`MAX_RIG_BYTES`] is read: a FIFO, a device or a
+/// directory is refused before it is opened. A leading UTF-8 byte-order mark is
+/// ignored.
+///
 /// # Errors
-/// An unreadable file or malformed rig, naming the file.
-pub fn load_project(path: &std::path::Path) -> Result<Project> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read rig file {}", path.display()))?;
+/// A missing, unreadable, non-regular, oversized or non-UTF-8 file, or a malformed
+/// rig, naming the file.
+pub fn load_project(path: &Path) -> Result<Project> {
+    let bytes = render::read_regular_file(path, "rig file", MAX_RIG_BYTES)
+        .map_err(|e| read_error(e, "rig file"))?;
+    let text = String::from_utf8(bytes)
+        .map_err(|_| anyhow!("rig file {} is not UTF-8 text", path.display()))?;
     Project::from_json(&text).with_context(|| format!("rig file {}", path.display()))
 }
 
-/// Decodes an image file under the default size limits.
+/// Decodes an image file under the default size limits into RGBA8 (a 16-bit picture
+/// is rounded to 8 bits; see [`load_picture`]).
 ///
 /// # Errors
-/// A missing, corrupt, truncated, unsupported or oversized image, as one sentence.
-pub fn load_image(path: &std::path::Path) -> Result<RgbaImage> {
-    Ok(render::load_image(path, &render::ImageLimits::default())?)
+/// A missing, non-regular, corrupt, truncated, unsupported or oversized image, as
+/// one sentence.
+pub fn load_image(path: &Path) -> Result<RgbaImage> {
+    Ok(load_picture(path)?.into_rgba8())
+}
+
+/// Decodes an image file (PNG, JPEG, WebP, TIFF, BMP, GIF) under the default size
+/// limits, keeping 16 bits per channel where the file has them.
+///
+/// # Errors
+/// As [`load_image`].
+pub fn load_picture(path: &Path) -> Result<Picture> {
+    render::load_picture(path, &render::ImageLimits::default()).map_err(|e| read_error(e, "image"))
+}
+
+/// Reads a 2-D mesh from a Wavefront OBJ file (see [`mesh::Mesh::read_obj`]).
+///
+/// Only a regular file of at most [`MAX_OBJ_BYTES`] is read.
+///
+/// # Errors
+/// A missing, unreadable, non-regular or oversized file; one that is not an OBJ
+/// mesh (not text, or no vertex lines); one with no faces; a malformed line.
+pub fn load_obj(path: &Path) -> Result<Mesh> {
+    let (file, _) = render::open_regular_file(path, "mesh file", MAX_OBJ_BYTES)
+        .map_err(|e| read_error(e, "mesh file"))?;
+    let mut reader = BufReader::new(file.take(MAX_OBJ_BYTES + 1));
+    let mesh = match Mesh::read_obj(&mut reader) {
+        Ok(mesh) => mesh,
+        Err(MeshError::Io(e)) if e.kind() == std::io::ErrorKind::InvalidData => {
+            bail!("{} is not an OBJ mesh (it is not text)", path.display())
+        }
+        Err(e) => return Err(e).with_context(|| format!("mesh {}", path.display())),
+    };
+    if reader.get_ref().limit() == 0 {
+        bail!(
+            "mesh file {} grew beyond {MAX_OBJ_BYTES} bytes while being read",
+            path.display()
+        );
+    }
+    if mesh.vertices.is_empty() {
+        let why = if reader
+            .get_ref()
+            .get_ref()
+            .metadata()
+            .is_ok_and(|m| m.len() == 0)
+        {
+            "it is empty"
+        } else {
+            "it has no `v` vertex lines"
+        };
+        bail!("{} is not an OBJ mesh ({why})", path.display());
+    }
+    if mesh.triangles.is_empty() {
+        bail!(
+            "mesh {} has no triangles (no `f` face lines)",
+            path.display()
+        );
+    }
+    Ok(mesh)
 }
 
 /// Target vertex count of the mesh when neither the project nor the command says.
@@ -121,10 +210,16 @@ pub struct Prepared {
 /// Meshes `image` for `project` (at `density` vertices, else the project's, else the
 /// default) and builds the rig.
 ///
+/// `density` follows the rule of a rig file's `density`
+/// ([`project::validate_density`]), with the same message.
+///
 /// # Errors
-/// Handles off the image or the shape, coincident handles, an image with no opaque
-/// pixel, and the like, each as one sentence.
+/// A density out of range, handles off the image or the shape, coincident handles,
+/// an image with no opaque pixel, and the like, each as one sentence.
 pub fn prepare(image: &RgbaImage, project: &Project, density: Option<usize>) -> Result<Prepared> {
+    if let Some(density) = density {
+        project::validate_density(density)?;
+    }
     project.validate(Some(image.dimensions()))?;
     let handles = handles(project);
     let (points, bars) = constraints(project, &handles);
@@ -182,17 +277,46 @@ pub fn warp_gpu(image: &RgbaImage, rig: &Rig) -> Result<RgbaImage> {
     Ok(gpu.warp_skinned(image, &mesh, &rig.node_affines(), w, h)?)
 }
 
+/// The picture warped by the rig's current pose on the CPU, at its full resolution
+/// and in its own depth: a 16-bit picture gives a 16-bit picture (write it with
+/// [`render::save_png_atomic`] for a 16-bit PNG); an 8-bit one exactly what [`warp`]
+/// gives.
+///
+/// # Errors
+/// Only if the deformation produced non-finite positions.
+pub fn warp_picture(picture: &Picture, rig: &Rig) -> Result<Picture> {
+    let (rest, deformed) = warp_positions(rig)?;
+    let mesh = render::WarpMesh {
+        rest: &rest,
+        deformed: &deformed,
+        triangles: rig.domain().triangles(),
+    };
+    let (w, h) = picture.dimensions();
+    Ok(render::warp_picture(
+        picture,
+        &mesh,
+        w,
+        h,
+        &render::RasterOptions::default(),
+    )?)
+}
+
+/// Rest and deformed positions in f32 for drawing.
+fn warp_positions(rig: &Rig) -> Result<(Vec<Vec2>, Vec<Vec2>)> {
+    let deformed = rig.deform();
+    if deformed.iter().any(|p| !p.is_finite()) {
+        bail!("the deformation produced non-finite positions");
+    }
+    let deformed = deformed.iter().map(|p| p.as_vec2()).collect();
+    Ok((rest_positions(rig), deformed))
+}
+
 /// The image warped by the rig's current pose, at the image's full resolution.
 ///
 /// # Errors
 /// Only if the deformation produced non-finite positions.
 pub fn warp(image: &RgbaImage, rig: &Rig) -> Result<RgbaImage> {
-    let deformed = rig.deform();
-    if deformed.iter().any(|p| !p.is_finite()) {
-        bail!("the deformation produced non-finite positions");
-    }
-    let rest = rest_positions(rig);
-    let deformed: Vec<Vec2> = deformed.iter().map(|p| p.as_vec2()).collect();
+    let (rest, deformed) = warp_positions(rig)?;
     let mesh = render::WarpMesh {
         rest: &rest,
         deformed: &deformed,

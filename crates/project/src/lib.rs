@@ -134,6 +134,29 @@ impl Default for Project {
     }
 }
 
+/// The mesh densities (target vertex counts) a rig file or a command may ask for.
+pub const DENSITY_RANGE: std::ops::RangeInclusive<usize> = 16..=4_000_000;
+
+/// Checks a mesh density (a target vertex count) against [`DENSITY_RANGE`]: the one
+/// rule for a rig file's `density` and a command line's `--density`.
+///
+/// # Errors
+/// [`ProjectError::Density`] outside the range.
+///
+/// # Example
+/// ```
+/// assert!(project::validate_density(20_000).is_ok());
+/// let err = project::validate_density(0).expect_err("too few");
+/// assert_eq!(err.to_string(), "density must be between 16 and 4000000 vertices, got 0");
+/// ```
+pub fn validate_density(density: usize) -> Result<(), ProjectError> {
+    if DENSITY_RANGE.contains(&density) {
+        Ok(())
+    } else {
+        Err(ProjectError::Density(density))
+    }
+}
+
 /// Why a project cannot be used.
 #[derive(Debug, thiserror::Error)]
 pub enum ProjectError {
@@ -146,14 +169,25 @@ pub enum ProjectError {
     /// A value out of range.
     #[error("invalid rig: {0}")]
     Invalid(String),
+    /// A mesh density outside [`DENSITY_RANGE`].
+    #[error(
+        "density must be between {min} and {max} vertices, got {0}",
+        min = DENSITY_RANGE.start(),
+        max = DENSITY_RANGE.end()
+    )]
+    Density(usize),
 }
 
 impl Project {
-    /// Parses and validates (without an image size) a project from JSON text.
+    /// Parses and validates (without an image size) a project from JSON text. A
+    /// leading UTF-8 byte-order mark is ignored.
     ///
     /// # Errors
     /// Malformed JSON, an unknown version, or values out of range.
     pub fn from_json(text: &str) -> Result<Self, ProjectError> {
+        // Editors on Windows like to start UTF-8 with a byte-order mark; JSON has no
+        // use for it.
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         // Read the version first so a future file gets a clear message.
         #[derive(Deserialize)]
         struct Probe {
@@ -193,12 +227,8 @@ impl Project {
                 self.degree
             ));
         }
-        if let Some(d) = self.density
-            && !(16..=4_000_000).contains(&d)
-        {
-            return bad(format!(
-                "density must be between 16 and 4000000 vertices, got {d}"
-            ));
+        if let Some(d) = self.density {
+            validate_density(d)?;
         }
         let inside = |p: [f64; 2]| match image_size {
             Some((w, h)) => {
@@ -342,11 +372,28 @@ mod tests {
                 "scale",
             ),
             (r#"{"version":1,"handels":[]}"#, "malformed"),
+            (
+                r#"{"version":1,"density":0,"handles":[]}"#,
+                "density must be between 16 and 4000000 vertices, got 0",
+            ),
+            (
+                r#"{"version":1,"density":4000001,"handles":[]}"#,
+                "density must be between 16 and 4000000 vertices, got 4000001",
+            ),
+            // A byte-order mark anywhere but at the start is not whitespace.
+            ("{\u{feff}\"version\":1,\"handles\":[]}", "malformed"),
         ];
         for (text, expected) in cases {
             let err = Project::from_json(text).expect_err(text).to_string();
             assert!(err.contains(expected), "{text}: {err}");
         }
+    }
+
+    #[test]
+    fn a_byte_order_mark_is_ignored() {
+        let text = sample().to_json();
+        let with_bom = format!("\u{feff}{text}");
+        assert_eq!(Project::from_json(&with_bom).expect("parses"), sample());
     }
 
     #[test]

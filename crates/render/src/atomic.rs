@@ -1,4 +1,5 @@
-//! Atomic file replacement: write beside the target, sync, rename over it.
+//! Atomic file replacement: write beside the target, sync, rename over it; and
+//! writing through to what cannot be replaced (devices, FIFOs) or to a link's target.
 
 use std::fs::{self, File, OpenOptions};
 use std::io::{self, BufWriter, Write};
@@ -8,7 +9,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use image::codecs::png::PngEncoder;
 use image::{ExtendedColorType, ImageEncoder, ImageError, RgbaImage};
 
-use crate::RenderError;
+use crate::{Picture, RenderError, Rgba16Image};
 
 /// Writes `bytes` to `path` atomically: readers see either the old file or
 /// the complete new one, never a partial write.
@@ -16,14 +17,21 @@ use crate::RenderError;
 /// The data goes to a uniquely named temporary file in the same directory
 /// (`.<name>.<pid>-<n>.tmp`), which is flushed to disk and then renamed over
 /// `path`. An existing target keeps its permissions. On any error the
-/// temporary file is removed and an existing `path` is left untouched. If
-/// `path` is a symbolic link, the link itself is replaced.
+/// temporary file is removed and an existing `path` is left untouched.
+///
+/// What is already at `path` is respected:
+/// * a symbolic link stays a link: its target (followed through any chain of
+///   links) is written, atomically as above when it is a regular file or does not
+///   exist yet;
+/// * a device or a FIFO (`/dev/null`, `/dev/stdout`, a named pipe) is opened and
+///   written through, since it cannot be replaced (opening a FIFO waits for a
+///   reader); such a write is not atomic.
 ///
 /// # Errors
 /// * [`RenderError::InvalidPath`] if `path` names no file;
 /// * [`RenderError::MissingDirectory`] if its directory does not exist;
 /// * [`RenderError::Io`] for any other failure (permissions, full disk, a
-///   directory in the way, …).
+///   directory in the way, a loop of symbolic links, …).
 ///
 /// # Example
 /// ```
@@ -43,47 +51,100 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), RenderError> {
     })
 }
 
-/// Encodes `image` as an 8-bit RGBA PNG and writes it to `path` atomically,
-/// as [`write_atomic`] does.
+/// An image [`save_png_atomic`] and [`write_png`] can encode: RGBA with 8 or 16
+/// bits per channel ([`RgbaImage`], [`Rgba16Image`] or a [`Picture`]).
+pub trait PngPixels {
+    /// Width, height, the colour type and the samples as bytes (16-bit samples in
+    /// native byte order, as [`ImageEncoder::write_image`] takes them).
+    fn png_layout(&self) -> (u32, u32, ExtendedColorType, &[u8]);
+}
+
+impl PngPixels for RgbaImage {
+    fn png_layout(&self) -> (u32, u32, ExtendedColorType, &[u8]) {
+        (
+            self.width(),
+            self.height(),
+            ExtendedColorType::Rgba8,
+            self.as_raw(),
+        )
+    }
+}
+
+impl PngPixels for Rgba16Image {
+    fn png_layout(&self) -> (u32, u32, ExtendedColorType, &[u8]) {
+        (
+            self.width(),
+            self.height(),
+            ExtendedColorType::Rgba16,
+            bytemuck::cast_slice(self.as_raw()),
+        )
+    }
+}
+
+impl PngPixels for Picture {
+    fn png_layout(&self) -> (u32, u32, ExtendedColorType, &[u8]) {
+        match self {
+            Picture::Rgba8(image) => image.png_layout(),
+            Picture::Rgba16(image) => image.png_layout(),
+        }
+    }
+}
+
+/// Encodes `image` as an RGBA PNG of its depth (8 or 16 bits per channel) into
+/// `writer` (for example standard output); `path` only names the destination in
+/// errors.
+///
+/// # Errors
+/// [`RenderError::Encode`] if the encoder rejects the image (for example one with
+/// a zero dimension), [`RenderError::Io`] if writing fails.
+pub fn write_png<P, W>(writer: W, image: &P, path: &Path) -> Result<(), RenderError>
+where
+    P: PngPixels + ?Sized,
+    W: Write,
+{
+    let (width, height, color, bytes) = image.png_layout();
+    if width == 0 || height == 0 {
+        return Err(RenderError::Encode {
+            path: path.to_owned(),
+            detail: format!("a PNG cannot be {width}x{height} pixels"),
+        });
+    }
+    let io_error = |source| RenderError::Io {
+        path: path.to_owned(),
+        action: "write",
+        source,
+    };
+    let mut writer = BufWriter::new(writer);
+    PngEncoder::new(&mut writer)
+        .write_image(bytes, width, height, color)
+        .map_err(|error| match error {
+            ImageError::IoError(source) => io_error(source),
+            other => RenderError::Encode {
+                path: path.to_owned(),
+                detail: other.to_string(),
+            },
+        })?;
+    writer.flush().map_err(io_error)
+}
+
+/// Encodes `image` as an RGBA PNG of its depth (8 bits per channel for an
+/// [`RgbaImage`], 16 for an [`Rgba16Image`]; a [`Picture`] in its own) and writes
+/// it to `path` as [`write_atomic`] does (atomically for a regular file, through to
+/// a device or FIFO, to the target of a symbolic link).
 ///
 /// # Errors
 /// The errors of [`write_atomic`], and [`RenderError::Encode`] if the encoder
 /// rejects the image (for example one with a zero dimension); in every case
 /// an existing `path` is left untouched.
-pub fn save_png_atomic(path: &Path, image: &RgbaImage) -> Result<(), RenderError> {
-    if image.width() == 0 || image.height() == 0 {
+pub fn save_png_atomic<P: PngPixels + ?Sized>(path: &Path, image: &P) -> Result<(), RenderError> {
+    let (width, height, _, _) = image.png_layout();
+    if width == 0 || height == 0 {
         return Err(RenderError::Encode {
             path: path.to_owned(),
-            detail: format!(
-                "a PNG cannot be {}x{} pixels",
-                image.width(),
-                image.height()
-            ),
+            detail: format!("a PNG cannot be {width}x{height} pixels"),
         });
     }
-    replace_with(path, |file| {
-        let io_error = |source| RenderError::Io {
-            path: path.to_owned(),
-            action: "write",
-            source,
-        };
-        let mut writer = BufWriter::new(file);
-        PngEncoder::new(&mut writer)
-            .write_image(
-                image.as_raw(),
-                image.width(),
-                image.height(),
-                ExtendedColorType::Rgba8,
-            )
-            .map_err(|error| match error {
-                ImageError::IoError(source) => io_error(source),
-                other => RenderError::Encode {
-                    path: path.to_owned(),
-                    detail: other.to_string(),
-                },
-            })?;
-        writer.flush().map_err(io_error)
-    })
+    replace_with(path, |file| write_png(file, image, path))
 }
 
 /// Removes the temporary file when dropped, unless it was renamed.
@@ -148,8 +209,37 @@ fn create_temp(dir: &Path, target: &Path, name: &str) -> Result<(TempFile, File)
     })
 }
 
+/// The file a write to `path` lands in: `path` itself, or, when it is a symbolic
+/// link, the end of its chain of links (relative links are read from the link's
+/// directory).
+fn follow_links(path: &Path) -> Result<PathBuf, RenderError> {
+    let mut current = path.to_path_buf();
+    // Linux gives up after 40 links too.
+    for _ in 0..40 {
+        match fs::symlink_metadata(&current) {
+            Ok(meta) if meta.file_type().is_symlink() => {
+                let link = fs::read_link(&current).map_err(|source| RenderError::Io {
+                    path: path.to_owned(),
+                    action: "follow the symbolic link",
+                    source,
+                })?;
+                current = match current.parent() {
+                    Some(dir) if link.is_relative() => dir.join(link),
+                    _ => link,
+                };
+            }
+            _ => return Ok(current),
+        }
+    }
+    Err(RenderError::Io {
+        path: path.to_owned(),
+        action: "follow the symbolic link",
+        source: io::Error::other("too many levels of symbolic links"),
+    })
+}
+
 /// The shared mechanism of [`write_atomic`] and [`save_png_atomic`]: `fill`
-/// writes the content into the temporary file.
+/// writes the content into the file (the temporary one, or the device).
 fn replace_with<F>(path: &Path, fill: F) -> Result<(), RenderError>
 where
     F: FnOnce(&mut File) -> Result<(), RenderError>,
@@ -157,8 +247,47 @@ where
     let invalid = || RenderError::InvalidPath {
         path: path.to_owned(),
     };
-    let name = path.file_name().ok_or_else(invalid)?.to_string_lossy();
-    let dir = match path.parent() {
+    path.file_name().ok_or_else(invalid)?;
+    let target = follow_links(path)?;
+    match fs::metadata(&target) {
+        // A device, FIFO or socket cannot be replaced: write through to it. (A
+        // directory falls through, and the rename reports it.)
+        Ok(meta) if !meta.is_file() && !meta.is_dir() => write_through(path, &target, fill),
+        _ => replace_file(path, &target, fill),
+    }
+}
+
+/// Opens the existing non-regular file `target` (where `path` leads) and writes to it.
+fn write_through<F>(path: &Path, target: &Path, fill: F) -> Result<(), RenderError>
+where
+    F: FnOnce(&mut File) -> Result<(), RenderError>,
+{
+    let mut file = OpenOptions::new()
+        .write(true)
+        .open(target)
+        .map_err(|source| RenderError::Io {
+            path: path.to_owned(),
+            action: "open",
+            source,
+        })?;
+    fill(&mut file)?;
+    file.flush().map_err(|source| RenderError::Io {
+        path: path.to_owned(),
+        action: "write",
+        source,
+    })
+}
+
+/// Writes a temporary file beside `target` (where `path` leads) and renames it over.
+fn replace_file<F>(path: &Path, target: &Path, fill: F) -> Result<(), RenderError>
+where
+    F: FnOnce(&mut File) -> Result<(), RenderError>,
+{
+    let invalid = || RenderError::InvalidPath {
+        path: path.to_owned(),
+    };
+    let name = target.file_name().ok_or_else(invalid)?.to_string_lossy();
+    let dir = match target.parent() {
         Some(parent) if !parent.as_os_str().is_empty() => parent,
         _ => Path::new("."),
     };
@@ -170,7 +299,7 @@ where
     };
 
     fill(&mut file)?;
-    if let Ok(meta) = fs::metadata(path)
+    if let Ok(meta) = fs::metadata(target)
         && meta.is_file()
     {
         // Best effort: failing to copy the mode is no reason to lose the data.
@@ -179,7 +308,7 @@ where
     file.sync_all().map_err(|e| io_error("write", e))?;
     drop(file);
 
-    fs::rename(&temp.path, path).map_err(|e| io_error("replace", e))?;
+    fs::rename(&temp.path, target).map_err(|e| io_error("replace", e))?;
     temp.renamed = true;
 
     // Make the rename itself durable (best effort; not possible everywhere).

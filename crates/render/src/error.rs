@@ -16,6 +16,34 @@ pub enum RenderError {
         path: PathBuf,
     },
 
+    /// The file to read is a FIFO, a device, a socket or a directory: it is refused
+    /// before it is opened (opening a FIFO blocks; a device may never end).
+    #[error("{what} {} is not a regular file ({kind})", path.display())]
+    NotRegularFile {
+        /// What the file was to be, e.g. `"image"` or `"rig file"`.
+        what: &'static str,
+        /// The file that was asked for.
+        path: PathBuf,
+        /// What it is instead, e.g. `"a FIFO"`.
+        kind: &'static str,
+    },
+
+    /// The file to read is larger than the caller accepts for its kind.
+    #[error(
+        "{what} {} is {}; {what}s over {} are refused",
+        path.display(), crate::files::human_bytes(*len), crate::files::human_bytes(*limit)
+    )]
+    FileTooLarge {
+        /// What the file was to be, e.g. `"rig file"`.
+        what: &'static str,
+        /// The file that was asked for.
+        path: PathBuf,
+        /// Its length in bytes.
+        len: u64,
+        /// The largest length accepted, in bytes.
+        limit: u64,
+    },
+
     /// The directory a file should be written into does not exist.
     #[error("cannot write {}: directory {} does not exist", path.display(), dir.display())]
     MissingDirectory {
@@ -44,14 +72,14 @@ pub enum RenderError {
         source: std::io::Error,
     },
 
-    /// The data is not in a format this crate decodes (PNG and JPEG).
-    #[error("{}: not a PNG or JPEG image", path.display())]
+    /// The data is not in a format this crate decodes (PNG, JPEG, WebP, TIFF, BMP, GIF).
+    #[error("{}: not a PNG, JPEG, WebP, TIFF, BMP or GIF image", path.display())]
     UnsupportedFormat {
         /// The file (or `<memory>`).
         path: PathBuf,
     },
 
-    /// The data is PNG or JPEG but uses a feature the decoder does not support.
+    /// The data is in a known format but uses a feature the decoder does not support.
     #[error("{}: unsupported image variant ({detail})", path.display())]
     UnsupportedVariant {
         /// The file (or `<memory>`).
@@ -60,7 +88,8 @@ pub enum RenderError {
         detail: String,
     },
 
-    /// The data is truncated or malformed.
+    /// The data is truncated or malformed (for a JPEG: it ends before its end-of-image
+    /// marker, or holds too few bytes for the pixels its header claims).
     #[error("{}: truncated or corrupt image data ({detail})", path.display())]
     Corrupt {
         /// The file (or `<memory>`).

@@ -1,6 +1,6 @@
 //! Decoding images from untrusted files with limits on size and memory.
 
-use std::io::{Cursor, Read};
+use std::io::Cursor;
 use std::path::Path;
 
 use image::error::LimitErrorKind;
@@ -9,7 +9,7 @@ use image::{
     ColorType, DynamicImage, ImageDecoder, ImageError, ImageFormat, ImageReader, RgbaImage,
 };
 
-use crate::RenderError;
+use crate::{Picture, RenderError, jpeg, read_regular_file};
 
 /// What `<memory>` errors name instead of a path (see [`decode_image`]).
 const IN_MEMORY: &str = "<memory>";
@@ -18,7 +18,7 @@ const IN_MEMORY: &str = "<memory>";
 ///
 /// The dimension limits are checked against the image header before any pixel
 /// buffer is allocated, so a file claiming to be 100000×100000 pixels fails
-/// at once. The memory limit bounds the decoder's pixel buffer plus the RGBA8
+/// at once. The memory limit bounds the decoder's pixel buffer plus the RGBA
 /// copy returned (and, for [`load_image`], the size of the file itself).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ImageLimits {
@@ -50,69 +50,73 @@ impl ImageLimits {
     }
 }
 
-/// Reads and decodes a PNG or JPEG file (format guessed from its content, not
-/// its name) into RGBA8, applying the EXIF orientation of JPEGs.
+/// Reads and decodes an image file (PNG, JPEG, WebP, TIFF, BMP, or the first frame
+/// of a GIF; the format is found from the content, not the name) into RGBA8,
+/// applying the EXIF orientation.
+///
+/// A 16-bit picture is rounded to 8 bits; [`load_picture`] keeps its depth.
 ///
 /// # Errors
-/// [`RenderError::NotFound`] if there is no such file, [`RenderError::Io`] if
-/// it cannot be read, and the errors of [`decode_image`] naming `path`.
+/// Those of [`load_picture`].
 pub fn load_image(path: &Path, limits: &ImageLimits) -> Result<RgbaImage, RenderError> {
-    let io_error = |source: std::io::Error| {
-        if source.kind() == std::io::ErrorKind::NotFound {
-            RenderError::NotFound {
-                path: path.to_owned(),
-            }
-        } else {
-            RenderError::Io {
-                path: path.to_owned(),
-                action: "read",
-                source,
-            }
-        }
-    };
-    let file = std::fs::File::open(path).map_err(io_error)?;
-    let memory_limit = || RenderError::MemoryLimit {
-        path: path.to_owned(),
-        limit: limits.max_alloc_bytes,
-    };
-    let expected_len = file.metadata().map_err(io_error)?.len();
-    if expected_len > limits.max_alloc_bytes {
-        return Err(memory_limit());
-    }
-    let mut bytes = Vec::new();
-    bytes
-        .try_reserve_exact(usize::try_from(expected_len).map_err(|_| memory_limit())?)
-        .map_err(|_| memory_limit())?;
-    // `take` guards against a file that grows while being read.
-    file.take(limits.max_alloc_bytes.saturating_add(1))
-        .read_to_end(&mut bytes)
-        .map_err(io_error)?;
-    if bytes.len() as u64 > limits.max_alloc_bytes {
-        return Err(memory_limit());
-    }
+    load_picture(path, limits).map(Picture::into_rgba8)
+}
+
+/// Reads and decodes an image file as [`load_image`] does, keeping 16 bits per
+/// channel where the file has more than 8 (16-bit PNG or TIFF, floating-point TIFF).
+///
+/// Only a regular file is read (a FIFO or a device is refused before it is opened),
+/// and no more of it than `limits.max_alloc_bytes`.
+///
+/// # Errors
+/// [`RenderError::NotFound`] if there is no such file,
+/// [`RenderError::NotRegularFile`] if it is a FIFO, device, socket or directory,
+/// [`RenderError::MemoryLimit`] if it is larger than `limits.max_alloc_bytes`,
+/// [`RenderError::Io`] if it cannot be read, and the errors of [`decode_picture`]
+/// naming `path`.
+pub fn load_picture(path: &Path, limits: &ImageLimits) -> Result<Picture, RenderError> {
+    let bytes = read_regular_file(path, "image", limits.max_alloc_bytes).map_err(|e| match e {
+        RenderError::FileTooLarge { .. } => RenderError::MemoryLimit {
+            path: path.to_owned(),
+            limit: limits.max_alloc_bytes,
+        },
+        other => other,
+    })?;
     decode(&bytes, limits, path)
 }
 
-/// Decodes a PNG or JPEG image held in memory (format guessed from the
-/// content) into RGBA8, applying the EXIF orientation of JPEGs.
+/// Decodes an image held in memory (format guessed from the content) into RGBA8, as
+/// [`load_image`] does.
 ///
 /// Errors name the placeholder path `<memory>`.
 ///
 /// # Errors
-/// * [`RenderError::UnsupportedFormat`] if the data is neither PNG nor JPEG;
-/// * [`RenderError::TooLarge`] if the header claims dimensions beyond `limits`;
-/// * [`RenderError::MemoryLimit`] if decoding would allocate more than allowed;
-/// * [`RenderError::Corrupt`] for truncated or malformed data;
-/// * [`RenderError::UnsupportedVariant`] for a PNG/JPEG feature the decoder lacks.
+/// Those of [`decode_picture`].
 ///
 /// # Example
 /// ```
 /// use render::{decode_image, ImageLimits, RenderError};
 ///
-/// let err = decode_image(b"GIF89a...", &ImageLimits::default()).expect_err("must fail");
+/// let err = decode_image(b"hello, world", &ImageLimits::default()).expect_err("must fail");
 /// assert!(matches!(err, RenderError::UnsupportedFormat { .. }));
 /// ```
 pub fn decode_image(bytes: &[u8], limits: &ImageLimits) -> Result<RgbaImage, RenderError> {
+    decode(bytes, limits, Path::new(IN_MEMORY)).map(Picture::into_rgba8)
+}
+
+/// Decodes an image held in memory, keeping 16 bits per channel where the data has
+/// more than 8 (see [`load_picture`]). Errors name the placeholder path `<memory>`.
+///
+/// # Errors
+/// * [`RenderError::UnsupportedFormat`] if the data is none of PNG, JPEG, WebP,
+///   TIFF, BMP or GIF;
+/// * [`RenderError::TooLarge`] if the header claims dimensions beyond `limits`;
+/// * [`RenderError::MemoryLimit`] if decoding would allocate more than allowed;
+/// * [`RenderError::Corrupt`] for truncated or malformed data (a JPEG is refused
+///   before decoding when it ends before its end-of-image marker, or when it holds
+///   too few bytes for the pixels its header claims);
+/// * [`RenderError::UnsupportedVariant`] for a feature the decoder lacks.
+pub fn decode_picture(bytes: &[u8], limits: &ImageLimits) -> Result<Picture, RenderError> {
     decode(bytes, limits, Path::new(IN_MEMORY))
 }
 
@@ -137,9 +141,16 @@ fn claimed_dimensions(bytes: &[u8], format: ImageFormat) -> Option<(u32, u32)> {
     }
 }
 
-fn decode(bytes: &[u8], limits: &ImageLimits, path: &Path) -> Result<RgbaImage, RenderError> {
+fn decode(bytes: &[u8], limits: &ImageLimits, path: &Path) -> Result<Picture, RenderError> {
     let format = match image::guess_format(bytes) {
-        Ok(format @ (ImageFormat::Png | ImageFormat::Jpeg)) => format,
+        Ok(
+            format @ (ImageFormat::Png
+            | ImageFormat::Jpeg
+            | ImageFormat::WebP
+            | ImageFormat::Tiff
+            | ImageFormat::Bmp
+            | ImageFormat::Gif),
+        ) => format,
         _ => {
             return Err(RenderError::UnsupportedFormat {
                 path: path.to_owned(),
@@ -153,6 +164,16 @@ fn decode(bytes: &[u8], limits: &ImageLimits, path: &Path) -> Result<RgbaImage, 
         height,
         limit: (limits.max_width, limits.max_height),
     };
+    // Decoders accept JPEG data cut short (the missing rows come out grey) and spend
+    // what the header claims on a few bytes; refuse such data before decoding.
+    if format == ImageFormat::Jpeg
+        && let Err(problem) = jpeg::check(bytes)
+    {
+        return Err(RenderError::Corrupt {
+            path: path.to_owned(),
+            detail: problem.detail(),
+        });
+    }
     // Fail on the header's claim before the decoder allocates anything.
     if format == ImageFormat::Png
         && let Some((w, h)) = claimed_dimensions(bytes, format)
@@ -168,10 +189,13 @@ fn decode(bytes: &[u8], limits: &ImageLimits, path: &Path) -> Result<RgbaImage, 
 
     let (width, height) = decoder.dimensions();
     let decoded = decoder.total_bytes();
-    let rgba_copy = if decoder.color_type() == ColorType::Rgba8 {
-        0
-    } else {
-        u64::from(width) * u64::from(height) * 4
+    let color = decoder.color_type();
+    // More than 8 bits per channel are kept as 16.
+    let wide = color.bits_per_pixel() > 8 * u16::from(color.channel_count());
+    let rgba_copy = match (color, wide) {
+        (ColorType::Rgba8, _) | (ColorType::Rgba16, _) => 0,
+        (_, false) => u64::from(width) * u64::from(height) * 4,
+        (_, true) => u64::from(width) * u64::from(height) * 8,
     };
     let memory_limit = || RenderError::MemoryLimit {
         path: path.to_owned(),
@@ -186,7 +210,11 @@ fn decode(bytes: &[u8], limits: &ImageLimits, path: &Path) -> Result<RgbaImage, 
     let orientation = decoder.orientation().unwrap_or(Orientation::NoTransforms);
     let mut image = DynamicImage::from_decoder(decoder).map_err(classify)?;
     image.apply_orientation(orientation);
-    Ok(image.into_rgba8())
+    Ok(if wide {
+        Picture::Rgba16(image.into_rgba16())
+    } else {
+        Picture::Rgba8(image.into_rgba8())
+    })
 }
 
 /// Turns a decoder error into the crate's error for `path`.

@@ -10,8 +10,11 @@
 //! * [`MeshView`] draws the mesh into a caller's render pass (an editor's window),
 //!   skinned in the vertex shader, with heat-map, cell, wireframe and fold-over
 //!   overlays.
-//! * [`load_image`] / [`decode_image`] decode PNG and JPEG under
-//!   [`ImageLimits`], failing fast on hostile headers.
+//! * [`load_picture`] / [`decode_picture`] decode PNG, JPEG, WebP, TIFF, BMP and
+//!   GIF under [`ImageLimits`] into a [`Picture`] of 8 or 16 bits per channel,
+//!   failing fast on hostile headers and refusing truncated JPEGs;
+//!   [`load_image`] / [`decode_image`] give RGBA8. [`read_regular_file`] reads
+//!   other inputs the same careful way (regular files only, capped).
 //! * [`save_png_atomic`] / [`write_atomic`] replace files atomically, so a
 //!   crash or a full disk never leaves a half-written file over a good one.
 //!
@@ -23,18 +26,23 @@
 
 mod atomic;
 mod error;
+mod files;
 mod gpu;
 mod image_io;
+mod jpeg;
 mod mesh;
+mod picture;
 mod raster;
 mod sample;
 mod view;
 mod warp;
 
-pub use atomic::{save_png_atomic, write_atomic};
+pub use atomic::{PngPixels, save_png_atomic, write_atomic, write_png};
 pub use error::RenderError;
+pub use files::{open_regular_file, read_regular_file};
 pub use gpu::{Affine, GpuContext, SkinnedMesh};
-pub use image_io::{ImageLimits, decode_image, load_image};
+pub use image_io::{ImageLimits, decode_image, decode_picture, load_image, load_picture};
 pub use mesh::WarpMesh;
+pub use picture::{Picture, Rgba16Image};
 pub use view::{MeshView, Overlay, ViewParams};
-pub use warp::{RasterOptions, coverage_counts, warp_cpu};
+pub use warp::{RasterOptions, coverage_counts, warp_cpu, warp_picture};

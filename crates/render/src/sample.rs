@@ -43,18 +43,40 @@ fn last_centre(size: u32) -> i64 {
     i64::from(size.saturating_sub(1)).min(1 << 30) << FRAC_BITS
 }
 
-/// A borrowed RGBA8 texture with clamp-to-edge bilinear sampling.
-pub(crate) struct Texture<'a> {
-    data: &'a [u8],
+/// A channel type a [`Texture`] can hold: `u8` or `u16`.
+pub(crate) trait Texel: Copy + Default + PartialEq + Send + Sync + 'static {
+    /// Weighted premultiplied average of four texels whose weights sum to
+    /// `WEIGHT_ONE²`.
+    fn blend(taps: &[([Self; 4], u64); 4]) -> [Self; 4];
+}
+
+impl Texel for u8 {
+    #[inline]
+    fn blend(taps: &[([u8; 4], u64); 4]) -> [u8; 4] {
+        blend(taps)
+    }
+}
+
+impl Texel for u16 {
+    #[inline]
+    fn blend(taps: &[([u16; 4], u64); 4]) -> [u16; 4] {
+        blend16(taps)
+    }
+}
+
+/// A borrowed RGBA texture (8 or 16 bits per channel) with clamp-to-edge
+/// bilinear sampling.
+pub(crate) struct Texture<'a, C = u8> {
+    data: &'a [C],
     width: usize,
     /// Position of the last texel column / row, in fixed point.
     max_x: i64,
     max_y: i64,
 }
 
-impl<'a> Texture<'a> {
-    /// Wraps `data` (row-major RGBA8, `width × height`, both non-zero).
-    pub(crate) fn new(data: &'a [u8], width: u32, height: u32) -> Self {
+impl<'a, C: Texel> Texture<'a, C> {
+    /// Wraps `data` (row-major RGBA, `width × height`, both non-zero).
+    pub(crate) fn new(data: &'a [C], width: u32, height: u32) -> Self {
         Self {
             data,
             width: width as usize,
@@ -64,18 +86,18 @@ impl<'a> Texture<'a> {
     }
 
     #[inline]
-    fn texel(&self, x: usize, y: usize) -> [u8; 4] {
+    fn texel(&self, x: usize, y: usize) -> [C; 4] {
         let i = (y * self.width + x) * 4;
         match self.data.get(i..i + 4) {
             Some(&[r, g, b, a]) => [r, g, b, a],
-            _ => [0; 4],
+            _ => [C::default(); 4],
         }
     }
 
     /// Samples at texture position `(u, v)` in source pixels (texel `(i, j)`
     /// has its centre at `(i + 0.5, j + 0.5)`).
     #[cfg(test)]
-    pub(crate) fn sample(&self, u: f64, v: f64) -> [u8; 4] {
+    pub(crate) fn sample(&self, u: f64, v: f64) -> [C; 4] {
         self.sample_fixed(to_fixed(u), to_fixed(v))
     }
 
@@ -87,14 +109,14 @@ impl<'a> Texture<'a> {
     /// coverage but no colour (no dark fringes on cut-outs). Filter weights
     /// have 16 fractional bits and are accumulated exactly in integers.
     #[inline(always)]
-    pub(crate) fn sample_fixed(&self, u: i64, v: i64) -> [u8; 4] {
+    pub(crate) fn sample_fixed(&self, u: i64, v: i64) -> [C; 4] {
         let (x0, x1, fx) = axis(u, self.max_x);
         let (y0, y1, fy) = axis(v, self.max_y);
         if fx == 0 && fy == 0 {
             return self.texel(x0, y0);
         }
         let (gx, gy) = (WEIGHT_ONE - fx, WEIGHT_ONE - fy);
-        blend(&[
+        C::blend(&[
             (self.texel(x0, y0), gx * gy),
             (self.texel(x1, y0), fx * gy),
             (self.texel(x0, y1), gx * fy),
@@ -179,6 +201,45 @@ fn blend(taps: &[([u8; 4], u64); 4]) -> [u8; 4] {
     }
 }
 
+/// [`blend`] for 16-bit channels.
+#[inline]
+fn blend16(taps: &[([u16; 4], u64); 4]) -> [u16; 4] {
+    const SHIFT: u32 = 2 * WEIGHT_BITS;
+    const HALF: u64 = 1 << (SHIFT - 1);
+    // Straight weighted average (≤ 2^48 per channel), rounded.
+    let straight = || {
+        let mut sums = [0u64; 3];
+        for &(texel, weight) in taps {
+            for (sum, &c) in sums.iter_mut().zip(&texel[..3]) {
+                *sum += weight * u64::from(c);
+            }
+        }
+        sums.map(|c| ((c + HALF) >> SHIFT) as u16)
+    };
+    if taps.iter().all(|(texel, _)| texel[3] == u16::MAX) {
+        let [r, g, b] = straight();
+        return [r, g, b, u16::MAX];
+    }
+    // Σ w·a ≤ 2^32·65535 < 2^48 and Σ w·a·c ≤ 2^32·65535² < 2^64: exact in u64.
+    let mut alpha = 0u64;
+    let mut premultiplied = [0u64; 3];
+    for &(texel, weight) in taps {
+        let wa = weight * u64::from(texel[3]);
+        alpha += wa;
+        for (sum, &c) in premultiplied.iter_mut().zip(&texel[..3]) {
+            *sum += wa * u64::from(c);
+        }
+    }
+    if alpha > 0 {
+        let inv = 1.0 / alpha as f64;
+        let [r, g, b] = premultiplied.map(|c| (c as f64 * inv + 0.5) as u16);
+        [r, g, b, ((alpha + HALF) >> SHIFT) as u16]
+    } else {
+        let [r, g, b] = straight();
+        [r, g, b, 0]
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -193,7 +254,7 @@ mod tests {
 
     #[test]
     fn clamps_to_edge() {
-        let data = [10, 20, 30, 40, 50, 60, 70, 80];
+        let data: [u8; 8] = [10, 20, 30, 40, 50, 60, 70, 80];
         let t = Texture::new(&data, 2, 1);
         assert_eq!(t.sample(-100.0, 0.5), [10, 20, 30, 40]);
         assert_eq!(t.sample(100.0, -7.0), [50, 60, 70, 80]);
@@ -203,14 +264,40 @@ mod tests {
 
     #[test]
     fn premultiplied_half_way_has_no_dark_fringe() {
-        let data = [255, 0, 0, 255, 0, 0, 0, 0];
+        let data: [u8; 8] = [255, 0, 0, 255, 0, 0, 0, 0];
         let t = Texture::new(&data, 2, 1);
         assert_eq!(t.sample(1.0, 0.5), [255, 0, 0, 128]);
     }
 
     #[test]
+    fn sixteen_bits_blend_like_eight() {
+        // The same texels widened to 16 bits (×257) sample to the 8-bit result
+        // widened, within rounding.
+        let narrow: [u8; 16] = [
+            255, 0, 0, 255, 0, 0, 0, 0, 10, 200, 30, 128, 90, 80, 70, 255,
+        ];
+        let wide: Vec<u16> = narrow.iter().map(|&c| u16::from(c) * 257).collect();
+        let (t8, t16) = (Texture::new(&narrow, 2, 2), Texture::new(&wide, 2, 2));
+        for (u, v) in [(1.0, 0.5), (0.7, 1.3), (1.0, 1.0), (0.5, 0.5), (1.5, 1.5)] {
+            let (a, b) = (t8.sample(u, v), t16.sample(u, v));
+            for k in 0..4 {
+                let widened = i32::from(a[k]) * 257;
+                assert!(
+                    (widened - i32::from(b[k])).abs() <= 257,
+                    "({u}, {v}): {a:?} vs {b:?}"
+                );
+            }
+        }
+        // Exactly between two 16-bit values the result keeps the precision 8 bits lack.
+        let fine: [u16; 8] = [1000, 2000, 3000, 65535, 1001, 2001, 3001, 65535];
+        let t = Texture::new(&fine, 2, 1);
+        assert_eq!(t.sample(1.0, 0.5), [1001, 2001, 3001, 65535]);
+        assert_eq!(t.sample(1.5, 0.5), [1001, 2001, 3001, 65535]);
+    }
+
+    #[test]
     fn transparent_regions_keep_their_colour() {
-        let data = [200, 100, 0, 0, 100, 50, 0, 0];
+        let data: [u8; 8] = [200, 100, 0, 0, 100, 50, 0, 0];
         let t = Texture::new(&data, 2, 1);
         assert_eq!(t.sample(1.0, 0.5), [150, 75, 0, 0]);
     }

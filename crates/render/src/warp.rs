@@ -4,8 +4,8 @@ use image::RgbaImage;
 use rayon::iter::ParallelExtend;
 
 use crate::raster::Raster;
-use crate::sample::{FIXED_RANGE, Texture, step_to_fixed, to_fixed};
-use crate::{RenderError, WarpMesh};
+use crate::sample::{FIXED_RANGE, Texel, Texture, step_to_fixed, to_fixed};
+use crate::{Picture, RenderError, Rgba16Image, WarpMesh};
 
 /// Options for [`warp_cpu`].
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -88,23 +88,72 @@ pub fn warp_cpu(
     height: u32,
     opts: &RasterOptions,
 ) -> Result<RgbaImage, RenderError> {
-    mesh.validate()?;
     let (tw, th) = texture.dimensions();
+    let pixels = warp_texels(
+        texture.as_raw(),
+        tw,
+        th,
+        mesh,
+        width,
+        height,
+        opts.background,
+    )?;
+    RgbaImage::from_raw(width, height, pixels).ok_or(RenderError::OutputTooLarge { width, height })
+}
+
+/// Draws `mesh` textured with `texture` as [`warp_cpu`] does, in the picture's own
+/// depth: a 16-bit picture is sampled and written with 16 bits per channel (the
+/// background's channels widened by ×257), an 8-bit one exactly as [`warp_cpu`]
+/// draws it.
+///
+/// # Errors
+/// As [`warp_cpu`].
+pub fn warp_picture(
+    texture: &Picture,
+    mesh: &WarpMesh,
+    width: u32,
+    height: u32,
+    opts: &RasterOptions,
+) -> Result<Picture, RenderError> {
+    match texture {
+        Picture::Rgba8(texture) => warp_cpu(texture, mesh, width, height, opts).map(Picture::Rgba8),
+        Picture::Rgba16(texture) => {
+            let (tw, th) = texture.dimensions();
+            let background = opts.background.map(|c| u16::from(c) * 257);
+            let pixels = warp_texels(texture.as_raw(), tw, th, mesh, width, height, background)?;
+            Rgba16Image::from_raw(width, height, pixels)
+                .map(Picture::Rgba16)
+                .ok_or(RenderError::OutputTooLarge { width, height })
+        }
+    }
+}
+
+/// The work of [`warp_cpu`] on row-major RGBA texels of either depth.
+fn warp_texels<C: Texel>(
+    texels: &[C],
+    tw: u32,
+    th: u32,
+    mesh: &WarpMesh,
+    width: u32,
+    height: u32,
+    background: [C; 4],
+) -> Result<Vec<C>, RenderError> {
+    mesh.validate()?;
     if tw == 0 || th == 0 {
         return Err(RenderError::EmptyTexture {
             width: tw,
             height: th,
         });
     }
-    let mut pixels = alloc::<u8>(width, height, 4)?;
+    let mut pixels = alloc::<C>(width, height, 4)?;
     let raster = Raster::new(mesh, width, height);
-    let texture = Texture::new(texture.as_raw(), tw, th);
-    let background = opts.background;
+    let texture = Texture::new(texels, tw, th);
+    let clear = background == [C::default(); 4];
     raster.scan(
         &mut pixels,
         4,
         |band| {
-            if background != [0; 4] {
+            if !clear {
                 for px in band.chunks_exact_mut(4) {
                     px.copy_from_slice(&background);
                 }
@@ -141,7 +190,7 @@ pub fn warp_cpu(
             }
         },
     );
-    RgbaImage::from_raw(width, height, pixels).ok_or(RenderError::OutputTooLarge { width, height })
+    Ok(pixels)
 }
 
 /// How many triangles of `mesh` cover each pixel of a `width × height`

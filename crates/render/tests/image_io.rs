@@ -7,7 +7,10 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use image::{Rgba, RgbaImage};
-use render::{ImageLimits, RenderError, decode_image, load_image, save_png_atomic, write_atomic};
+use render::{
+    ImageLimits, Picture, RenderError, decode_image, decode_picture, load_image, load_picture,
+    read_regular_file, save_png_atomic, write_atomic,
+};
 use support::{encode_png, png_with_header, random_image};
 
 /// Files in `dir` other than `keep`.
@@ -88,16 +91,194 @@ fn garbage_and_other_formats_are_unsupported() {
     for bytes in [
         &b""[..],
         b"hello, world",
-        b"GIF89a\x01\x00\x01\x00\x00\x00\x00",
-        b"BM\x1e\x00\x00\x00\x00\x00",
+        b"P6\n1 1\n255\nabc",
+        b"\0\0\x01\0junk",
     ] {
         let err = decode_image(bytes, &limits).expect_err("not an image");
         assert!(
             matches!(err, RenderError::UnsupportedFormat { .. }),
             "{err}"
         );
-        assert_eq!(err.to_string(), "<memory>: not a PNG or JPEG image");
+        assert_eq!(
+            err.to_string(),
+            "<memory>: not a PNG, JPEG, WebP, TIFF, BMP or GIF image"
+        );
     }
+    // Known formats with broken data are corrupt, not a panic.
+    for bytes in [
+        &b"GIF89a\x01\x00\x01\x00\x00\x00\x00"[..],
+        b"BM\x1e\x00\x00\x00\x00\x00",
+        b"II*\x00\x08\x00\x00\x00",
+        b"RIFF\x10\x00\x00\x00WEBPVP8 ",
+    ] {
+        let err = decode_image(bytes, &limits).expect_err("broken");
+        assert!(
+            matches!(
+                err,
+                RenderError::Corrupt { .. } | RenderError::UnsupportedVariant { .. }
+            ),
+            "{err}"
+        );
+    }
+}
+
+/// Encodes `image` in `format` in memory.
+fn encode(image: &image::DynamicImage, format: image::ImageFormat) -> Vec<u8> {
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    image.write_to(&mut bytes, format).expect("encode");
+    bytes.into_inner()
+}
+
+#[test]
+fn webp_tiff_bmp_and_gif_open_too() {
+    // Few colours (a GIF keeps up to 256 exactly), some transparent.
+    let image = RgbaImage::from_fn(23, 17, |x, y| {
+        let k = ((x / 4 + y / 3) % 5) as u8;
+        Rgba([k * 50, 255 - k * 40, k * 13, if k == 4 { 0 } else { 255 }])
+    });
+    let dynamic = image::DynamicImage::ImageRgba8(image.clone());
+    for format in [
+        image::ImageFormat::WebP,
+        image::ImageFormat::Tiff,
+        image::ImageFormat::Bmp,
+        image::ImageFormat::Gif,
+    ] {
+        let bytes = encode(&dynamic, format);
+        let decoded = decode_image(&bytes, &ImageLimits::default())
+            .unwrap_or_else(|e| panic!("{format:?}: {e}"));
+        assert_eq!(decoded.dimensions(), (23, 17), "{format:?}");
+        for (got, want) in decoded.pixels().zip(image.pixels()) {
+            // Fully transparent pixels may lose their colour (GIF).
+            if want[3] == 0 {
+                assert_eq!(got[3], 0, "{format:?}");
+            } else {
+                assert_eq!(got, want, "{format:?}");
+            }
+        }
+        let tiny = ImageLimits {
+            max_width: 20,
+            ..ImageLimits::default()
+        };
+        let err = decode_image(&bytes, &tiny).expect_err("too wide");
+        assert!(
+            matches!(err, RenderError::TooLarge { .. }),
+            "{format:?}: {err}"
+        );
+    }
+}
+
+#[test]
+fn a_gif_opens_on_its_first_frame() {
+    use image::codecs::gif::GifEncoder;
+    let frame = |c: u8| image::Frame::new(RgbaImage::from_pixel(4, 3, Rgba([c, 0, 0, 255])));
+    let mut bytes = Vec::new();
+    {
+        let mut encoder = GifEncoder::new(&mut bytes);
+        encoder
+            .encode_frames([frame(200), frame(50)])
+            .expect("encode frames");
+    }
+    let decoded = decode_image(&bytes, &ImageLimits::default()).expect("decode");
+    assert_eq!(decoded.get_pixel(1, 1).0, [200, 0, 0, 255]);
+}
+
+#[test]
+fn sixteen_bit_pictures_keep_their_depth() {
+    let wide = render::Rgba16Image::from_fn(9, 7, |x, y| {
+        Rgba([
+            (x * 7001 + y * 13) as u16,
+            (y * 9001 + 1) as u16,
+            65535 - (x * y * 300) as u16,
+            if x == 0 { 0 } else { 40000 + x as u16 },
+        ])
+    });
+    let dir = tempfile::tempdir().expect("tempdir");
+    // A 16-bit PNG written from a Picture reads back as the same 16-bit picture.
+    let path = dir.path().join("wide.png");
+    save_png_atomic(&path, &Picture::Rgba16(wide.clone())).expect("save");
+    let back = load_picture(&path, &ImageLimits::default()).expect("load");
+    assert_eq!(back, Picture::Rgba16(wide.clone()));
+    let decoded = image::open(&path).expect("open");
+    assert_eq!(decoded.color(), image::ColorType::Rgba16);
+    // A 16-bit TIFF too.
+    let tiff = encode(
+        &image::DynamicImage::ImageRgba16(wide.clone()),
+        image::ImageFormat::Tiff,
+    );
+    let back = decode_picture(&tiff, &ImageLimits::default()).expect("tiff");
+    assert_eq!(back, Picture::Rgba16(wide.clone()));
+    // 16-bit grey becomes 16-bit RGBA; 8-bit stays 8-bit.
+    let grey = image::ImageBuffer::<image::Luma<u16>, _>::from_fn(3, 2, |x, y| {
+        image::Luma([(x * 20000 + y) as u16])
+    });
+    let png = encode(
+        &image::DynamicImage::ImageLuma16(grey),
+        image::ImageFormat::Png,
+    );
+    match decode_picture(&png, &ImageLimits::default()).expect("grey") {
+        Picture::Rgba16(p) => assert_eq!(p.get_pixel(2, 1).0, [40001, 40001, 40001, 65535]),
+        other => panic!("expected 16 bits, got {}", other.bits_per_channel()),
+    }
+    let narrow = encode_png(&random_image(5, 5, 9));
+    assert_eq!(
+        decode_picture(&narrow, &ImageLimits::default())
+            .expect("narrow")
+            .bits_per_channel(),
+        8
+    );
+    // The RGBA8 view rounds.
+    assert_eq!(
+        decode_image(&tiff, &ImageLimits::default()).expect("rgba8"),
+        Picture::Rgba16(wide).into_rgba8()
+    );
+}
+
+/// A baseline JPEG of a smooth picture.
+fn jpeg(width: u32, height: u32) -> Vec<u8> {
+    let image = image::RgbImage::from_fn(width, height, |x, y| {
+        image::Rgb([(x * 3) as u8, (y * 5) as u8, ((x + y) * 2) as u8])
+    });
+    encode(
+        &image::DynamicImage::ImageRgb8(image),
+        image::ImageFormat::Jpeg,
+    )
+}
+
+#[test]
+fn a_jpeg_cut_short_is_refused_as_truncated() {
+    let whole = jpeg(80, 60);
+    assert!(decode_image(&whole, &ImageLimits::default()).is_ok());
+    for cut in [whole.len() / 2, whole.len() - 2, whole.len() - 1, 700] {
+        let err = decode_image(&whole[..cut], &ImageLimits::default()).expect_err("truncated");
+        assert!(
+            matches!(err, RenderError::Corrupt { .. }),
+            "cut at {cut}: {err}"
+        );
+        assert!(err.to_string().contains("truncated"), "cut at {cut}: {err}");
+    }
+}
+
+#[test]
+fn a_tiny_jpeg_claiming_a_huge_size_is_refused_before_decoding() {
+    let mut forged = jpeg(16, 16);
+    let sof = forged
+        .windows(2)
+        .position(|w| w == [0xFF, 0xC0])
+        .expect("a baseline frame header");
+    forged[sof + 5..sof + 7].copy_from_slice(&16000u16.to_be_bytes());
+    forged[sof + 7..sof + 9].copy_from_slice(&16000u16.to_be_bytes());
+    let start = Instant::now();
+    let err = decode_image(&forged, &ImageLimits::default()).expect_err("too short");
+    assert!(
+        start.elapsed() < Duration::from_millis(100),
+        "{:?}",
+        start.elapsed()
+    );
+    assert!(matches!(err, RenderError::Corrupt { .. }), "{err}");
+    assert_eq!(
+        err.to_string(),
+        "<memory>: truncated or corrupt image data (its data is too short for 16000×16000 pixels)"
+    );
 }
 
 #[test]
@@ -180,11 +361,14 @@ fn load_names_the_path() {
     let err = load_image(&text, &ImageLimits::default()).expect_err("not an image");
     assert_eq!(
         err.to_string(),
-        format!("{}: not a PNG or JPEG image", text.display())
+        format!(
+            "{}: not a PNG, JPEG, WebP, TIFF, BMP or GIF image",
+            text.display()
+        )
     );
 
     let err = load_image(dir.path(), &ImageLimits::default()).expect_err("a directory");
-    assert!(matches!(err, RenderError::Io { .. }), "{err}");
+    assert!(matches!(err, RenderError::NotRegularFile { .. }), "{err}");
 
     let big = dir.path().join("big.png");
     fs::write(&big, encode_png(&random_image(64, 64, 3))).expect("write");
@@ -291,4 +475,179 @@ fn opaque_red_png_decodes_to_red() {
     let image = RgbaImage::from_pixel(3, 3, Rgba([255, 0, 0, 255]));
     let decoded = decode_image(&encode_png(&image), &ImageLimits::default()).expect("decode");
     assert_eq!(decoded, image);
+}
+
+#[cfg(unix)]
+fn mkfifo(path: &Path) {
+    let status = std::process::Command::new("mkfifo")
+        .arg(path)
+        .status()
+        .expect("mkfifo runs");
+    assert!(status.success(), "mkfifo {}", path.display());
+}
+
+#[cfg(unix)]
+#[test]
+fn fifos_and_devices_are_refused_without_reading() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let fifo = dir.path().join("pipe.png");
+    mkfifo(&fifo);
+    let start = Instant::now();
+    // Opening the FIFO would block: nothing writes to it.
+    let err = load_image(&fifo, &ImageLimits::default()).expect_err("a FIFO");
+    assert_eq!(
+        err.to_string(),
+        format!("image {} is not a regular file (a FIFO)", fifo.display())
+    );
+    let err = load_image(Path::new("/dev/zero"), &ImageLimits::default()).expect_err("a device");
+    assert_eq!(
+        err.to_string(),
+        "image /dev/zero is not a regular file (a character device)"
+    );
+    // Through a symbolic link too.
+    let link = dir.path().join("link.json");
+    std::os::unix::fs::symlink("/dev/zero", &link).expect("symlink");
+    let err = read_regular_file(&link, "rig file", 8 << 20).expect_err("a device");
+    assert!(matches!(err, RenderError::NotRegularFile { .. }), "{err}");
+    assert!(start.elapsed() < Duration::from_secs(2));
+}
+
+#[test]
+fn reads_are_capped_before_reading() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("big.json");
+    let file = fs::File::create(&path).expect("create");
+    // A sparse file: 52.4 MB claimed, nothing written.
+    file.set_len(52_400_000).expect("set_len");
+    let err = read_regular_file(&path, "rig file", 8 << 20).expect_err("too large");
+    assert_eq!(
+        err.to_string(),
+        format!(
+            "rig file {} is 52.4 MB; rig files over 8 MiB are refused",
+            path.display()
+        )
+    );
+    assert!(matches!(
+        err,
+        RenderError::FileTooLarge {
+            len: 52_400_000,
+            ..
+        }
+    ));
+    fs::write(&path, b"small").expect("write");
+    assert_eq!(
+        read_regular_file(&path, "rig file", 8 << 20).expect("read"),
+        b"small"
+    );
+    let err = read_regular_file(&dir.path().join("nope"), "rig file", 8).expect_err("missing");
+    assert!(matches!(err, RenderError::NotFound { .. }), "{err}");
+}
+
+#[cfg(unix)]
+#[test]
+fn writing_to_a_device_writes_through_and_keeps_the_device() {
+    use std::os::unix::fs::FileTypeExt;
+    let null = Path::new("/dev/null");
+    write_atomic(null, b"nothing to see").expect("write to /dev/null");
+    save_png_atomic(null, &random_image(4, 4, 6)).expect("png to /dev/null");
+    let meta = fs::metadata(null).expect("stat");
+    assert!(meta.file_type().is_char_device(), "/dev/null was replaced");
+}
+
+#[cfg(unix)]
+#[test]
+fn writing_to_a_symlink_writes_its_target_and_keeps_the_link() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let target = dir.path().join("real.png");
+    fs::write(&target, b"old").expect("write");
+    let link = dir.path().join("link.png");
+    std::os::unix::fs::symlink("real.png", &link).expect("symlink");
+    let image = random_image(6, 5, 7);
+    save_png_atomic(&link, &image).expect("save through the link");
+    assert!(
+        fs::symlink_metadata(&link)
+            .expect("lstat")
+            .file_type()
+            .is_symlink()
+    );
+    assert_eq!(
+        load_image(&target, &ImageLimits::default()).expect("load"),
+        image
+    );
+    // A chain of links, the last one dangling: the file is created where it points.
+    let second = dir.path().join("second.json");
+    std::os::unix::fs::symlink("new.json", &second).expect("symlink");
+    let first = dir.path().join("first.json");
+    std::os::unix::fs::symlink(&second, &first).expect("symlink");
+    write_atomic(&first, b"{}").expect("write through two links");
+    assert_eq!(fs::read(dir.path().join("new.json")).expect("read"), b"{}");
+    assert!(
+        fs::symlink_metadata(&first)
+            .expect("lstat")
+            .file_type()
+            .is_symlink()
+    );
+    assert!(
+        fs::symlink_metadata(&second)
+            .expect("lstat")
+            .file_type()
+            .is_symlink()
+    );
+    let mut names = leftovers(dir.path(), &[]);
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "first.json",
+            "link.png",
+            "new.json",
+            "real.png",
+            "second.json"
+        ]
+    );
+    // A loop of links is an error, not a hang.
+    let a = dir.path().join("a");
+    let b = dir.path().join("b");
+    std::os::unix::fs::symlink("b", &a).expect("symlink");
+    std::os::unix::fs::symlink("a", &b).expect("symlink");
+    let err = write_atomic(&a, b"x").expect_err("a loop");
+    assert!(err.to_string().contains("symbolic link"), "{err}");
+}
+
+#[cfg(unix)]
+#[test]
+fn writing_to_a_fifo_reaches_its_reader() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let fifo = dir.path().join("out.png");
+    mkfifo(&fifo);
+    let reader = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || fs::read(&fifo).expect("read the FIFO"))
+    };
+    let image = random_image(7, 3, 8);
+    save_png_atomic(&fifo, &image).expect("save to the FIFO");
+    let bytes = reader.join().expect("reader thread");
+    assert_eq!(
+        decode_image(&bytes, &ImageLimits::default()).expect("decode"),
+        image
+    );
+    assert!(
+        fs::metadata(&fifo)
+            .expect("stat")
+            .file_type()
+            .is_fifo_like()
+    );
+}
+
+/// `FileType::is_fifo` behind a name that reads well above.
+#[cfg(unix)]
+trait FifoLike {
+    fn is_fifo_like(&self) -> bool;
+}
+
+#[cfg(unix)]
+impl FifoLike for fs::FileType {
+    fn is_fifo_like(&self) -> bool {
+        std::os::unix::fs::FileTypeExt::is_fifo(self)
+    }
 }

@@ -502,3 +502,85 @@ fn wild_but_valid_meshes_never_panic() {
         assert_eq!(counts.len(), (w * h) as usize);
     }
 }
+
+/// `image` widened to 16 bits per channel, with low bits that 8 bits cannot hold.
+fn widen(image: &RgbaImage) -> render::Rgba16Image {
+    render::Rgba16Image::from_fn(image.width(), image.height(), |x, y| {
+        let p = image.get_pixel(x, y).0;
+        let fine = |c: u8| (u16::from(c) * 257).saturating_sub(((x * 31 + y * 17) % 97) as u16);
+        Rgba([fine(p[0]), fine(p[1]), fine(p[2]), fine(p[3])])
+    })
+}
+
+#[test]
+fn sixteen_bit_pictures_warp_in_sixteen_bits() {
+    let image = random_image(61, 47, 11);
+    let wide = widen(&image);
+    let mut grid = Grid::new(61.0, 47.0, 9, 7);
+    grid.jitter(0.3, 1e-6, 12, Vec2::new(61.0 / 9.0, 47.0 / 7.0));
+    let mesh = |deformed: &[Vec2]| -> (Vec<Vec2>, Vec<Vec2>) {
+        (grid.positions.clone(), deformed.to_vec())
+    };
+    let opts = RasterOptions {
+        background: [1, 2, 3, 4],
+    };
+    // At rest, 16 bits come back exactly (8 bits could not hold them).
+    let (rest, deformed) = mesh(&grid.positions);
+    let warp_mesh = WarpMesh {
+        rest: &rest,
+        deformed: &deformed,
+        triangles: &grid.triangles,
+    };
+    let out = render::warp_picture(
+        &render::Picture::Rgba16(wide.clone()),
+        &warp_mesh,
+        61,
+        47,
+        &opts,
+    )
+    .expect("warp");
+    assert_eq!(out, render::Picture::Rgba16(wide.clone()));
+
+    // Swirled, the 16-bit result rounded to 8 bits is the 8-bit result within a
+    // level or two (the two filter the same positions at different precision), and
+    // an 8-bit picture goes through `warp_picture` exactly as through `warp_cpu`.
+    let swirled = support::swirl(&grid.positions, 47.0);
+    let (rest, deformed) = mesh(&swirled);
+    let warp_mesh = WarpMesh {
+        rest: &rest,
+        deformed: &deformed,
+        triangles: &grid.triangles,
+    };
+    let narrow16 = render::Picture::Rgba16(wide.clone()).into_rgba8();
+    let eight = warp_cpu(&narrow16, &warp_mesh, 70, 50, &opts).expect("warp 8");
+    let via_picture = render::warp_picture(
+        &render::Picture::Rgba8(narrow16.clone()),
+        &warp_mesh,
+        70,
+        50,
+        &opts,
+    )
+    .expect("warp picture 8");
+    assert_eq!(via_picture, render::Picture::Rgba8(eight.clone()));
+    let sixteen = render::warp_picture(&render::Picture::Rgba16(wide), &warp_mesh, 70, 50, &opts)
+        .expect("warp 16");
+    let render::Picture::Rgba16(sixteen) = sixteen else {
+        panic!("a 16-bit picture warps to a 16-bit picture");
+    };
+    assert_eq!(
+        sixteen.get_pixel(69, 49).0,
+        [257, 514, 771, 1028],
+        "background"
+    );
+    let rounded = render::Picture::Rgba16(sixteen).into_rgba8();
+    // Alpha agrees within a level; colour too where alpha is not so low that
+    // un-premultiplying magnifies the rounding of 8-bit filtering.
+    for (a, b) in rounded.pixels().zip(eight.pixels()) {
+        assert!(a[3].abs_diff(b[3]) <= 1, "{a:?} vs {b:?}");
+        if b[3] >= 64 {
+            for k in 0..3 {
+                assert!(a[k].abs_diff(b[k]) <= 2, "{a:?} vs {b:?}");
+            }
+        }
+    }
+}
