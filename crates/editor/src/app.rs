@@ -925,15 +925,25 @@ impl EditorApp {
         let doc = self.doc.as_ref()?;
         let project = doc.project_for_saving(None);
         let image = doc.image.clone();
+        let deep = doc.deep.clone();
         Some(move || {
             let clock = Instant::now();
             let result = (|| -> Result<()> {
                 let prepared = pipeline::prepare(&image, &project, None)?;
-                let warped = pipeline::warp(&image, &prepared.rig)?;
-                if cancel.is_set() {
-                    anyhow::bail!("cancelled");
+                // A 16-bit picture exports with 16 bits, as `c2warp render` does.
+                if let Some(deep) = deep {
+                    let warped = pipeline::warp_picture(&deep, &prepared.rig)?;
+                    if cancel.is_set() {
+                        anyhow::bail!("cancelled");
+                    }
+                    render::save_png_atomic(&path, &warped)?;
+                } else {
+                    let warped = pipeline::warp(&image, &prepared.rig)?;
+                    if cancel.is_set() {
+                        anyhow::bail!("cancelled");
+                    }
+                    render::save_png_atomic(&path, &warped)?;
                 }
-                render::save_png_atomic(&path, &warped)?;
                 Ok(())
             })()
             .with_context(|| format!("cannot export {}", path.display()));
@@ -1067,10 +1077,14 @@ fn remesh(
     cause: Rebuild,
 ) -> impl FnOnce() -> Outcome + Send + 'static {
     let image = doc.image.clone();
+    let deep = doc.deep.clone();
     let image_path = doc.image_path.clone();
     move || Outcome::Rebuilt {
         cause,
-        document: Document::with_image(image, image_path, project),
+        document: Document::with_image(image, image_path, project).map(|mut d| {
+            d.deep = deep;
+            d
+        }),
     }
 }
 

@@ -77,8 +77,11 @@ pub enum Edit {
 pub struct Document {
     /// The rig file as it would be saved (virtual handles are filled in on save).
     project: Project,
-    /// The picture, at full resolution.
+    /// The picture, at full resolution, 8 bits per channel (meshing, the view).
     pub image: Arc<RgbaImage>,
+    /// The picture as its file has it when that has 16 bits per channel: exports are
+    /// drawn from it, so they keep the depth.
+    pub deep: Option<Arc<render::Picture>>,
     /// Where the picture came from (`None`: the built-in picture).
     pub image_path: Option<PathBuf>,
     /// Where the project was last saved or loaded from.
@@ -122,6 +125,7 @@ impl Document {
         Ok(Self {
             project,
             image,
+            deep: None,
             image_path,
             project_path: None,
             rig: prepared.rig,
@@ -148,12 +152,32 @@ impl Document {
     /// An unreadable, corrupt, unsupported or oversized picture, or one that cannot be
     /// meshed (no opaque pixel).
     pub fn open_image(path: &Path) -> Result<Self> {
-        let image = pipeline::load_image(path)?;
+        let picture = pipeline::load_picture(path)?;
         let project = Project {
             image: Some(path.to_path_buf()),
             ..Project::default()
         };
-        Self::new(image, Some(path.to_path_buf()), project)
+        Self::from_picture(picture, Some(path.to_path_buf()), project)
+    }
+
+    /// As [`Document::new`] for a decoded picture of either depth (a 16-bit one is
+    /// kept for exports).
+    ///
+    /// # Errors
+    /// As [`Document::new`].
+    pub fn from_picture(
+        picture: render::Picture,
+        image_path: Option<PathBuf>,
+        project: Project,
+    ) -> Result<Self> {
+        match picture {
+            render::Picture::Rgba8(image) => Self::new(image, image_path, project),
+            deep @ render::Picture::Rgba16(_) => {
+                let mut document = Self::new(deep.to_rgba8().into_owned(), image_path, project)?;
+                document.deep = Some(Arc::new(deep));
+                Ok(document)
+            }
+        }
     }
 
     /// A project file and the picture it names (relative to the project file).
@@ -167,9 +191,9 @@ impl Document {
             bail!("{} names no image", path.display());
         };
         let image_path = path.parent().unwrap_or(Path::new("")).join(image);
-        let picture = pipeline::load_image(&image_path)
+        let picture = pipeline::load_picture(&image_path)
             .with_context(|| format!("the image of project {}", path.display()))?;
-        let mut document = Self::new(picture, Some(image_path), project)
+        let mut document = Self::from_picture(picture, Some(image_path), project)
             .with_context(|| format!("project {}", path.display()))?;
         document.project_path = Some(path.to_path_buf());
         Ok(document)

@@ -450,3 +450,62 @@ fn an_opened_picture_is_fitted_and_stays_fitted_when_the_window_changes() {
     h.run();
     assert!(fitted(&h), "{:?}", h.state().viewport);
 }
+
+#[test]
+fn a_sixteen_bit_picture_exports_with_sixteen_bits() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let source = dir.path().join("deep.png");
+    let deep = image::ImageBuffer::<image::Rgba<u16>, _>::from_fn(64, 48, |x, y| {
+        image::Rgba([(x * 1000 + 7) as u16, (y * 1300 + 3) as u16, 40_001, 65_535])
+    });
+    deep.save(&source).expect("write a 16-bit PNG");
+    let mut h = editor_with(Box::new(NoDesktop), false);
+    h.state_mut().open_in_background(source);
+    settle(&mut h);
+    assert_eq!(
+        h.state()
+            .document()
+            .and_then(|d| d.deep.as_ref())
+            .map(|p| p.bits_per_channel()),
+        Some(16),
+        "{:?}",
+        h.state().message
+    );
+    let out = dir.path().join("out.png");
+    h.state_mut().export_to(&out);
+    let exported = image::open(&out).expect("an exported PNG");
+    assert_eq!(exported.color(), image::ColorType::Rgba16);
+    // At rest (no handles) the export is the picture itself, all 16 bits of it.
+    assert_eq!(exported.to_rgba16(), deep);
+}
+
+#[test]
+fn a_fifo_or_a_device_is_refused_at_once() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let fifo = dir.path().join("picture.png");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .expect("mkfifo runs");
+    assert!(made.success());
+    let project = dir.path().join("fifo.json");
+    std::fs::write(
+        &project,
+        r#"{"version": 1, "image": "picture.png", "handles": []}"#,
+    )
+    .expect("write");
+    let mut h = editor_with(Box::new(NoDesktop), false);
+    let before = handles(&h);
+    for path in [fifo, project, std::path::PathBuf::from("/dev/zero")] {
+        h.state_mut().request_open(path.clone());
+        settle(&mut h);
+        let message = h.state().message.clone().expect("a message");
+        assert!(
+            message.is_error && message.text.contains("not a regular file"),
+            "{}: {}",
+            path.display(),
+            message.text
+        );
+        assert_eq!(handles(&h), before);
+    }
+}
