@@ -107,10 +107,12 @@ struct Source {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    // Before any thread starts: the GPU path's Vulkan layer complains on stderr
-    // without it (see runtime_dir.rs).
+    // Before any thread starts: the GPU path's Vulkan layer (the editor's too)
+    // complains on stderr without it (see runtime_dir.rs).
     let _runtime_dir = match &cli.command {
-        Some(Command::Render { gpu: true, .. }) => runtime_dir::ensure(),
+        Some(Command::Render { gpu: true, .. } | Command::Open { .. }) | None => {
+            runtime_dir::ensure()
+        }
         _ => None,
     };
     let result = match cli.command {

@@ -411,9 +411,12 @@ fn walk(seed: u64, actions: usize) {
         assert!(monkey.h.state_mut().edit(Edit::Settings(s)));
     }
     let clock = Instant::now();
+    let mut slowest: Vec<(f64, String)> = Vec::new();
     for step in 0..actions {
         let result = std::panic::catch_unwind(AssertUnwindSafe(|| {
+            let started = Instant::now();
             let what = monkey.act();
+            slowest.push((started.elapsed().as_secs_f64(), what.clone()));
             monkey.trail.push(what);
             monkey.h.state().sanity_check()
         }));
@@ -461,6 +464,10 @@ fn walk(seed: u64, actions: usize) {
         "monkey seed {seed}: {actions} actions in {seconds:.1} s ({:.0} actions/s), gpu={gpu}",
         actions as f64 / seconds
     );
+    slowest.sort_by(|a, b| b.0.total_cmp(&a.0));
+    for (s, what) in slowest.iter().take(3) {
+        println!("  slowest: {s:.2} s  {what}");
+    }
 }
 
 fn env_list(name: &str, default: &[u64]) -> Vec<u64> {
