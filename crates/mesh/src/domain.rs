@@ -271,8 +271,13 @@ pub fn domain_from_image(
     })
 }
 
-/// Labels connected components of pixels equal to `value`; returns per-pixel labels
-/// (`u32::MAX` for other pixels) and the size of each component.
+/// Labels connected components of pixels equal to `value` (8-connected when `eight`,
+/// else 4-connected); returns per-pixel labels (`u32::MAX` for other pixels) and the size
+/// of each component. Components are numbered in the order of their first pixel in rows
+/// from the top, left to right.
+///
+/// Works on runs of equal pixels along rows, joined with a union-find where they touch
+/// a run of the row above.
 fn label_components(
     mask: &[bool],
     w: usize,
@@ -280,38 +285,79 @@ fn label_components(
     value: bool,
     eight: bool,
 ) -> (Vec<u32>, Vec<usize>) {
-    let mut labels = vec![u32::MAX; w * h];
-    let mut sizes = Vec::new();
-    let mut stack = Vec::new();
-    for start in 0..w * h {
-        if mask[start] != value || labels[start] != u32::MAX {
-            continue;
+    // Runs `[x0, x1)` of each row, rows in order; `row_start[y]..row_start[y + 1]`.
+    let mut runs: Vec<(u32, u32)> = Vec::new();
+    let mut row_start = Vec::with_capacity(h + 1);
+    for row in mask.chunks_exact(w) {
+        row_start.push(runs.len());
+        let mut x = 0;
+        while x < w {
+            if row[x] != value {
+                x += 1;
+                continue;
+            }
+            let x0 = x;
+            while x < w && row[x] == value {
+                x += 1;
+            }
+            runs.push((x0 as u32, x as u32));
         }
-        let l = sizes.len() as u32;
-        labels[start] = l;
-        stack.push(start);
-        let mut size = 0;
-        while let Some(i) = stack.pop() {
-            size += 1;
-            let (x, y) = ((i % w) as isize, (i / w) as isize);
-            for dy in -1isize..=1 {
-                for dx in -1isize..=1 {
-                    if (dx == 0 && dy == 0) || (!eight && dx != 0 && dy != 0) {
-                        continue;
-                    }
-                    let (nx, ny) = (x + dx, y + dy);
-                    if nx < 0 || ny < 0 || nx >= w as isize || ny >= h as isize {
-                        continue;
-                    }
-                    let j = ny as usize * w + nx as usize;
-                    if mask[j] == value && labels[j] == u32::MAX {
-                        labels[j] = l;
-                        stack.push(j);
-                    }
+    }
+    row_start.push(runs.len());
+    let mut parent: Vec<u32> = (0..runs.len() as u32).collect();
+    fn root(parent: &mut [u32], mut i: u32) -> u32 {
+        let mut r = i;
+        while parent[r as usize] != r {
+            r = parent[r as usize];
+        }
+        while parent[i as usize] != r {
+            let next = parent[i as usize];
+            parent[i as usize] = r;
+            i = next;
+        }
+        r
+    }
+    // Diagonal neighbours count for 8-connectivity: runs then touch when they merely
+    // meet at a corner.
+    let reach = u32::from(eight);
+    for y in 1..h {
+        let (above, here) = (
+            row_start[y - 1]..row_start[y],
+            row_start[y]..row_start[y + 1],
+        );
+        let mut i = above.start;
+        for j in here {
+            let (x0, x1) = runs[j];
+            // Skip runs above that end before this one starts.
+            while i < above.end && runs[i].1 + reach <= x0 {
+                i += 1;
+            }
+            let mut k = i;
+            while k < above.end && runs[k].0 < x1 + reach {
+                let (a, b) = (root(&mut parent, k as u32), root(&mut parent, j as u32));
+                if a != b {
+                    let (lo, hi) = (a.min(b), a.max(b));
+                    parent[hi as usize] = lo;
                 }
+                k += 1;
             }
         }
-        sizes.push(size);
+    }
+    // Number components by their first run; the root of a set is its first run.
+    let mut labels = vec![u32::MAX; w * h];
+    let mut sizes: Vec<usize> = Vec::new();
+    let mut number = vec![u32::MAX; runs.len()];
+    for (y, span) in row_start.windows(2).enumerate() {
+        for (j, &(x0, x1)) in runs.iter().enumerate().take(span[1]).skip(span[0]) {
+            let r = root(&mut parent, j as u32) as usize;
+            if number[r] == u32::MAX {
+                number[r] = sizes.len() as u32;
+                sizes.push(0);
+            }
+            let l = number[r];
+            sizes[l as usize] += (x1 - x0) as usize;
+            labels[y * w + x0 as usize..y * w + x1 as usize].fill(l);
+        }
     }
     (labels, sizes)
 }
@@ -332,62 +378,78 @@ fn drop_small_islands(mask: &mut [bool], w: usize, h: usize, min_area: f64) {
 
 /// Dilates the mask with a `(2r+1)²` square, clipped to the image.
 fn dilate(mask: &mut [bool], w: usize, h: usize, r: usize) {
-    let run = |line: &[bool], out: &mut [bool]| {
-        // Sliding count of inside pixels in [i - r, i + r].
-        let n = line.len();
+    // Rows: a sliding count of inside pixels in [x - r, x + r].
+    let mut tmp = vec![false; w];
+    for row in mask.chunks_exact_mut(w) {
         let mut count = 0usize;
-        for &v in &line[..r.min(n)] {
+        for &v in &row[..r.min(w)] {
             count += usize::from(v);
         }
-        for i in 0..n {
-            if i + r < n {
-                count += usize::from(line[i + r]);
+        for x in 0..w {
+            if x + r < w {
+                count += usize::from(row[x + r]);
             }
-            if i > r {
-                count -= usize::from(line[i - r - 1]);
+            if x > r {
+                count -= usize::from(row[x - r - 1]);
             }
-            out[i] = count > 0;
+            tmp[x] = count > 0;
         }
-    };
-    let mut tmp = vec![false; w.max(h)];
-    for y in 0..h {
-        let row = &mut mask[y * w..(y + 1) * w];
-        run(row, &mut tmp[..w]);
-        row.copy_from_slice(&tmp[..w]);
+        row.copy_from_slice(&tmp);
     }
-    let mut col = vec![false; h];
-    for x in 0..w {
-        for y in 0..h {
-            col[y] = mask[y * w + x];
+    // Columns, a row at a time (in memory order): per-column counts of inside pixels in
+    // rows [y - r, y + r].
+    let rows: Vec<bool> = mask.to_vec();
+    let row = |y: usize| &rows[y * w..(y + 1) * w];
+    let mut count = vec![0u32; w];
+    for y in 0..r.min(h) {
+        for (c, &v) in count.iter_mut().zip(row(y)) {
+            *c += u32::from(v);
         }
-        run(&col, &mut tmp[..h]);
-        for y in 0..h {
-            mask[y * w + x] = tmp[y];
+    }
+    for y in 0..h {
+        if y + r < h {
+            for (c, &v) in count.iter_mut().zip(row(y + r)) {
+                *c += u32::from(v);
+            }
+        }
+        if y > r {
+            for (c, &v) in count.iter_mut().zip(row(y - r - 1)) {
+                *c -= u32::from(v);
+            }
+        }
+        for (m, &c) in mask[y * w..(y + 1) * w].iter_mut().zip(&count) {
+            *m = c > 0;
         }
     }
 }
 
 /// Fills the outside pixels of every 2×2 block whose inside pixels touch only
 /// diagonally, until there is none.
+///
+/// Blocks are visited from the last (bottom right) to the first, and the blocks around
+/// every pixel a fix sets are checked again before going on; the order matters (a fix
+/// can turn a later diagonal block into a three-pixel one), so it is kept fixed.
 fn make_well_composed(mask: &mut [bool], w: usize, h: usize) {
     if w < 2 || h < 2 {
         return;
     }
     // Blocks are named by their top-left pixel.
-    let mut todo: Vec<(usize, usize)> = (0..h - 1)
-        .flat_map(|y| (0..w - 1).map(move |x| (x, y)))
-        .collect();
-    while let Some((x, y)) = todo.pop() {
-        let (a, b) = (mask[y * w + x], mask[y * w + x + 1]);
-        let (c, d) = (mask[(y + 1) * w + x], mask[(y + 1) * w + x + 1]);
-        if a == d && b == c && a != b {
-            for (px, py) in [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)] {
-                if !mask[py * w + px] {
-                    mask[py * w + px] = true;
-                    // Re-check the blocks around the changed pixel.
-                    for by in py.saturating_sub(1)..=py.min(h - 2) {
-                        for bx in px.saturating_sub(1)..=px.min(w - 2) {
-                            todo.push((bx, by));
+    let bw = w - 1;
+    let mut todo: Vec<(usize, usize)> = Vec::new();
+    for block in (0..bw * (h - 1)).rev() {
+        todo.push((block % bw, block / bw));
+        while let Some((x, y)) = todo.pop() {
+            let (a, b) = (mask[y * w + x], mask[y * w + x + 1]);
+            let (c, d) = (mask[(y + 1) * w + x], mask[(y + 1) * w + x + 1]);
+            if a == d && b == c && a != b {
+                for (px, py) in [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)] {
+                    if !mask[py * w + px] {
+                        mask[py * w + px] = true;
+                        // Re-check the blocks around the changed pixel.
+                        for by in py.saturating_sub(1)..=py.min(h - 2) {
+                            for bx in px.saturating_sub(1)..=px.min(w - 2) {
+                                todo.push((bx, by));
+                            }
                         }
                     }
                 }
@@ -461,6 +523,79 @@ mod tests {
                     m[(y + 1) * w + x + 1],
                 );
                 assert!(!(a == d && b == c && a != b));
+            }
+        }
+    }
+
+    /// The labels of a plain flood fill.
+    fn flood_labels(mask: &[bool], w: usize, h: usize, eight: bool) -> (Vec<u32>, Vec<usize>) {
+        let mut labels = vec![u32::MAX; w * h];
+        let mut sizes = Vec::new();
+        for start in 0..w * h {
+            if !mask[start] || labels[start] != u32::MAX {
+                continue;
+            }
+            let l = sizes.len() as u32;
+            let mut stack = vec![start];
+            labels[start] = l;
+            let mut size = 0;
+            while let Some(i) = stack.pop() {
+                size += 1;
+                let (x, y) = ((i % w) as isize, (i / w) as isize);
+                for (dx, dy) in [
+                    (-1, -1),
+                    (0, -1),
+                    (1, -1),
+                    (-1, 0),
+                    (1, 0),
+                    (-1, 1),
+                    (0, 1),
+                    (1, 1),
+                ] {
+                    let (nx, ny) = (x + dx, y + dy);
+                    if (!eight && dx != 0 && dy != 0)
+                        || nx < 0
+                        || ny < 0
+                        || nx >= w as isize
+                        || ny >= h as isize
+                    {
+                        continue;
+                    }
+                    let j = ny as usize * w + nx as usize;
+                    if mask[j] && labels[j] == u32::MAX {
+                        labels[j] = l;
+                        stack.push(j);
+                    }
+                }
+            }
+            sizes.push(size);
+        }
+        (labels, sizes)
+    }
+
+    #[test]
+    fn labels_match_a_flood_fill() {
+        let (w, h) = (37, 23);
+        let mut state = 0x1357_9bdfu32;
+        for density in [2, 3, 5] {
+            let mask: Vec<bool> = (0..w * h)
+                .map(|_| {
+                    state ^= state << 13;
+                    state ^= state >> 17;
+                    state ^= state << 5;
+                    !state.is_multiple_of(density)
+                })
+                .collect();
+            for eight in [false, true] {
+                assert_eq!(
+                    label_components(&mask, w, h, true, eight),
+                    flood_labels(&mask, w, h, eight)
+                );
+                let inverse: Vec<bool> = mask.iter().map(|m| !m).collect();
+                assert_eq!(
+                    label_components(&mask, w, h, false, eight),
+                    flood_labels(&inverse, w, h, eight)
+                );
             }
         }
     }
