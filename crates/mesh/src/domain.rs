@@ -198,7 +198,7 @@ pub fn domain_from_image(
     let (labels, sizes) = label_components(&mask, w, h, true, false);
     let traced = trace(&mask, w, h);
     let raw: Vec<Vec<[i64; 2]>> = traced.iter().map(|r| r.pts.clone()).collect();
-    let simplified = simplify_rings(&raw, tol);
+    let simplified = simplify_rings(&raw, &vec![tol; raw.len()], [w as i64, h as i64]);
 
     // Group rings by the component of their inside pixel: one outer ring (positive area)
     // and its holes (negative area) per component.
