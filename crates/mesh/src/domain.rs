@@ -600,6 +600,52 @@ mod tests {
         }
     }
 
+    /// Every vertex of a traced outline lies within the tolerance of the simplified
+    /// segment that replaced it, also where rings came close and vertices were put back.
+    #[test]
+    fn simplified_outlines_follow_the_traced_ones() {
+        let (w, h) = (90, 70);
+        let mut state = 0x2468_ace1u32;
+        for (density, tol) in [(7, 1.3), (11, 0.75), (23, 2.5), (5, 3.0)] {
+            let mut mask: Vec<bool> = (0..w * h)
+                .map(|_| {
+                    state ^= state << 13;
+                    state ^= state >> 17;
+                    state ^= state << 5;
+                    state.is_multiple_of(density)
+                })
+                .collect();
+            dilate(&mut mask, w, h, 1);
+            make_well_composed(&mut mask, w, h);
+            let rings: Vec<Vec<[i64; 2]>> = trace(&mask, w, h).into_iter().map(|r| r.pts).collect();
+            let tols = vec![tol; rings.len()];
+            let simplified = simplify_rings(&rings, &tols, [w as i64, h as i64]);
+            for (ring, kept) in rings.iter().zip(&simplified) {
+                // Walk the ring; between two kept vertices, check the ones dropped.
+                let at = |p: [i64; 2]| DVec2::new(p[0] as f64, p[1] as f64);
+                let start = ring.iter().position(|p| *p == kept[0]).unwrap();
+                let mut next = 1;
+                let mut from = kept[0];
+                for k in 1..=ring.len() {
+                    let p = ring[(start + k) % ring.len()];
+                    let to = kept[next % kept.len()];
+                    if p == to {
+                        from = to;
+                        next += 1;
+                    } else {
+                        let d = crate::geometry::dist2_point_segment(at(p), at(from), at(to));
+                        assert!(
+                            d.sqrt() <= tol + 1e-9,
+                            "{p:?} is {} from {from:?}-{to:?}",
+                            d.sqrt()
+                        );
+                    }
+                }
+                assert_eq!(next, kept.len() + 1);
+            }
+        }
+    }
+
     #[test]
     fn small_islands_and_holes() {
         let (w, h) = (20, 20);

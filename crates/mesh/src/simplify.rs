@@ -17,9 +17,12 @@ fn to_f(p: P) -> DVec2 {
 /// The input rings must be simple and pairwise disjoint (as traced outlines are). Where a
 /// simplified ring would cross or touch itself or another ring, the offending segments
 /// get back some of their original vertices until no conflict is left, so the output
-/// rings are simple and disjoint too. Orientation and the sign of the area are kept.
+/// rings are simple and disjoint too (the two segments a vertex brought back makes are
+/// simplified again, so they follow the outline within the tolerance as well).
+/// Orientation and the sign of the area are kept.
 ///
-/// No point farther than its ring's tolerance from the ring changes sides, except
+/// Every original vertex lies within its ring's tolerance of the simplified segment
+/// that replaces it, so no point farther than its ring's tolerance from the ring changes sides, except
 /// against the image border: a segment along the border is never replaced, so a
 /// simplified segment cannot shave off a sliver along it (pixels there lie only half a
 /// pixel from the outline).
@@ -42,6 +45,9 @@ pub(crate) fn simplify_rings(rings: &[Vec<P>], tols: &[f64], size: P) -> Vec<Vec
             {
                 keep[r][k] = true;
                 progress = true;
+                // The two new segments must follow the outline within the tolerance too.
+                let tol2 = tols[r] * tols[r];
+                refine(&rings[r], &mut keep[r], vec![(i, k), (k, j)], tol2);
             }
         }
         if !progress {
@@ -80,6 +86,32 @@ fn farthest_between(ring: &[P], i: usize, j: usize) -> Option<usize> {
     best
 }
 
+/// Douglas–Peucker on the spans `(i, j)` of a closed ring (from vertex `i` to vertex `j`,
+/// cyclically; `i == j` is the whole ring): keeps, recursively, the vertex of a span
+/// farthest from its chord while that is more than `√tol2` away.
+fn refine(ring: &[P], keep: &mut [bool], mut spans: Vec<(usize, usize)>, tol2: f64) {
+    let n = ring.len();
+    while let Some((i, j)) = spans.pop() {
+        let (a, b) = (to_f(ring[i]), to_f(ring[j]));
+        let mut best = None;
+        let mut best_d = tol2;
+        let mut k = (i + 1) % n;
+        while k != j {
+            let d = dist2_point_segment(to_f(ring[k]), a, b);
+            if d > best_d {
+                best_d = d;
+                best = Some(k);
+            }
+            k = (k + 1) % n;
+        }
+        if let Some(k) = best {
+            keep[k] = true;
+            spans.push((i, k));
+            spans.push((k, j));
+        }
+    }
+}
+
 /// Douglas–Peucker on a closed ring, keeping the vertices on the border of the image
 /// `[0, size[0]] × [0, size[1]]`; returns which vertices to keep (at least 3, with the
 /// sign of the area preserved, or all of them).
@@ -102,34 +134,14 @@ fn douglas_peucker(ring: &[P], tol: f64, size: P) -> Vec<bool> {
         .collect();
     keep[0] = true;
     keep[far] = true;
-    let tol2 = tol * tol;
-    // Spans (i, j) between kept vertices, j possibly == n meaning index 0.
-    let mut stack: Vec<(usize, usize)> = Vec::new();
+    // Spans between consecutive kept vertices, the last one back to vertex 0.
+    let mut spans: Vec<(usize, usize)> = Vec::new();
     let mut prev = 0;
     for k in (1..n).filter(|&k| keep[k]).chain([n]) {
-        stack.push((prev, k));
+        spans.push((prev, k % n));
         prev = k;
     }
-    while let Some((i, j)) = stack.pop() {
-        if j <= i + 1 {
-            continue;
-        }
-        let (a, b) = (to_f(ring[i]), to_f(ring[j % n]));
-        let mut best = 0;
-        let mut best_d = -1.0;
-        for (k, &p) in ring.iter().enumerate().take(j).skip(i + 1) {
-            let d = dist2_point_segment(to_f(p), a, b);
-            if d > best_d {
-                best_d = d;
-                best = k;
-            }
-        }
-        if best_d > tol2 {
-            keep[best] = true;
-            stack.push((i, best));
-            stack.push((best, j));
-        }
-    }
+    refine(ring, &mut keep, spans, tol * tol);
     let kept: Vec<DVec2> = ring
         .iter()
         .zip(&keep)
