@@ -1,4 +1,4 @@
-//! Times `domain_from_image` + `triangulate` on an opaque image, on cut-outs (a wobbly
+//! Times `domain_for_density` + `triangulate` on an opaque image, on cut-outs (a wobbly
 //! blob with a hole at 1024² and 4096², and the built-in lizard) and on pictures of
 //! small specks, for several target vertex counts, and reports mesh quality.
 //!
@@ -7,7 +7,7 @@
 use std::time::Instant;
 
 use glam::DVec2;
-use mesh::{Constraints, DomainOptions, MeshOptions, domain_from_image, triangulate};
+use mesh::{Constraints, DomainOptions, MeshOptions, domain_for_density, triangulate};
 
 fn cutout(size: u32) -> image::RgbaImage {
     let c = size as f64 / 2.0;
@@ -81,18 +81,13 @@ fn main() {
         ("20000 specks 1024²", specks(1024, 20_000)),
     ];
     for (name, img) in &images {
-        let t0 = Instant::now();
-        let domain = domain_from_image(img, &DomainOptions::default()).expect("domain");
-        let t_domain = t0.elapsed();
-        let rings: usize = domain.rings().map(|r| r.len()).sum();
-        println!(
-            "{name}: domain {:.1} ms, {} polygons, {} ring vertices, area {:.0}",
-            t_domain.as_secs_f64() * 1e3,
-            domain.polygons.len(),
-            rings,
-            domain.area()
-        );
+        println!("{name}:");
         for target in [500usize, 20_000, 100_000, 600_000] {
+            let t0 = Instant::now();
+            let domain =
+                domain_for_density(img, &DomainOptions::default(), target).expect("domain");
+            let t_domain = t0.elapsed();
+            let rings: usize = domain.rings().map(|r| r.len()).sum();
             let opts = MeshOptions {
                 target_vertices: target,
                 ..MeshOptions::default()
@@ -102,11 +97,17 @@ fn main() {
             let el = t1.elapsed();
             let (worst, frac) = min_angle_deg(&t.mesh);
             println!(
-                "  target {target:>7}: {:>7} vertices ({:+.1}%), {:>8} triangles, {:>7.1} ms; min angle {:.1}°, {:.3}% angles < 20°",
+                "  target {target:>7}: domain {:>7.1} ms ({} polygons, {} ring vertices, area {:.0}); \
+                 mesh {:>7.1} ms, {:>7} vertices ({:+.1}%), {:>8} triangles; min angle {:.1}°, \
+                 {:.3}% angles < 20°",
+                t_domain.as_secs_f64() * 1e3,
+                domain.polygons.len(),
+                rings,
+                domain.area(),
+                el.as_secs_f64() * 1e3,
                 t.mesh.vertices.len(),
                 (t.mesh.vertices.len() as f64 / target as f64 - 1.0) * 100.0,
                 t.mesh.triangles.len(),
-                el.as_secs_f64() * 1e3,
                 worst,
                 frac * 100.0 / 3.0
             );
