@@ -1,12 +1,13 @@
-//! Times `domain_from_image` + `triangulate` on a 1024×1024 opaque image and on a
-//! cut-out, for several target vertex counts, and reports mesh quality.
+//! Times `domain_for_density` + `triangulate` on an opaque image, on cut-outs (a wobbly
+//! blob with a hole at 1024² and 4096², and the built-in lizard) and on pictures of
+//! small specks, for several target vertex counts, and reports mesh quality.
 //!
 //! Run with `cargo run --release -p mesh --example mesh_timing`.
 
 use std::time::Instant;
 
 use glam::DVec2;
-use mesh::{Constraints, DomainOptions, MeshOptions, domain_from_image, triangulate};
+use mesh::{Constraints, DomainOptions, MeshOptions, domain_for_density, triangulate};
 
 fn cutout(size: u32) -> image::RgbaImage {
     let c = size as f64 / 2.0;
@@ -27,6 +28,27 @@ fn cutout(size: u32) -> image::RgbaImage {
     })
 }
 
+/// `count` specks of 1 to 3 px on a side, scattered over a `size²` transparent picture.
+fn specks(size: u32, count: usize) -> image::RgbaImage {
+    let mut img = image::RgbaImage::new(size, size);
+    let mut state = 0x2545_f491_u64;
+    let mut next = move |n: u32| {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state % u64::from(n)) as u32
+    };
+    for _ in 0..count {
+        let (x, y, s) = (next(size - 3), next(size - 3), 1 + next(3));
+        for dy in 0..s {
+            for dx in 0..s {
+                img.put_pixel(x + dx, y + dy, image::Rgba([20, 30, 40, 255]));
+            }
+        }
+    }
+    img
+}
+
 fn min_angle_deg(m: &mesh::Mesh) -> (f64, f64) {
     let mut worst = 180.0f64;
     let mut below = 0usize;
@@ -44,26 +66,28 @@ fn min_angle_deg(m: &mesh::Mesh) -> (f64, f64) {
 }
 
 fn main() {
+    let lizard = image::load_from_memory(include_bytes!("../../../assets/lizard.png"))
+        .expect("the built-in lizard decodes")
+        .to_rgba8();
     let images = [
         (
-            "opaque",
+            "opaque 1024²",
             image::RgbaImage::from_pixel(1024, 1024, image::Rgba([1, 2, 3, 255])),
         ),
-        ("cut-out", cutout(1024)),
+        ("cut-out 1024²", cutout(1024)),
+        ("cut-out 4096²", cutout(4096)),
+        ("lizard", lizard),
+        ("3000 specks 2048²", specks(2048, 3000)),
+        ("20000 specks 1024²", specks(1024, 20_000)),
     ];
     for (name, img) in &images {
-        let t0 = Instant::now();
-        let domain = domain_from_image(img, &DomainOptions::default()).expect("domain");
-        let t_domain = t0.elapsed();
-        let rings: usize = domain.rings().map(|r| r.len()).sum();
-        println!(
-            "{name}: domain {:.1} ms, {} polygons, {} ring vertices, area {:.0}",
-            t_domain.as_secs_f64() * 1e3,
-            domain.polygons.len(),
-            rings,
-            domain.area()
-        );
-        for target in [20_000usize, 100_000, 600_000] {
+        println!("{name}:");
+        for target in [500usize, 20_000, 100_000, 600_000] {
+            let t0 = Instant::now();
+            let domain =
+                domain_for_density(img, &DomainOptions::default(), target).expect("domain");
+            let t_domain = t0.elapsed();
+            let rings: usize = domain.rings().map(|r| r.len()).sum();
             let opts = MeshOptions {
                 target_vertices: target,
                 ..MeshOptions::default()
@@ -73,11 +97,17 @@ fn main() {
             let el = t1.elapsed();
             let (worst, frac) = min_angle_deg(&t.mesh);
             println!(
-                "  target {target:>7}: {:>7} vertices ({:+.1}%), {:>8} triangles, {:>7.1} ms; min angle {:.1}°, {:.3}% angles < 20°",
+                "  target {target:>7}: domain {:>7.1} ms ({} polygons, {} ring vertices, area {:.0}); \
+                 mesh {:>7.1} ms, {:>7} vertices ({:+.1}%), {:>8} triangles; min angle {:.1}°, \
+                 {:.3}% angles < 20°",
+                t_domain.as_secs_f64() * 1e3,
+                domain.polygons.len(),
+                rings,
+                domain.area(),
+                el.as_secs_f64() * 1e3,
                 t.mesh.vertices.len(),
                 (t.mesh.vertices.len() as f64 / target as f64 - 1.0) * 100.0,
                 t.mesh.triangles.len(),
-                el.as_secs_f64() * 1e3,
                 worst,
                 frac * 100.0 / 3.0
             );

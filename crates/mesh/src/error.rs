@@ -10,7 +10,7 @@
 pub enum MeshError {
     /// The domain has no area: the image has no pixels, or none with alpha above the
     /// threshold, or a hand-made [`Domain`](crate::Domain) has no polygon of positive area.
-    #[error("the domain is empty: the image has no opaque pixels")]
+    #[error("the domain is empty: the image has no visible pixels")]
     EmptyDomain,
 
     /// A coordinate is NaN or infinite.

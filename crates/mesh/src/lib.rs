@@ -15,6 +15,10 @@
 //!   tracing, so the outline runs about a pixel outside the visible pixels: a warped
 //!   cut-out keeps its soft edge, and simplification (Douglas–Peucker, 0.75 px by
 //!   default) can never cut off a visible pixel.
+//! * **Nothing visible is dropped.** Every pixel with alpha > 0 (by default) is inside
+//!   the domain. Content finer than the mesh spacing (specks, hair, text) keeps its exact
+//!   outline while that costs at most half the target vertex count; beyond that it is
+//!   merged into coarser cover polygons sized to the density ([`domain_for_density`]).
 //! * **Connectivity.** Islands are 8-connected. The mask is then made well-composed
 //!   (diagonal-only contacts are filled in), so 4- and 8-connectivity agree and every
 //!   traced outline is a simple ring disjoint from the others; simplification keeps it so.
@@ -42,6 +46,7 @@
 //! # Ok::<(), mesh::MeshError>(())
 //! ```
 
+mod cover;
 mod domain;
 mod error;
 mod geometry;
@@ -51,7 +56,7 @@ mod simplify;
 mod trace;
 mod triangulate;
 
-pub use domain::{Domain, DomainOptions, Polygon, domain_from_image};
+pub use domain::{Domain, DomainOptions, Polygon, domain_for_density, domain_from_image};
 pub use error::MeshError;
 pub use mesh::Mesh;
 pub use triangulate::{

@@ -10,14 +10,28 @@ fn to_f(p: P) -> DVec2 {
     DVec2::new(p[0] as f64, p[1] as f64)
 }
 
-/// Simplifies closed rings with Douglas–Peucker at tolerance `tol` (pixels).
+/// Simplifies closed rings with Douglas–Peucker, ring `i` at tolerance `tols[i]`
+/// (pixels), keeping every vertex on the border of the image `[0, size[0]] × [0,
+/// size[1]]`.
 ///
 /// The input rings must be simple and pairwise disjoint (as traced outlines are). Where a
 /// simplified ring would cross or touch itself or another ring, the offending segments
 /// get back some of their original vertices until no conflict is left, so the output
-/// rings are simple and disjoint too. Orientation and the sign of the area are kept.
-pub(crate) fn simplify_rings(rings: &[Vec<P>], tol: f64) -> Vec<Vec<P>> {
-    let mut keep: Vec<Vec<bool>> = rings.iter().map(|r| douglas_peucker(r, tol)).collect();
+/// rings are simple and disjoint too (the two segments a vertex brought back makes are
+/// simplified again, so they follow the outline within the tolerance as well).
+/// Orientation and the sign of the area are kept.
+///
+/// Every original vertex lies within its ring's tolerance of the simplified segment
+/// that replaces it, so no point farther than its ring's tolerance from the ring changes sides, except
+/// against the image border: a segment along the border is never replaced, so a
+/// simplified segment cannot shave off a sliver along it (pixels there lie only half a
+/// pixel from the outline).
+pub(crate) fn simplify_rings(rings: &[Vec<P>], tols: &[f64], size: P) -> Vec<Vec<P>> {
+    let mut keep: Vec<Vec<bool>> = rings
+        .iter()
+        .zip(tols)
+        .map(|(r, &tol)| douglas_peucker(r, tol, size))
+        .collect();
     // Resolve conflicts; each round keeps at least one more original vertex, so this ends.
     loop {
         let conflicts = find_conflicts(rings, &keep);
@@ -31,6 +45,9 @@ pub(crate) fn simplify_rings(rings: &[Vec<P>], tol: f64) -> Vec<Vec<P>> {
             {
                 keep[r][k] = true;
                 progress = true;
+                // The two new segments must follow the outline within the tolerance too.
+                let tol2 = tols[r] * tols[r];
+                refine(&rings[r], &mut keep[r], vec![(i, k), (k, j)], tol2);
             }
         }
         if !progress {
@@ -69,11 +86,37 @@ fn farthest_between(ring: &[P], i: usize, j: usize) -> Option<usize> {
     best
 }
 
-/// Douglas–Peucker on a closed ring; returns which vertices to keep (at least 3, with the
-/// sign of the area preserved, or all of them).
-fn douglas_peucker(ring: &[P], tol: f64) -> Vec<bool> {
+/// Douglas–Peucker on the spans `(i, j)` of a closed ring (from vertex `i` to vertex `j`,
+/// cyclically; `i == j` is the whole ring): keeps, recursively, the vertex of a span
+/// farthest from its chord while that is more than `√tol2` away.
+fn refine(ring: &[P], keep: &mut [bool], mut spans: Vec<(usize, usize)>, tol2: f64) {
     let n = ring.len();
-    let mut keep = vec![false; n];
+    while let Some((i, j)) = spans.pop() {
+        let (a, b) = (to_f(ring[i]), to_f(ring[j]));
+        let mut best = None;
+        let mut best_d = tol2;
+        let mut k = (i + 1) % n;
+        while k != j {
+            let d = dist2_point_segment(to_f(ring[k]), a, b);
+            if d > best_d {
+                best_d = d;
+                best = Some(k);
+            }
+            k = (k + 1) % n;
+        }
+        if let Some(k) = best {
+            keep[k] = true;
+            spans.push((i, k));
+            spans.push((k, j));
+        }
+    }
+}
+
+/// Douglas–Peucker on a closed ring, keeping the vertices on the border of the image
+/// `[0, size[0]] × [0, size[1]]`; returns which vertices to keep (at least 3, with the
+/// sign of the area preserved, or all of them).
+fn douglas_peucker(ring: &[P], tol: f64, size: P) -> Vec<bool> {
+    let n = ring.len();
     if n <= 4 || tol <= 0.0 {
         return vec![true; n];
     }
@@ -85,31 +128,20 @@ fn douglas_peucker(ring: &[P], tol: f64) -> Vec<bool> {
                 .total_cmp(&to_f(ring[b]).distance_squared(p0))
         })
         .unwrap_or(n / 2);
+    let mut keep: Vec<bool> = ring
+        .iter()
+        .map(|p| p[0] == 0 || p[1] == 0 || p[0] == size[0] || p[1] == size[1])
+        .collect();
     keep[0] = true;
     keep[far] = true;
-    let tol2 = tol * tol;
-    // Spans (i, j) with j possibly == n meaning index 0.
-    let mut stack = vec![(0usize, far), (far, n)];
-    while let Some((i, j)) = stack.pop() {
-        if j <= i + 1 {
-            continue;
-        }
-        let (a, b) = (to_f(ring[i]), to_f(ring[j % n]));
-        let mut best = 0;
-        let mut best_d = -1.0;
-        for (k, &p) in ring.iter().enumerate().take(j).skip(i + 1) {
-            let d = dist2_point_segment(to_f(p), a, b);
-            if d > best_d {
-                best_d = d;
-                best = k;
-            }
-        }
-        if best_d > tol2 {
-            keep[best] = true;
-            stack.push((i, best));
-            stack.push((best, j));
-        }
+    // Spans between consecutive kept vertices, the last one back to vertex 0.
+    let mut spans: Vec<(usize, usize)> = Vec::new();
+    let mut prev = 0;
+    for k in (1..n).filter(|&k| keep[k]).chain([n]) {
+        spans.push((prev, k % n));
+        prev = k;
     }
+    refine(ring, &mut keep, spans, tol * tol);
     let kept: Vec<DVec2> = ring
         .iter()
         .zip(&keep)
@@ -232,8 +264,37 @@ mod tests {
         }
         ring.push([20, 0]);
         // Orientation for positive area in the crate's convention.
-        let out = simplify_rings(&[ring.clone()], 0.75);
+        let out = simplify_rings(&[ring.clone()], &[0.75], [100, 100]);
         assert!(out[0].len() >= 3 && out[0].len() < ring.len());
+    }
+
+    #[test]
+    fn no_sliver_is_shaved_off_along_the_image_border() {
+        // The shape runs down the left border, steps in by 3 px and goes on: the chord
+        // from (0, 0) to (3, 200) passes within 1.5 px of both step corners, so plain
+        // Douglas–Peucker at 2 px would cut off the pixels along the border above the
+        // step, though their centres lie 2.5 px from any outline edge not on the border.
+        let ring: Vec<P> = vec![[0, 0], [0, 100], [3, 100], [3, 200], [50, 200], [50, 0]];
+        let inside = |ring: &[P], p: DVec2| {
+            let mut odd = false;
+            for i in 0..ring.len() {
+                let (a, b) = (to_f(ring[i]), to_f(ring[(i + 1) % ring.len()]));
+                if (a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x)
+                {
+                    odd = !odd;
+                }
+            }
+            odd
+        };
+        let pixel = DVec2::new(0.5, 97.5);
+        // The same outline away from the border loses its corner, and the pixel with it.
+        let moved: Vec<P> = ring.iter().map(|p| [p[0] + 10, p[1] + 10]).collect();
+        let free = simplify_rings(&[moved], &[2.0], [100, 300]);
+        assert_eq!(free[0].len(), 4);
+        assert!(!inside(&free[0], pixel + DVec2::splat(10.0)));
+        // On the image border the vertices stay.
+        let kept = simplify_rings(&[ring], &[2.0], [50, 200]);
+        assert!(inside(&kept[0], pixel));
     }
 
     #[test]
@@ -249,7 +310,7 @@ mod tests {
         // Two thin combs interleaved closely would cross if simplified independently.
         let outer: Vec<P> = vec![[0, 0], [0, 10], [1, 10], [1, 1], [30, 1], [30, 0]];
         let inner: Vec<P> = vec![[2, 2], [2, 3], [15, 3], [15, 2]];
-        let out = simplify_rings(&[outer, inner], 3.0);
+        let out = simplify_rings(&[outer, inner], &[3.0, 3.0], [100, 100]);
         let ids: Vec<Vec<bool>> = out.iter().map(|r| vec![true; r.len()]).collect();
         assert!(find_conflicts(&out, &ids).is_empty());
     }

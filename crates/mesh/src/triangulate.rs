@@ -15,7 +15,7 @@ use crate::geometry::{
     RingBands, SegmentGrid, dist2_point_segment, exactly_collinear, lerp, ring_signed_area,
     segment_hits,
 };
-use crate::{Domain, DomainOptions, Mesh, MeshError, domain_from_image};
+use crate::{Domain, DomainOptions, Mesh, MeshError, domain_for_density};
 
 type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
 
@@ -78,10 +78,11 @@ pub struct TriangulatedImage {
     pub is_convex: bool,
 }
 
-/// Meshes an image in one call: [`domain_from_image`] then [`triangulate`].
+/// Meshes an image in one call: [`domain_for_density`] at
+/// [`MeshOptions::target_vertices`], then [`triangulate`].
 ///
 /// # Errors
-/// As [`domain_from_image`] and [`triangulate`].
+/// As [`domain_for_density`] and [`triangulate`].
 ///
 /// # Example
 /// ```
@@ -105,7 +106,7 @@ pub fn mesh_image(
     opts: &MeshOptions,
     constraints: &Constraints,
 ) -> Result<TriangulatedImage, MeshError> {
-    let domain = domain_from_image(image, domain_opts)?;
+    let domain = domain_for_density(image, domain_opts, opts.target_vertices)?;
     triangulate(&domain, constraints, opts)
 }
 

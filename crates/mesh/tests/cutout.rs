@@ -7,7 +7,8 @@ mod support;
 
 use glam::DVec2;
 use mesh::{
-    Constraints, DomainOptions, MeshError, MeshOptions, domain_from_image, mesh_image, triangulate,
+    Constraints, DomainOptions, MeshError, MeshOptions, domain_for_density, domain_from_image,
+    mesh_image, triangulate,
 };
 use proptest::prelude::*;
 use support::{
@@ -114,22 +115,25 @@ fn rings_are_oriented_and_disjoint() {
 }
 
 #[test]
-fn small_islands_are_dropped_and_small_holes_filled() {
+fn small_islands_are_kept_and_small_holes_filled() {
     let img = support::image_from(100, 100, |p| {
         let big = (p.x - 50.0).abs() < 30.0 && (p.y - 50.0).abs() < 30.0;
-        let pinhole = (p.x - 40.5).abs() < 1.0 && (p.y - 40.5).abs() < 1.0;
+        // 5 × 5 pixels; 3 × 3 once the shape is dilated.
+        let pinhole = (p.x - 40.0).abs() < 2.5 && (p.y - 40.0).abs() < 2.5;
         let speck = (p.x - 95.5).abs() < 1.0 && (p.y - 95.5).abs() < 1.0;
         (big && !pinhole) || speck
     });
     let d = domain_from_image(&img, &DomainOptions::default()).unwrap();
-    assert_eq!(d.polygons.len(), 1);
-    assert!(d.polygons[0].holes.is_empty());
-    let keep_all = DomainOptions {
-        min_component_area: 0.0,
+    assert_eq!(d.polygons.len(), 2, "the one-pixel speck is kept");
+    assert!(d.polygons.iter().all(|p| p.holes.is_empty()));
+    assert!(d.contains(DVec2::new(95.5, 95.5)));
+    let keep_holes = DomainOptions {
+        min_hole_area: 0.0,
         ..Default::default()
     };
-    let d = domain_from_image(&img, &keep_all).unwrap();
+    let d = domain_from_image(&img, &keep_holes).unwrap();
     assert_eq!(d.polygons.len(), 2);
+    assert_eq!(d.polygons.iter().map(|p| p.holes.len()).sum::<usize>(), 1);
 }
 
 #[test]
@@ -167,7 +171,7 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(40))]
 
     /// Random blobs, holes and speckle: the mesh is valid, matches the domain and covers
-    /// every opaque pixel.
+    /// every pixel above the threshold, at every density.
     #[test]
     fn random_images(
         w in 1u32..200,
@@ -175,7 +179,7 @@ proptest! {
         shapes in prop::collection::vec((0.0f64..1.0, 0.0f64..1.0, 0.5f64..30.0, any::<bool>()), 1..8),
         noise in 0u32..4,
         tol in 0.0f64..2.5,
-        min_area in 0.0f64..30.0,
+        min_hole in 0.0f64..30.0,
         target in 10usize..5000,
         pts in prop::collection::vec((0.0f64..1.0, 0.0f64..1.0), 0..10),
     ) {
@@ -197,11 +201,11 @@ proptest! {
             image::Rgba([0, 0, 0, if inside { 200 } else { 3 }])
         });
         let dopts = DomainOptions {
+            alpha_threshold: 8,
             simplify_tolerance: tol,
-            min_component_area: min_area,
-            ..Default::default()
+            min_hole_area: min_hole,
         };
-        let d = match domain_from_image(&img, &dopts) {
+        let d = match domain_for_density(&img, &dopts, target) {
             Ok(d) => d,
             Err(MeshError::EmptyDomain) => {
                 prop_assert!(img.pixels().all(|p| p.0[3] <= 8));
@@ -222,13 +226,11 @@ proptest! {
         for (p, &v) in points.iter().zip(&t.point_vertices) {
             prop_assert_eq!(t.mesh.vertices[v as usize], *p);
         }
-        if min_area == 0.0 {
-            let loc = Locator::new(&t.mesh);
-            for (x, y, p) in img.enumerate_pixels() {
-                if p.0[3] > 8 {
-                    let centre = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
-                    prop_assert!(loc.contains(centre), "pixel ({x}, {y}) uncovered");
-                }
+        let loc = Locator::new(&t.mesh);
+        for (x, y, p) in img.enumerate_pixels() {
+            if p.0[3] > 8 {
+                let centre = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
+                prop_assert!(loc.contains(centre), "pixel ({x}, {y}) uncovered");
             }
         }
     }

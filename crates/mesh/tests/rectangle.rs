@@ -62,10 +62,23 @@ fn opaque_domain_is_the_full_rectangle() {
     assert!(d.is_full_rectangle);
     assert_eq!((d.width, d.height), (5, 3));
     assert_eq!(d.area(), 15.0);
+    // By default the faintest visible pixel is inside.
+    let img = image::RgbaImage::from_pixel(5, 3, image::Rgba([0, 0, 0, 1]));
+    let d = domain_from_image(&img, &DomainOptions::default()).unwrap();
+    assert!(d.is_full_rectangle);
     // Alpha equal to the threshold is outside.
     let img = image::RgbaImage::from_pixel(5, 3, image::Rgba([0, 0, 0, 8]));
+    let faint_out = DomainOptions {
+        alpha_threshold: 8,
+        ..Default::default()
+    };
     assert!(matches!(
-        domain_from_image(&img, &DomainOptions::default()),
+        domain_from_image(&img, &faint_out),
+        Err(MeshError::EmptyDomain)
+    ));
+    let clear = image::RgbaImage::from_pixel(5, 3, image::Rgba([0, 0, 0, 0]));
+    assert!(matches!(
+        domain_from_image(&clear, &DomainOptions::default()),
         Err(MeshError::EmptyDomain)
     ));
 }
@@ -164,7 +177,7 @@ fn degenerate_images() {
     let weird_domain = DomainOptions {
         alpha_threshold: 0,
         simplify_tolerance: f64::NAN,
-        min_component_area: f64::INFINITY,
+        min_hole_area: f64::INFINITY,
     };
     mesh_image(&dot, &weird_domain, &m, &c)
         .unwrap()
@@ -184,17 +197,17 @@ fn noisy_alpha_does_not_break_anything() {
         image::Rgba([0, 0, 0, if state % 5 < 2 { 255 } else { 0 }])
     });
     for tol in [0.0, 0.75, 2.0] {
-        for min_area in [0.0, 16.0] {
+        for min_hole in [0.0, 16.0] {
             let o = DomainOptions {
                 simplify_tolerance: tol,
-                min_component_area: min_area,
+                min_hole_area: min_hole,
                 ..Default::default()
             };
             let t = mesh_image(&img, &o, &opts(3_000), &Constraints::default()).unwrap();
             t.mesh.sanity_check().unwrap();
             let loc = support::Locator::new(&t.mesh);
             for (x, y, p) in img.enumerate_pixels() {
-                if p.0[3] > 8 && min_area == 0.0 {
+                if p.0[3] > 0 {
                     let c = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
                     assert!(loc.contains(c), "opaque pixel ({x}, {y}) not covered");
                 }
