@@ -153,8 +153,9 @@ pub struct EditorApp {
     /// The keyboard shortcuts window is open.
     pub help_open: bool,
     pub(crate) dialogs: Box<dyn Dialogs>,
-    /// Rigs with more samples than this are rebuilt on the worker thread (new
-    /// parameters, an undo that rebuilds), so the window keeps answering.
+    /// An undo or redo that rebuilds a rig with more samples than this (it brings
+    /// back other handles) runs on the worker thread, so the window keeps answering.
+    /// (New parameters always rebuild on the worker.)
     pub large_mesh: usize,
     /// Use the built-in file dialog (the desktop has none, or the user prefers it).
     pub builtin_dialogs: bool,
@@ -378,8 +379,9 @@ impl EditorApp {
                 self.rebuild_in_background(*settings);
                 return true;
             }
-            if *settings != doc.settings() && doc.rig().domain().len() > self.large_mesh {
-                // A rebuild of a large rig would stall the window: on the worker.
+            if *settings != doc.settings() {
+                // A rebuild can take seconds (a large mesh, a fixed boundary's many
+                // nodes): on the worker, so the window keeps answering.
                 let before = doc.snapshot();
                 let mut copy = doc.clone();
                 let label = "Re-weighting".to_owned();
@@ -561,8 +563,12 @@ impl EditorApp {
             self.restore_in_background(back, target);
             return;
         }
-        if doc.rig().domain().len() > self.large_mesh && doc.rebuilds_for(target, true) {
-            // A rebuild of a large rig: on the worker, on a copy.
+        let new_settings = crate::document::Settings::of(target) != doc.settings();
+        if new_settings
+            || (doc.rig().domain().len() > self.large_mesh && doc.rebuilds_for(target, true))
+        {
+            // A rebuild for other parameters, or of a large rig: on the worker, on a
+            // copy.
             let target = target.clone();
             let mut copy = doc.clone();
             let label = if back { "Undoing" } else { "Redoing" }.to_owned();

@@ -118,7 +118,8 @@ impl EditorApp {
             let a = self.viewport.to_screen(a);
             painter.line_segment([a, b], Stroke::new(4.0, SELECTED));
         }
-        if let Some((what, seconds)) = self.busy_with() {
+        if let Some((what, seconds)) = self.busy_with().filter(|(_, s)| *s > 0.25) {
+            // A short job (a rebuild at a low density) shows only in the status bar.
             painter.rect_filled(rect, 0.0, Color32::from_black_alpha(120));
             painter.text(
                 rect.center(),
@@ -127,7 +128,7 @@ impl EditorApp {
                 egui::FontId::proportional(20.0),
                 Color32::WHITE,
             );
-        } else {
+        } else if !self.is_busy() {
             self.hover_weights(ui, &response);
         }
     }
