@@ -17,6 +17,14 @@ use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
+/// The largest pose coordinate (pixels) or rotation (radians) a handle may have (the
+/// numeric core refuses larger ones too: blending them could overflow).
+pub const MAX_POSE: f64 = 1e9;
+/// The smallest scale of a point handle.
+pub const MIN_SCALE: f64 = 1e-9;
+/// The largest scale of a point handle.
+pub const MAX_SCALE: f64 = 1e9;
+
 /// The file format version this crate reads and writes.
 pub const VERSION: u32 = 1;
 
@@ -268,6 +276,18 @@ impl Project {
             {
                 return bad(format!("handle {i}: coordinates must be finite numbers"));
             }
+            if let HandleSpec::Point { scale, .. } = h
+                && !(MIN_SCALE..=MAX_SCALE).contains(scale)
+            {
+                return bad(format!(
+                    "handle {i}: scale must be between {MIN_SCALE:e} and {MAX_SCALE:e}, got {scale}"
+                ));
+            }
+            if numbers.iter().any(|x| x.abs() > MAX_POSE) {
+                return bad(format!(
+                    "handle {i}: a pose beyond ±{MAX_POSE:e} pixels (or radians) is refused"
+                ));
+            }
             if let Some(p) = points.iter().find(|p| !inside(**p)) {
                 return bad(format!(
                     "handle {i}: rest position ({}, {}) lies outside the image",
@@ -379,6 +399,18 @@ mod tests {
             (
                 r#"{"version":1,"density":4000001,"handles":[]}"#,
                 "density must be between 16 and 4000000 vertices, got 4000001",
+            ),
+            (
+                r#"{"version":1,"handles":[{"type":"point","rest":[1,1],"scale":1e300}]}"#,
+                "scale must be between",
+            ),
+            (
+                r#"{"version":1,"handles":[{"type":"point","rest":[1,1],"translate":[2e9,0]}]}"#,
+                "pose beyond",
+            ),
+            (
+                r#"{"version":1,"handles":[{"type":"bar","rest":[[1,1],[2,2]],"pose":[[1,1],[1e10,2]]}]}"#,
+                "pose beyond",
             ),
             // A byte-order mark anywhere but at the start is not whitespace.
             ("{\u{feff}\"version\":1,\"handles\":[]}", "malformed"),

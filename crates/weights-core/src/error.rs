@@ -67,6 +67,20 @@ pub enum RigError {
         /// Index of the handle.
         handle: usize,
     },
+    /// A pose beyond [`MAX_POSE`](crate::MAX_POSE) pixels (or radians), or a scale
+    /// outside [`MIN_SCALE`](crate::MIN_SCALE)..=[`MAX_SCALE`](crate::MAX_SCALE): the
+    /// deformation would overflow.
+    #[error(
+        "handle {handle} has a pose beyond ±{max_pose:e} or a scale outside \
+         [{min_scale:e}, {max_scale:e}]",
+        max_pose = crate::MAX_POSE,
+        min_scale = crate::MIN_SCALE,
+        max_scale = crate::MAX_SCALE
+    )]
+    PoseOutOfRange {
+        /// Index of the handle.
+        handle: usize,
+    },
     /// An index that names no handle.
     #[error("there is no handle {handle}")]
     NoSuchHandle {

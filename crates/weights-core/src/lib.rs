@@ -31,7 +31,7 @@ pub use basis::{Basis, MAX_DEGREE, MIN_DEGREE, MiddleControls};
 pub use domain::{Domain, Metric};
 pub use error::{DomainError, RigError};
 pub use rig::{
-    BuildTimings, Handle, MAX_BAR_PIECES, Node, NodeKind, NodeRadii, Rig, RigOptions, RigStats,
-    UpdateTimings, bar_samples, bar_spacing,
+    BuildTimings, Handle, MAX_BAR_PIECES, MAX_POSE, MAX_SCALE, MIN_SCALE, Node, NodeKind,
+    NodeRadii, Rig, RigOptions, RigStats, UpdateTimings, bar_samples, bar_spacing,
 };
 pub use transform::Similarity;

@@ -1105,7 +1105,16 @@ fn check_options(o: &RigOptions) -> Result<(), RigError> {
     Ok(())
 }
 
+/// The largest pose coordinate (pixels) or angle (radians) a handle may have: far
+/// beyond any picture, and small enough that blending transforms can never overflow.
+pub const MAX_POSE: f64 = 1e9;
+/// The smallest scale a point handle may have.
+pub const MIN_SCALE: f64 = 1e-9;
+/// The largest scale a point handle may have.
+pub const MAX_SCALE: f64 = 1e9;
+
 fn check_handle(i: usize, h: &Handle) -> Result<(), RigError> {
+    let in_range = |x: f64| x.abs() <= MAX_POSE;
     match h {
         Handle::Point { rest, transform } => {
             if !rest.is_finite() || !transform.is_finite() {
@@ -1114,6 +1123,12 @@ fn check_handle(i: usize, h: &Handle) -> Result<(), RigError> {
             if transform.scale <= 0.0 {
                 return Err(RigError::BadScale { handle: i });
             }
+            if !(MIN_SCALE..=MAX_SCALE).contains(&transform.scale)
+                || !in_range(transform.rotation)
+                || !transform.translation.to_array().into_iter().all(in_range)
+            {
+                return Err(RigError::PoseOutOfRange { handle: i });
+            }
         }
         Handle::Bar { rest, pose } => {
             if !rest.iter().chain(pose).all(|p| p.is_finite()) {
@@ -1121,6 +1136,9 @@ fn check_handle(i: usize, h: &Handle) -> Result<(), RigError> {
             }
             if rest[0] == rest[1] {
                 return Err(RigError::ZeroLengthBar { handle: i });
+            }
+            if !pose.iter().flat_map(|p| p.to_array()).all(in_range) {
+                return Err(RigError::PoseOutOfRange { handle: i });
             }
         }
     }

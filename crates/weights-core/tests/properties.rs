@@ -477,6 +477,44 @@ fn degenerate_rigs_never_panic() {
             Some(|e| matches!(e, RigError::OutsideDomain { .. })),
         ),
         (
+            "a pose that would overflow",
+            &convex,
+            vec![
+                Handle::point(DVec2::new(3.0, 3.0)),
+                Handle::Point {
+                    rest: DVec2::new(12.0, 8.0),
+                    transform: Similarity {
+                        translation: DVec2::new(1e300, 0.0),
+                        rotation: 0.0,
+                        scale: 1.0,
+                    },
+                },
+            ],
+            Some(|e| matches!(e, RigError::PoseOutOfRange { handle: 1 })),
+        ),
+        (
+            "a scale that would overflow",
+            &convex,
+            vec![Handle::Point {
+                rest: DVec2::new(12.0, 8.0),
+                transform: Similarity {
+                    translation: DVec2::ZERO,
+                    rotation: 0.0,
+                    scale: 1e300,
+                },
+            }],
+            Some(|e| matches!(e, RigError::PoseOutOfRange { .. })),
+        ),
+        (
+            "a bar posed far away",
+            &convex,
+            vec![Handle::Bar {
+                rest: [DVec2::new(2.0, 2.0), DVec2::new(10.0, 2.0)],
+                pose: [DVec2::new(2.0, 2.0), DVec2::new(2e9, 2.0)],
+            }],
+            Some(|e| matches!(e, RigError::PoseOutOfRange { .. })),
+        ),
+        (
             "crossing bars",
             &convex,
             vec![
