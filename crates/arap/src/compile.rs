@@ -1,0 +1,383 @@
+//! Compilation (§4.3, step 2): split the unknowns into free and constrained ones for
+//! a given set of constrained vertices and rigidity weights, and factorise step one's
+//! and step two's systems once.
+
+use std::sync::Arc;
+
+use glam::DVec2;
+
+use crate::error::ArapError;
+use crate::registration::{Mesh, Registration};
+use crate::solver::{Cholesky, LowerCsc, Ordering};
+use crate::topology::Rows;
+use crate::triangle::{block_product, corner_error_coefficients};
+
+/// A system compiled for one set of constrained vertices (handles) and rigidity
+/// weights: the paper's "compilation" (§4.3 step 2), a function from the handles'
+/// positions to the deformed mesh. Build it with [`Registration::compile`]; pose it
+/// with [`Compiled::update`] or [`Compiled::update_into`], which only
+/// back-substitute.
+///
+/// It is `Send + Sync` and shares the registration's data.
+pub struct Compiled {
+    pub(crate) mesh: Arc<Mesh>,
+    pub(crate) constrained: Vec<u32>,
+    /// Free vertices in increasing order; free unknown `i` is vertex `free[i]`.
+    pub(crate) free: Vec<u32>,
+    /// The constant part of step one's right-hand side (interleaved x, y; non-zero
+    /// only where step one's similarity is not pinned down, see
+    /// [`Compiled::loose_triangles`]).
+    pub(crate) step_one_rhs: Vec<f64>,
+    /// Couplings of free unknowns to constrained vertices.
+    pub(crate) couplings: Vec<Coupling>,
+    /// `G'` of eq. 8 (`2m × 2m`), factorised; `None` when nothing is free.
+    pub(crate) step_one: Option<Cholesky>,
+    /// `H'` of eq. 16 (`m × m`, for x and y alike), factorised.
+    pub(crate) step_two: Option<Cholesky>,
+    /// Kept triangles in components that have a constraint: the per-triangle pass.
+    pub(crate) active: Vec<u32>,
+    /// For each free vertex, its corners as `(index into active, d)`: the vertex's
+    /// share of step two's linear term is `Σ rotation(active) · d`.
+    pub(crate) gather: Rows<(u32, DVec2)>,
+    pub(crate) loose: Vec<u32>,
+}
+
+/// One block of `B` (eq. 8) and `D` (eq. 16): how free unknown `free` depends on the
+/// position of constraint `constraint`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Coupling {
+    pub free: u32,
+    pub constraint: u32,
+    /// Step one's 2×2 block `p·I + q·R90`.
+    pub g: (f64, f64),
+    /// Step two's scalar entry.
+    pub h: f64,
+}
+
+impl std::fmt::Debug for Compiled {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Compiled")
+            .field("constrained", &self.constrained.len())
+            .field("free", &self.free.len())
+            .field("active_triangles", &self.active.len())
+            .field("loose_triangles", &self.loose.len())
+            .finish_non_exhaustive()
+    }
+}
+
+impl Registration {
+    /// Compiles the system for the vertices in `constrained` (the handles) with
+    /// optional per-triangle `rigidity` weights (§5.2; the paper paints 10000 and
+    /// uses 1 elsewhere; `None` means 1 everywhere). A weight multiplies its
+    /// triangle's terms in step one and in step two's final solve. Targets are later
+    /// given to [`Compiled::update`] in the order of `constrained`.
+    ///
+    /// Where the paper's systems would be singular, this defines the answer instead:
+    /// - a connected component (through triangles) without any constrained vertex
+    ///   stays at rest, and so does a vertex in no kept triangle unless constrained;
+    /// - a component with a single constrained vertex translates with it (step one
+    ///   and the final result alike);
+    /// - more generally, step one's similarity error leaves each edge-connected piece
+    ///   of the mesh free to turn and scale unless two vertices of the piece at
+    ///   distinct rest positions are pinned down (constrained, or in a piece that is
+    ///   pinned down, transitively). On pieces left loose that way (a component with
+    ///   one handle, a flap hanging off the rest by a single vertex, handles that
+    ///   share one rest position), step one also keeps each triangle's rest edges
+    ///   (the step-two term with the rest shape as target), so they follow by
+    ///   translation. Everywhere else the systems are exactly the paper's.
+    ///   [`Compiled::loose_triangles`] lists them.
+    ///
+    /// Nothing here depends on the targets; [`Compiled::update`] only
+    /// back-substitutes.
+    ///
+    /// # Errors
+    /// [`ArapError::VertexOutOfRange`] for an index past the last vertex,
+    /// [`ArapError::DuplicateConstraint`] for a vertex given twice,
+    /// [`ArapError::RigidityLength`] / [`ArapError::BadRigidity`] for a rigidity list
+    /// of the wrong length or with a weight that is not finite and positive.
+    pub fn compile(
+        &self,
+        constrained: &[u32],
+        rigidity: Option<&[f64]>,
+    ) -> Result<Compiled, ArapError> {
+        let mesh = &self.mesh;
+        let n = mesh.rest.len();
+        let topo = &mesh.topology;
+
+        let mut constraint_of = vec![u32::MAX; n];
+        for (i, &v) in constrained.iter().enumerate() {
+            self.check_vertex(v)?;
+            let slot = &mut constraint_of[v as usize];
+            if *slot != u32::MAX {
+                return Err(ArapError::DuplicateConstraint {
+                    vertex: v,
+                    first: *slot as usize,
+                    second: i,
+                });
+            }
+            *slot = i as u32;
+        }
+        if let Some(w) = rigidity {
+            if w.len() != mesh.triangles.len() {
+                return Err(ArapError::RigidityLength {
+                    got: w.len(),
+                    triangles: mesh.triangles.len(),
+                });
+            }
+            if let Some((triangle, &weight)) = w
+                .iter()
+                .enumerate()
+                .find(|(_, w)| !(w.is_finite() && **w > 0.0))
+            {
+                return Err(ArapError::BadRigidity { triangle, weight });
+            }
+        }
+        let weight = |t: usize| rigidity.map_or(1.0, |w| w[t]);
+
+        // Components that some constraint reaches; the others stay at rest.
+        let components = topo
+            .component
+            .iter()
+            .map(|&c| c as usize + 1)
+            .max()
+            .unwrap_or(0);
+        let mut reached = vec![false; components];
+        for &v in constrained {
+            reached[topo.component[v as usize] as usize] = true;
+        }
+
+        let pinned = pinned_pieces(mesh, constrained);
+
+        // Free unknowns: vertices of reached components that are not constrained.
+        // (A reached vertex in no kept triangle is a component of its own, reached
+        // only through its own constraint.)
+        let mut free_index = vec![u32::MAX; n];
+        let mut free = Vec::new();
+        for v in 0..n {
+            if constraint_of[v] == u32::MAX && reached[topo.component[v] as usize] {
+                free_index[v] = free.len() as u32;
+                free.push(v as u32);
+            }
+        }
+        let m = free.len();
+
+        // Per adjacency slot: step one's block (p, q) and step two's entry.
+        let slots = topo.adjacency.items.len();
+        let mut g = vec![(0.0, 0.0); slots];
+        let mut h = vec![0.0; slots];
+        let mut rest_pull = vec![DVec2::ZERO; n];
+        let mut active = Vec::new();
+        let mut active_index = vec![u32::MAX; mesh.triangles.len()];
+        let mut loose = Vec::new();
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            if !mesh.kept[t] || !reached[topo.component[tri[0] as usize] as usize] {
+                continue;
+            }
+            active_index[t] = active.len() as u32;
+            active.push(t as u32);
+            let w = weight(t);
+            let s = &topo.slots[t];
+            // Step one (eqs. 3–5): each corner predicted from the other two.
+            for c in 0..3 {
+                let coef = corner_error_coefficients(mesh.local[t][c]);
+                for k1 in 0..3 {
+                    for k2 in 0..3 {
+                        let (p, q) = block_product(coef[k1], coef[k2]);
+                        let slot = s[3 * ((c + k1) % 3) + (c + k2) % 3] as usize;
+                        g[slot].0 += w * p;
+                        g[slot].1 += w * q;
+                    }
+                }
+            }
+            // Step two (eqs. 12, 13): each directed edge i → j.
+            let is_loose = !pinned[topo.piece[t] as usize];
+            if is_loose {
+                loose.push(t as u32);
+            }
+            for i in 0..3 {
+                let j = (i + 1) % 3;
+                for (slot, sign) in [
+                    (3 * i + i, 1.0),
+                    (3 * j + j, 1.0),
+                    (3 * i + j, -1.0),
+                    (3 * j + i, -1.0),
+                ] {
+                    h[s[slot] as usize] += sign * w;
+                    if is_loose {
+                        g[s[slot] as usize].0 += sign * w;
+                    }
+                }
+                if is_loose {
+                    let e = mesh.rest[tri[j] as usize] - mesh.rest[tri[i] as usize];
+                    rest_pull[tri[i] as usize] -= w * e;
+                    rest_pull[tri[j] as usize] += w * e;
+                }
+            }
+        }
+
+        // Lower triangles of G' (interleaved) and H', and the couplings B and D.
+        let mut h_csc = LowerCsc {
+            n: m,
+            col_ptr: Vec::with_capacity(m + 1),
+            row_idx: Vec::new(),
+            values: Vec::new(),
+        };
+        let mut g_csc = LowerCsc {
+            n: 2 * m,
+            col_ptr: Vec::with_capacity(2 * m + 1),
+            row_idx: Vec::new(),
+            values: Vec::new(),
+        };
+        h_csc.col_ptr.push(0);
+        g_csc.col_ptr.push(0);
+        let mut couplings = Vec::new();
+        let mut column_y: Vec<(u32, f64)> = Vec::new();
+        for (fa, &a) in free.iter().enumerate() {
+            let start = topo.adjacency.ptr[a as usize] as usize;
+            column_y.clear();
+            for (k, &b) in topo.adjacency.row(a as usize).iter().enumerate() {
+                let slot = start + k;
+                let (p, q) = g[slot];
+                let fb = free_index[b as usize];
+                if fb != u32::MAX {
+                    if fb as usize >= fa {
+                        h_csc.row_idx.push(fb);
+                        h_csc.values.push(h[slot]);
+                        // Rows 2fb, 2fb + 1 of G_ba = G_abᵀ = [[p, −q], [q, p]].
+                        g_csc.row_idx.extend([2 * fb, 2 * fb + 1]);
+                        g_csc.values.extend([p, q]);
+                        if fb as usize != fa {
+                            column_y.extend([(2 * fb, -q), (2 * fb + 1, p)]);
+                        } else {
+                            column_y.push((2 * fb + 1, p));
+                        }
+                    }
+                } else if constraint_of[b as usize] != u32::MAX {
+                    couplings.push(Coupling {
+                        free: fa as u32,
+                        constraint: constraint_of[b as usize],
+                        g: (p, q),
+                        h: h[slot],
+                    });
+                }
+            }
+            h_csc.col_ptr.push(h_csc.row_idx.len() as u32);
+            g_csc.col_ptr.push(g_csc.row_idx.len() as u32);
+            for &(r, v) in &column_y {
+                g_csc.row_idx.push(r);
+                g_csc.values.push(v);
+            }
+            g_csc.col_ptr.push(g_csc.row_idx.len() as u32);
+        }
+
+        let (step_one, step_two) = if m == 0 {
+            (None, None)
+        } else {
+            let ordering = Ordering::amd(&h_csc)?;
+            let two = Cholesky::new(&h_csc, &ordering)?;
+            let one = Cholesky::new(&g_csc, &ordering.interleaved())?;
+            (Some(one), Some(two))
+        };
+
+        let step_one_rhs = free
+            .iter()
+            .flat_map(|&v| {
+                let p = rest_pull[v as usize];
+                [p.x, p.y]
+            })
+            .collect();
+
+        // Step two's linear term, gathered per free vertex: corner c of a triangle
+        // ends edge c−1 → c and starts edge c → c+1.
+        let active_index = &active_index;
+        let gather = Rows::from_pairs(
+            m,
+            free.iter().enumerate().flat_map(|(fa, &v)| {
+                topo.corners.row(v as usize).iter().map(move |&code| {
+                    let (t, c) = ((code / 3) as usize, (code % 3) as usize);
+                    let tri = mesh.triangles[t];
+                    let r = |k: usize| mesh.rest[tri[k % 3] as usize];
+                    let d = (r(c) - r(c + 2)) - (r(c + 1) - r(c));
+                    (fa as u32, (active_index[t], weight(t) * d))
+                })
+            }),
+        );
+
+        Ok(Compiled {
+            mesh: Arc::clone(mesh),
+            constrained: constrained.to_vec(),
+            free,
+            step_one_rhs,
+            couplings,
+            step_one,
+            step_two,
+            active,
+            gather,
+            loose,
+        })
+    }
+}
+
+/// Which edge-connected pieces step one pins down: a piece is pinned once two of its
+/// vertices at distinct rest positions are (constrained vertices are; every vertex of
+/// a pinned piece is).
+fn pinned_pieces(mesh: &Mesh, constrained: &[u32]) -> Vec<bool> {
+    let topo = &mesh.topology;
+    let pieces = topo.piece_vertices.len();
+    let mut pinned = vec![false; pieces];
+    let mut first: Vec<Option<DVec2>> = vec![None; pieces];
+    let mut known = vec![false; mesh.rest.len()];
+    let mut queue: Vec<u32> = Vec::new();
+    for &v in constrained {
+        known[v as usize] = true;
+        queue.push(v);
+    }
+    while let Some(v) = queue.pop() {
+        let at = mesh.rest[v as usize];
+        for &p in topo.vertex_pieces.row(v as usize) {
+            let p = p as usize;
+            if pinned[p] {
+                continue;
+            }
+            match first[p] {
+                None => first[p] = Some(at),
+                Some(f) if (at - f).length() > mesh.tolerance => {
+                    pinned[p] = true;
+                    for &u in topo.piece_vertices.row(p) {
+                        if !known[u as usize] {
+                            known[u as usize] = true;
+                            queue.push(u);
+                        }
+                    }
+                }
+                Some(_) => {}
+            }
+        }
+    }
+    pinned
+}
+
+impl Compiled {
+    /// The constrained vertices, in the order targets are given.
+    pub fn constrained(&self) -> &[u32] {
+        &self.constrained
+    }
+
+    /// Number of vertices of the mesh.
+    pub fn vertex_count(&self) -> usize {
+        self.mesh.rest.len()
+    }
+
+    /// Number of free unknowns (vertices solved for; `m` in the paper).
+    pub fn free_count(&self) -> usize {
+        self.free.len()
+    }
+
+    /// Triangles on which step one's similarity error alone would leave the shape
+    /// free to turn and scale, and which step one therefore also holds to their rest
+    /// edges (see [`Registration::compile`]); empty for an edge-connected mesh with
+    /// two handles at distinct rest positions.
+    pub fn loose_triangles(&self) -> &[u32] {
+        &self.loose
+    }
+}

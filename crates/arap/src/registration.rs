@@ -1,0 +1,193 @@
+//! Registration (§4.3, step 1): everything that depends on the rest mesh alone.
+
+use std::sync::Arc;
+
+use glam::DVec2;
+
+use crate::error::ArapError;
+use crate::topology::Topology;
+use crate::triangle::{fitting_matrix, is_degenerate, local_coordinates};
+
+/// The rest mesh with what the paper computes once per rest shape ("registration",
+/// §4.3 step 1): each triangle's local coordinates `(x, y)` of every corner in the
+/// frame of the opposite edge — the rows of step one's error matrix `G` (eq. 5) and
+/// of `H` (eq. 13) — and each triangle's fitting matrix `F` of step two (eq. 11),
+/// inverted.
+///
+/// Positions are in any consistent unit (image pixels in C2Warp); nothing depends on
+/// where the origin is.
+///
+/// Triangles whose rest corners span no area (a repeated vertex, coincident or
+/// collinear corners; see [`Registration::skipped_triangles`]) are left out of both
+/// steps: they have no local frame. A vertex that no kept triangle uses stays at rest
+/// unless it is constrained.
+///
+/// Cloning is cheap (the data is shared).
+///
+/// ```
+/// use arap::Registration;
+/// use glam::DVec2;
+///
+/// // A unit square split into two triangles.
+/// let rest = [DVec2::new(0.0, 0.0), DVec2::new(1.0, 0.0), DVec2::new(1.0, 1.0), DVec2::new(0.0, 1.0)];
+/// let registration = Registration::new(&rest, &[[0, 1, 2], [0, 2, 3]])?;
+/// assert_eq!(registration.vertex_count(), 4);
+/// # Ok::<(), arap::ArapError>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct Registration {
+    pub(crate) mesh: Arc<Mesh>,
+}
+
+/// The registered rest mesh, shared by every compiled system built from it.
+#[derive(Debug)]
+pub(crate) struct Mesh {
+    pub rest: Vec<DVec2>,
+    pub triangles: Vec<[u32; 3]>,
+    /// Whether each triangle takes part (is not degenerate).
+    pub kept: Vec<bool>,
+    pub skipped: Vec<u32>,
+    /// Local coordinates of corner `c` in the frame `tri[c + 1] → tri[c + 2]`.
+    pub local: Vec<[DVec2; 3]>,
+    /// Step two's fitting matrix (`F⁻¹` folded with `C`'s map), see
+    /// [`crate::triangle::fitting_matrix`].
+    pub fit: Vec<[[f64; 6]; 2]>,
+    pub topology: Topology,
+    /// Two rest positions closer than this count as one point when deciding whether
+    /// step one's similarity is pinned down.
+    pub tolerance: f64,
+}
+
+impl Registration {
+    /// Registers a rest mesh: `rest[i]` is vertex `i`'s position, each triangle names
+    /// three vertices. Either orientation is accepted, also mixed.
+    ///
+    /// # Errors
+    /// [`ArapError::NonFiniteRest`] for a NaN or infinite position,
+    /// [`ArapError::TriangleVertexOutOfRange`] for a triangle naming a vertex past the
+    /// end, [`ArapError::TooManyVertices`] past `u32::MAX` vertices.
+    pub fn new(rest: &[DVec2], triangles: &[[u32; 3]]) -> Result<Self, ArapError> {
+        if rest.len() > u32::MAX as usize {
+            return Err(ArapError::TooManyVertices {
+                vertices: rest.len(),
+            });
+        }
+        if let Some(vertex) = rest.iter().position(|p| !p.is_finite()) {
+            return Err(ArapError::NonFiniteRest { vertex });
+        }
+        for (triangle, tri) in triangles.iter().enumerate() {
+            if let Some(&vertex) = tri.iter().find(|&&v| v as usize >= rest.len()) {
+                return Err(ArapError::TriangleVertexOutOfRange {
+                    triangle,
+                    vertex,
+                    vertices: rest.len(),
+                });
+            }
+        }
+        let corners = |tri: &[u32; 3]| tri.map(|v| rest[v as usize]);
+        let mut kept = Vec::with_capacity(triangles.len());
+        let mut local = Vec::with_capacity(triangles.len());
+        let mut fit = Vec::with_capacity(triangles.len());
+        let mut skipped = Vec::new();
+        for (t, tri) in triangles.iter().enumerate() {
+            let p = corners(tri);
+            let matrix = if is_degenerate(p) {
+                None
+            } else {
+                fitting_matrix(p)
+            };
+            match matrix {
+                Some(m) => {
+                    kept.push(true);
+                    local.push(
+                        [0, 1, 2].map(|c| local_coordinates(p[c], p[(c + 1) % 3], p[(c + 2) % 3])),
+                    );
+                    fit.push(m);
+                }
+                None => {
+                    kept.push(false);
+                    skipped.push(t as u32);
+                    local.push([DVec2::ZERO; 3]);
+                    fit.push([[0.0; 6]; 2]);
+                }
+            }
+        }
+        let topology = Topology::new(rest.len(), triangles, &kept);
+        let (lo, hi) = rest.iter().fold(
+            (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+            |(lo, hi), &p| (lo.min(p), hi.max(p)),
+        );
+        let diagonal = if rest.is_empty() {
+            0.0
+        } else {
+            (hi - lo).length()
+        };
+        Ok(Self {
+            mesh: Arc::new(Mesh {
+                rest: rest.to_vec(),
+                triangles: triangles.to_vec(),
+                kept,
+                skipped,
+                local,
+                fit,
+                topology,
+                tolerance: 1e-9 * diagonal,
+            }),
+        })
+    }
+
+    /// Number of vertices.
+    pub fn vertex_count(&self) -> usize {
+        self.mesh.rest.len()
+    }
+
+    /// Number of triangles, skipped ones included (rigidity lists have this length).
+    pub fn triangle_count(&self) -> usize {
+        self.mesh.triangles.len()
+    }
+
+    /// The rest positions.
+    pub fn rest(&self) -> &[DVec2] {
+        &self.mesh.rest
+    }
+
+    /// The triangles as given.
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.mesh.triangles
+    }
+
+    /// Triangles left out because their rest corners span no area (twice the area at
+    /// most `1e-12` times the longest edge squared), in increasing order.
+    pub fn skipped_triangles(&self) -> &[u32] {
+        &self.mesh.skipped
+    }
+
+    /// The vertices that share a kept triangle with `vertex` (its one-ring), in
+    /// increasing order, without `vertex` itself.
+    ///
+    /// # Errors
+    /// [`ArapError::VertexOutOfRange`] if there is no such vertex.
+    pub fn neighbours(&self, vertex: u32) -> Result<Vec<u32>, ArapError> {
+        self.check_vertex(vertex)?;
+        Ok(self
+            .mesh
+            .topology
+            .adjacency
+            .row(vertex as usize)
+            .iter()
+            .copied()
+            .filter(|&v| v != vertex)
+            .collect())
+    }
+
+    pub(crate) fn check_vertex(&self, vertex: u32) -> Result<(), ArapError> {
+        if (vertex as usize) < self.mesh.rest.len() {
+            Ok(())
+        } else {
+            Err(ArapError::VertexOutOfRange {
+                vertex,
+                vertices: self.mesh.rest.len(),
+            })
+        }
+    }
+}

@@ -1,0 +1,204 @@
+//! Manipulation (§4.3, step 3): one back-substitution for step one, the per-triangle
+//! fit, and one back-substitution (x and y together) for step two.
+
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use glam::DVec2;
+use rayon::prelude::*;
+
+use crate::compile::Compiled;
+use crate::error::ArapError;
+use crate::triangle::{fitted_rotation, rotate};
+
+/// Below this many triangles the per-triangle pass runs on one thread.
+const PARALLEL_TRIANGLES: usize = 16_384;
+
+/// The result of one pose: vertex positions, indexed like the rest positions.
+///
+/// Keep one around and pass it to [`Compiled::update_into`] to reuse its buffers
+/// across drag frames.
+#[derive(Default)]
+pub struct Deformation {
+    /// Step one's intermediate result (§4.1): the scale-free fit, which lets triangles
+    /// grow and shrink.
+    pub step_one: Vec<DVec2>,
+    /// The final result (§4.2): step two's scale-adjusted positions.
+    pub positions: Vec<DVec2>,
+    scratch: Scratch,
+}
+
+impl Clone for Deformation {
+    fn clone(&self) -> Self {
+        Self {
+            step_one: self.step_one.clone(),
+            positions: self.positions.clone(),
+            scratch: Scratch::default(),
+        }
+    }
+}
+
+impl std::fmt::Debug for Deformation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Deformation")
+            .field("step_one", &self.step_one)
+            .field("positions", &self.positions)
+            .finish_non_exhaustive()
+    }
+}
+
+/// Buffers reused between updates.
+#[derive(Default)]
+struct Scratch {
+    step_one: Vec<f64>,
+    step_two: Vec<f64>,
+    rotations: Vec<DVec2>,
+    memory: Option<(StackReq, MemBuffer)>,
+}
+
+impl Compiled {
+    /// Poses the mesh: `targets[i]` is where constrained vertex
+    /// [`constrained()[i]`](Compiled::constrained) goes. Returns step one's result and
+    /// the final one; constrained vertices sit exactly on their targets in both.
+    ///
+    /// ```
+    /// use arap::Registration;
+    /// use glam::DVec2;
+    ///
+    /// // A 3 × 2 strip of unit squares, each split along a diagonal.
+    /// let rest: Vec<DVec2> = (0..3)
+    ///     .flat_map(|y| (0..4).map(move |x| DVec2::new(x as f64, y as f64)))
+    ///     .collect();
+    /// let mut triangles = Vec::new();
+    /// for y in 0..2u32 {
+    ///     for x in 0..3u32 {
+    ///         let v = y * 4 + x;
+    ///         triangles.push([v, v + 1, v + 5]);
+    ///         triangles.push([v, v + 5, v + 4]);
+    ///     }
+    /// }
+    /// let registration = Registration::new(&rest, &triangles)?;
+    /// // Pin the two ends of the middle row; drag the right one up.
+    /// let compiled = registration.compile(&[4, 7], None)?;
+    /// let pose = compiled.update(&[DVec2::new(0.0, 1.0), DVec2::new(3.0, 2.5)])?;
+    /// assert_eq!(pose.positions[7], DVec2::new(3.0, 2.5));
+    /// assert!(pose.positions.iter().all(|p| p.is_finite()));
+    /// # Ok::<(), arap::ArapError>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`ArapError::TargetCount`] if `targets` is not as long as the constraint list,
+    /// [`ArapError::NonFiniteTarget`] for a NaN or infinite target.
+    pub fn update(&self, targets: &[DVec2]) -> Result<Deformation, ArapError> {
+        let mut out = Deformation::default();
+        self.update_into(targets, &mut out)?;
+        Ok(out)
+    }
+
+    /// [`Compiled::update`] into `out`, reusing its buffers: a drag frame allocates
+    /// nothing after the first.
+    ///
+    /// # Errors
+    /// As [`Compiled::update`]; `out` is left unchanged on error.
+    pub fn update_into(&self, targets: &[DVec2], out: &mut Deformation) -> Result<(), ArapError> {
+        if targets.len() != self.constrained.len() {
+            return Err(ArapError::TargetCount {
+                got: targets.len(),
+                expected: self.constrained.len(),
+            });
+        }
+        if let Some(constraint) = targets.iter().position(|t| !t.is_finite()) {
+            return Err(ArapError::NonFiniteTarget { constraint });
+        }
+        let mesh = &*self.mesh;
+        out.step_one.clear();
+        out.step_one.extend_from_slice(&mesh.rest);
+        for (&v, &t) in self.constrained.iter().zip(targets) {
+            out.step_one[v as usize] = t;
+        }
+        let (Some(one), Some(two)) = (&self.step_one, &self.step_two) else {
+            out.positions.clone_from(&out.step_one);
+            return Ok(());
+        };
+        let m = self.free.len();
+        let scratch = &mut out.scratch;
+        let req = one.scratch(1).or(two.scratch(2));
+        if scratch.memory.as_ref().is_none_or(|(r, _)| *r != req) {
+            scratch.memory = Some((req, MemBuffer::new(req)));
+        }
+        let Some((_, memory)) = scratch.memory.as_mut() else {
+            unreachable!("allocated above")
+        };
+        let stack = MemStack::new(memory);
+
+        // Step one (eq. 8): G'u = −Bq (+ the rest pull on loose pieces).
+        let r1 = &mut scratch.step_one;
+        r1.clear();
+        r1.extend_from_slice(&self.step_one_rhs);
+        for c in &self.couplings {
+            let q = targets[c.constraint as usize];
+            let (p, s) = c.g;
+            let a = 2 * c.free as usize;
+            r1[a] -= p * q.x + s * q.y;
+            r1[a + 1] -= -s * q.x + p * q.y;
+        }
+        one.solve_in_place(r1, 1, stack);
+        for (i, &v) in self.free.iter().enumerate() {
+            out.step_one[v as usize] = DVec2::new(r1[2 * i], r1[2 * i + 1]);
+        }
+
+        // Step two, fitting (eqs. 9–11): each rest triangle's rotation onto its
+        // step-one triangle, scaled back to rest size.
+        let rotations = &mut scratch.rotations;
+        rotations.resize(self.active.len(), DVec2::X);
+        let step_one = &out.step_one;
+        let fit = |(r, &t): (&mut DVec2, &u32)| {
+            let tri = mesh.triangles[t as usize];
+            *r = fitted_rotation(&mesh.fit[t as usize], tri.map(|v| step_one[v as usize]));
+        };
+        if self.active.len() >= PARALLEL_TRIANGLES {
+            rotations
+                .par_iter_mut()
+                .zip(self.active.par_iter())
+                .for_each(fit);
+        } else {
+            rotations.iter_mut().zip(self.active.iter()).for_each(fit);
+        }
+
+        // Step two, final solve (eq. 16): H'u = −Dq − f_u, x and y as two columns.
+        let r2 = &mut scratch.step_two;
+        r2.resize(2 * m, 0.0);
+        let (xs, ys) = r2.split_at_mut(m);
+        let rotations = &*rotations;
+        let gather = |(i, (x, y)): (usize, (&mut f64, &mut f64))| {
+            let mut b = DVec2::ZERO;
+            for &(t, d) in self.gather.row(i) {
+                b += rotate(rotations[t as usize], d);
+            }
+            *x = b.x;
+            *y = b.y;
+        };
+        if self.active.len() >= PARALLEL_TRIANGLES {
+            xs.par_iter_mut()
+                .zip(ys.par_iter_mut())
+                .enumerate()
+                .with_min_len(1024)
+                .for_each(gather);
+        } else {
+            xs.iter_mut()
+                .zip(ys.iter_mut())
+                .enumerate()
+                .for_each(gather);
+        }
+        for c in &self.couplings {
+            let q = targets[c.constraint as usize];
+            xs[c.free as usize] -= c.h * q.x;
+            ys[c.free as usize] -= c.h * q.y;
+        }
+        two.solve_in_place(r2, 2, stack);
+
+        out.positions.clone_from(&out.step_one);
+        for (i, &v) in self.free.iter().enumerate() {
+            out.positions[v as usize] = DVec2::new(r2[i], r2[m + i]);
+        }
+        Ok(())
+    }
+}
