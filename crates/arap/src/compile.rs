@@ -4,11 +4,12 @@
 
 use std::sync::Arc;
 
+use faer::c64;
 use glam::DVec2;
 
 use crate::error::ArapError;
 use crate::registration::{Mesh, Registration};
-use crate::solver::{Cholesky, LowerCsc, Ordering};
+use crate::solver::{Cholesky, Complex, LowerCsc, Ordering};
 use crate::topology::Rows;
 use crate::triangle::{block_product, corner_error_coefficients};
 
@@ -24,16 +25,16 @@ pub struct Compiled {
     pub(crate) constrained: Vec<u32>,
     /// Free vertices in increasing order; free unknown `i` is vertex `free[i]`.
     pub(crate) free: Vec<u32>,
-    /// The constant part of step one's right-hand side (interleaved x, y; non-zero
-    /// only where step one's similarity is not pinned down, see
-    /// [`Compiled::loose_triangles`]).
-    pub(crate) step_one_rhs: Vec<f64>,
+    /// The constant part of step one's right-hand side (non-zero only where step
+    /// one's similarity is not pinned down, see [`Compiled::loose_triangles`]).
+    pub(crate) step_one_rhs: Vec<DVec2>,
     /// Couplings of free unknowns to constrained vertices.
     pub(crate) couplings: Vec<Coupling>,
-    /// `G'` of eq. 8 (`2m × 2m`), factorised; `None` when nothing is free.
-    pub(crate) step_one: Option<Cholesky>,
+    /// `G'` of eq. 8 (`2m × 2m`, as an `m × m` Hermitian matrix), factorised;
+    /// `None` when nothing is free.
+    pub(crate) step_one: Option<Cholesky<Complex>>,
     /// `H'` of eq. 16 (`m × m`, for x and y alike), factorised.
-    pub(crate) step_two: Option<Cholesky>,
+    pub(crate) step_two: Option<Cholesky<f64>>,
     /// Kept triangles in components that have a constraint: the per-triangle pass.
     pub(crate) active: Vec<u32>,
     /// For each free vertex, its corners as `(index into active, d)`: the vertex's
@@ -48,8 +49,8 @@ pub struct Compiled {
 pub(crate) struct Coupling {
     pub free: u32,
     pub constraint: u32,
-    /// Step one's 2×2 block `p·I + q·R90`.
-    pub g: (f64, f64),
+    /// Step one's 2×2 block `p·I + q·R90` as the complex number `p − i·q`.
+    pub g: Complex,
     /// Step two's scalar entry.
     pub h: f64,
 }
@@ -215,77 +216,62 @@ impl Registration {
             }
         }
 
-        // Lower triangles of G' (interleaved) and H', and the couplings B and D.
-        let mut h_csc = LowerCsc {
-            n: m,
-            col_ptr: Vec::with_capacity(m + 1),
-            row_idx: Vec::new(),
-            values: Vec::new(),
-        };
-        let mut g_csc = LowerCsc {
-            n: 2 * m,
-            col_ptr: Vec::with_capacity(2 * m + 1),
-            row_idx: Vec::new(),
-            values: Vec::new(),
-        };
-        h_csc.col_ptr.push(0);
-        g_csc.col_ptr.push(0);
+        // The lower triangles of G' and H' share one pattern (vertex pairs); G' is
+        // stored as the Hermitian matrix whose real form it is (see solver.rs): its
+        // block p·I + q·R90 at (a, b) is p − i·q, and the entry below the diagonal,
+        // at (b, a), is the conjugate p + i·q.
+        let mut col_ptr = Vec::with_capacity(m + 1);
+        let mut row_idx = Vec::new();
+        let mut h_values = Vec::new();
+        let mut g_values = Vec::new();
+        col_ptr.push(0u32);
         let mut couplings = Vec::new();
-        let mut column_y: Vec<(u32, f64)> = Vec::new();
         for (fa, &a) in free.iter().enumerate() {
             let start = topo.adjacency.ptr[a as usize] as usize;
-            column_y.clear();
             for (k, &b) in topo.adjacency.row(a as usize).iter().enumerate() {
                 let slot = start + k;
                 let (p, q) = g[slot];
                 let fb = free_index[b as usize];
                 if fb != u32::MAX {
                     if fb as usize >= fa {
-                        h_csc.row_idx.push(fb);
-                        h_csc.values.push(h[slot]);
-                        // Rows 2fb, 2fb + 1 of G_ba = G_abᵀ = [[p, −q], [q, p]].
-                        g_csc.row_idx.extend([2 * fb, 2 * fb + 1]);
-                        g_csc.values.extend([p, q]);
-                        if fb as usize != fa {
-                            column_y.extend([(2 * fb, -q), (2 * fb + 1, p)]);
-                        } else {
-                            column_y.push((2 * fb + 1, p));
-                        }
+                        row_idx.push(fb);
+                        h_values.push(h[slot]);
+                        g_values.push(c64::new(p, q));
                     }
                 } else if constraint_of[b as usize] != u32::MAX {
                     couplings.push(Coupling {
                         free: fa as u32,
                         constraint: constraint_of[b as usize],
-                        g: (p, q),
+                        g: Complex(DVec2::new(p, -q)),
                         h: h[slot],
                     });
                 }
             }
-            h_csc.col_ptr.push(h_csc.row_idx.len() as u32);
-            g_csc.col_ptr.push(g_csc.row_idx.len() as u32);
-            for &(r, v) in &column_y {
-                g_csc.row_idx.push(r);
-                g_csc.values.push(v);
-            }
-            g_csc.col_ptr.push(g_csc.row_idx.len() as u32);
+            col_ptr.push(row_idx.len() as u32);
         }
 
         let (step_one, step_two) = if m == 0 {
             (None, None)
         } else {
+            let h_csc = LowerCsc {
+                n: m,
+                col_ptr,
+                row_idx,
+                values: h_values,
+            };
             let ordering = Ordering::amd(&h_csc)?;
             let two = Cholesky::new(&h_csc, &ordering)?;
-            let one = Cholesky::new(&g_csc, &ordering.interleaved())?;
+            let g_csc = LowerCsc {
+                n: m,
+                col_ptr: h_csc.col_ptr,
+                row_idx: h_csc.row_idx,
+                values: g_values,
+            };
+            let one = Cholesky::new(&g_csc, &ordering)?;
             (Some(one), Some(two))
         };
 
-        let step_one_rhs = free
-            .iter()
-            .flat_map(|&v| {
-                let p = rest_pull[v as usize];
-                [p.x, p.y]
-            })
-            .collect();
+        let step_one_rhs = free.iter().map(|&v| rest_pull[v as usize]).collect();
 
         // Step two's linear term, gathered per free vertex: corner c of a triangle
         // ends edge c−1 → c and starts edge c → c+1.

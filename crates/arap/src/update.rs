@@ -1,12 +1,12 @@
 //! Manipulation (§4.3, step 3): one back-substitution for step one, the per-triangle
 //! fit, and one back-substitution (x and y together) for step two.
 
-use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use glam::DVec2;
 use rayon::prelude::*;
 
 use crate::compile::Compiled;
 use crate::error::ArapError;
+use crate::solver::Entry;
 use crate::triangle::{fitted_rotation, rotate};
 
 /// Below this many triangles the per-triangle pass runs on one thread.
@@ -48,10 +48,10 @@ impl std::fmt::Debug for Deformation {
 /// Buffers reused between updates.
 #[derive(Default)]
 struct Scratch {
-    step_one: Vec<f64>,
-    step_two: Vec<f64>,
+    step_one: Vec<DVec2>,
+    step_two: Vec<DVec2>,
     rotations: Vec<DVec2>,
-    memory: Option<(StackReq, MemBuffer)>,
+    work: Vec<DVec2>,
 }
 
 impl Compiled {
@@ -118,31 +118,17 @@ impl Compiled {
             out.positions.clone_from(&out.step_one);
             return Ok(());
         };
-        let m = self.free.len();
         let scratch = &mut out.scratch;
-        let req = one.scratch(1).or(two.scratch(2));
-        if scratch.memory.as_ref().is_none_or(|(r, _)| *r != req) {
-            scratch.memory = Some((req, MemBuffer::new(req)));
-        }
-        let Some((_, memory)) = scratch.memory.as_mut() else {
-            unreachable!("allocated above")
-        };
-        let stack = MemStack::new(memory);
 
         // Step one (eq. 8): G'u = −Bq (+ the rest pull on loose pieces).
         let r1 = &mut scratch.step_one;
-        r1.clear();
-        r1.extend_from_slice(&self.step_one_rhs);
+        r1.clone_from(&self.step_one_rhs);
         for c in &self.couplings {
-            let q = targets[c.constraint as usize];
-            let (p, s) = c.g;
-            let a = 2 * c.free as usize;
-            r1[a] -= p * q.x + s * q.y;
-            r1[a + 1] -= -s * q.x + p * q.y;
+            r1[c.free as usize] -= c.g.mul(targets[c.constraint as usize]);
         }
-        one.solve_in_place(r1, 1, stack);
-        for (i, &v) in self.free.iter().enumerate() {
-            out.step_one[v as usize] = DVec2::new(r1[2 * i], r1[2 * i + 1]);
+        one.solve_in_place(r1, &mut scratch.work);
+        for (&v, &p) in self.free.iter().zip(r1.iter()) {
+            out.step_one[v as usize] = p;
         }
 
         // Step two, fitting (eqs. 9–11): each rest triangle's rotation onto its
@@ -158,46 +144,39 @@ impl Compiled {
             rotations
                 .par_iter_mut()
                 .zip(self.active.par_iter())
+                .with_min_len(1024)
                 .for_each(fit);
         } else {
             rotations.iter_mut().zip(self.active.iter()).for_each(fit);
         }
 
-        // Step two, final solve (eq. 16): H'u = −Dq − f_u, x and y as two columns.
+        // Step two, final solve (eq. 16): H'u = −Dq − f_u, x and y together.
         let r2 = &mut scratch.step_two;
-        r2.resize(2 * m, 0.0);
-        let (xs, ys) = r2.split_at_mut(m);
+        r2.resize(self.free.len(), DVec2::ZERO);
         let rotations = &*rotations;
-        let gather = |(i, (x, y)): (usize, (&mut f64, &mut f64))| {
-            let mut b = DVec2::ZERO;
+        let gather = |(i, b): (usize, &mut DVec2)| {
+            let mut sum = DVec2::ZERO;
             for &(t, d) in self.gather.row(i) {
-                b += rotate(rotations[t as usize], d);
+                sum += rotate(rotations[t as usize], d);
             }
-            *x = b.x;
-            *y = b.y;
+            *b = sum;
         };
         if self.active.len() >= PARALLEL_TRIANGLES {
-            xs.par_iter_mut()
-                .zip(ys.par_iter_mut())
+            r2.par_iter_mut()
                 .enumerate()
                 .with_min_len(1024)
                 .for_each(gather);
         } else {
-            xs.iter_mut()
-                .zip(ys.iter_mut())
-                .enumerate()
-                .for_each(gather);
+            r2.iter_mut().enumerate().for_each(gather);
         }
         for c in &self.couplings {
-            let q = targets[c.constraint as usize];
-            xs[c.free as usize] -= c.h * q.x;
-            ys[c.free as usize] -= c.h * q.y;
+            r2[c.free as usize] -= c.h * targets[c.constraint as usize];
         }
-        two.solve_in_place(r2, 2, stack);
+        two.solve_in_place(r2, &mut scratch.work);
 
         out.positions.clone_from(&out.step_one);
-        for (i, &v) in self.free.iter().enumerate() {
-            out.positions[v as usize] = DVec2::new(r2[i], r2[m + i]);
+        for (&v, &p) in self.free.iter().zip(r2.iter()) {
+            out.positions[v as usize] = p;
         }
         Ok(())
     }

@@ -247,3 +247,32 @@ pub fn similarity(angle: f64, scale: f64, translation: DVec2) -> impl Fn(DVec2) 
     let rot = DVec2::from_angle(angle) * scale;
     move |p: DVec2| rot.rotate(p) + translation
 }
+
+/// Four handles spread over a mesh: the vertices nearest to points inset from the
+/// corners of its bounding box.
+pub fn spread_handles(mesh: &MeshData) -> Vec<u32> {
+    let (lo, hi) = mesh.rest.iter().fold(
+        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+        |(lo, hi), &p| (lo.min(p), hi.max(p)),
+    );
+    let at = |fx: f64, fy: f64| nearest(mesh, lo + (hi - lo) * DVec2::new(fx, fy));
+    vec![at(0.1, 0.15), at(0.9, 0.2), at(0.15, 0.85), at(0.85, 0.9)]
+}
+
+/// A drag of [`spread_handles`] at time `t ∈ [0, 1]`: every other handle pulled
+/// right and up by up to a third of the mesh's size, the others nudged.
+pub fn drag_pose(mesh: &MeshData, handles: &[u32], t: f64) -> Vec<DVec2> {
+    let size = mesh.rest.iter().fold(0.0_f64, |m, p| m.max(p.x).max(p.y));
+    handles
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| {
+            let p = mesh.rest[v as usize];
+            if i % 2 == 1 {
+                p + DVec2::new(0.2 * t * size, -0.3 * t * size)
+            } else {
+                p + DVec2::new(0.0, 0.05 * t * size)
+            }
+        })
+        .collect()
+}
