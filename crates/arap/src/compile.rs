@@ -9,8 +9,7 @@ use glam::DVec2;
 
 use crate::error::ArapError;
 use crate::registration::{Mesh, Registration};
-use crate::solver::{Cholesky, Complex, LowerCsc, Ordering};
-use crate::topology::Rows;
+use crate::solver::{Cholesky, Complex, LowerPattern, Ordering, Structure};
 use crate::triangle::{block_product, corner_error_coefficients};
 
 /// A system compiled for one set of constrained vertices (handles) and rigidity
@@ -36,11 +35,18 @@ pub struct Compiled {
     /// `H'` of eq. 16 (`m × m`, for x and y alike), factorised.
     pub(crate) step_two: Option<Cholesky<f64>>,
     /// Kept triangles in components that have a constraint: the per-triangle pass.
-    pub(crate) active: Vec<u32>,
-    /// For each free vertex, its corners as `(index into active, d)`: the vertex's
-    /// share of step two's linear term is `Σ rotation(active) · d`.
-    pub(crate) gather: Rows<(u32, DVec2)>,
+    pub(crate) triangles: Vec<PassTriangle>,
     pub(crate) loose: Vec<u32>,
+}
+
+/// A triangle of the per-triangle pass, laid out for it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PassTriangle {
+    pub vertices: [u32; 3],
+    /// Step two's fitting coefficients.
+    pub fit: [DVec2; 2],
+    /// Rest edges `v0 → v1` and `v1 → v2` times the rigidity weight.
+    pub edges: [DVec2; 2],
 }
 
 /// One block of `B` (eq. 8) and `D` (eq. 16): how free unknown `free` depends on the
@@ -60,7 +66,7 @@ impl std::fmt::Debug for Compiled {
         f.debug_struct("Compiled")
             .field("constrained", &self.constrained.len())
             .field("free", &self.free.len())
-            .field("active_triangles", &self.active.len())
+            .field("active_triangles", &self.triangles.len())
             .field("loose_triangles", &self.loose.len())
             .finish_non_exhaustive()
     }
@@ -168,13 +174,11 @@ impl Registration {
         let mut h = vec![0.0; slots];
         let mut rest_pull = vec![DVec2::ZERO; n];
         let mut active = Vec::new();
-        let mut active_index = vec![u32::MAX; mesh.triangles.len()];
         let mut loose = Vec::new();
         for (t, tri) in mesh.triangles.iter().enumerate() {
             if !mesh.kept[t] || !reached[topo.component[tri[0] as usize] as usize] {
                 continue;
             }
-            active_index[t] = active.len() as u32;
             active.push(t as u32);
             let w = weight(t);
             let s = &topo.slots[t];
@@ -253,41 +257,37 @@ impl Registration {
         let (step_one, step_two) = if m == 0 {
             (None, None)
         } else {
-            let h_csc = LowerCsc {
+            let pattern = LowerPattern {
                 n: m,
                 col_ptr,
                 row_idx,
-                values: h_values,
             };
-            let ordering = Ordering::amd(&h_csc)?;
-            let two = Cholesky::new(&h_csc, &ordering)?;
-            let g_csc = LowerCsc {
-                n: m,
-                col_ptr: h_csc.col_ptr,
-                row_idx: h_csc.row_idx,
-                values: g_values,
-            };
-            let one = Cholesky::new(&g_csc, &ordering)?;
-            (Some(one), Some(two))
+            let ordering = Ordering::amd(&pattern)?;
+            let structure = Structure::new(&pattern, &ordering)?;
+            let (one, two) = rayon::join(
+                || Cholesky::<Complex>::new(&structure, &pattern, &g_values),
+                || Cholesky::<f64>::new(&structure, &pattern, &h_values),
+            );
+            (Some(one?), Some(two?))
         };
 
         let step_one_rhs = free.iter().map(|&v| rest_pull[v as usize]).collect();
 
-        // Step two's linear term, gathered per free vertex: corner c of a triangle
-        // ends edge c−1 → c and starts edge c → c+1.
-        let active_index = &active_index;
-        let gather = Rows::from_pairs(
-            m,
-            free.iter().enumerate().flat_map(|(fa, &v)| {
-                topo.corners.row(v as usize).iter().map(move |&code| {
-                    let (t, c) = ((code / 3) as usize, (code % 3) as usize);
-                    let tri = mesh.triangles[t];
-                    let r = |k: usize| mesh.rest[tri[k % 3] as usize];
-                    let d = (r(c) - r(c + 2)) - (r(c + 1) - r(c));
-                    (fa as u32, (active_index[t], weight(t) * d))
-                })
-            }),
-        );
+        // The per-triangle pass of every update: fitting coefficients and the rest
+        // edges 0 → 1, 1 → 2, weighted.
+        let triangles = active
+            .iter()
+            .map(|&t| {
+                let tri = mesh.triangles[t as usize];
+                let r = tri.map(|v| mesh.rest[v as usize]);
+                let w = weight(t as usize);
+                PassTriangle {
+                    vertices: tri,
+                    fit: mesh.fit[t as usize],
+                    edges: [w * (r[1] - r[0]), w * (r[2] - r[1])],
+                }
+            })
+            .collect();
 
         Ok(Compiled {
             mesh: Arc::clone(mesh),
@@ -297,8 +297,7 @@ impl Registration {
             couplings,
             step_one,
             step_two,
-            active,
-            gather,
+            triangles,
             loose,
         })
     }

@@ -6,7 +6,7 @@ use glam::DVec2;
 
 use crate::error::ArapError;
 use crate::topology::Topology;
-use crate::triangle::{fitting_matrix, is_degenerate, local_coordinates};
+use crate::triangle::{fitting_coefficients, is_degenerate, local_coordinates};
 
 /// The rest mesh with what the paper computes once per rest shape ("registration",
 /// §4.3 step 1): each triangle's local coordinates `(x, y)` of every corner in the
@@ -49,9 +49,9 @@ pub(crate) struct Mesh {
     pub skipped: Vec<u32>,
     /// Local coordinates of corner `c` in the frame `tri[c + 1] → tri[c + 2]`.
     pub local: Vec<[DVec2; 3]>,
-    /// Step two's fitting matrix (`F⁻¹` folded with `C`'s map), see
-    /// [`crate::triangle::fitting_matrix`].
-    pub fit: Vec<[[f64; 6]; 2]>,
+    /// Step two's fitting (`F⁻¹` folded with `C`'s map) as two complex
+    /// coefficients, see [`crate::triangle::fitting_coefficients`].
+    pub fit: Vec<[DVec2; 2]>,
     pub topology: Topology,
     /// Two rest positions closer than this count as one point when deciding whether
     /// step one's similarity is pinned down.
@@ -94,7 +94,7 @@ impl Registration {
             let matrix = if is_degenerate(p) {
                 None
             } else {
-                fitting_matrix(p)
+                fitting_coefficients(p)
             };
             match matrix {
                 Some(m) => {
@@ -108,7 +108,7 @@ impl Registration {
                     kept.push(false);
                     skipped.push(t as u32);
                     local.push([DVec2::ZERO; 3]);
-                    fit.push([[0.0; 6]; 2]);
+                    fit.push([DVec2::ZERO; 2]);
                 }
             }
         }

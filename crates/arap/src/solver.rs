@@ -10,14 +10,17 @@
 //! stored as complex numbers (`DVec2` as `re + i·im`): the same factor and the same
 //! substitutions in half the memory.
 
+use std::sync::Arc;
+
 use faer::c64;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::perm::PermRef;
-use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::amd;
 use faer::sparse::linalg::cholesky::{
-    CholeskySymbolicParams, SymbolicCholeskyRaw, SymmetricOrdering, factorize_symbolic_cholesky,
+    CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
+    factorize_symbolic_cholesky,
 };
+use faer::sparse::linalg::{SupernodalThreshold, SymbolicSupernodalParams};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::traits::ComplexField;
 use faer::{Par, Side};
@@ -25,20 +28,24 @@ use glam::DVec2;
 
 use crate::error::ArapError;
 
-/// A symmetric (Hermitian) matrix given by its lower triangle in compressed columns,
-/// rows sorted within each column.
-pub(crate) struct LowerCsc<T> {
+/// The pattern of a symmetric (Hermitian) matrix's lower triangle in compressed
+/// columns, rows sorted within each column; values come beside it in that order.
+pub(crate) struct LowerPattern {
     pub n: usize,
     pub col_ptr: Vec<u32>,
     pub row_idx: Vec<u32>,
-    pub values: Vec<T>,
 }
 
-impl<T> LowerCsc<T> {
+impl LowerPattern {
     fn symbolic(&self) -> SymbolicSparseColMatRef<'_, u32> {
         SymbolicSparseColMatRef::new_checked(self.n, self.n, &self.col_ptr, None, &self.row_idx)
     }
 }
+
+/// Supernodes merge with their neighbours only where that stores few explicit
+/// zeros: every pose's substitutions read every stored entry, while the
+/// factorisation, done once, gains little from larger blocks on meshes.
+const RELAX: &[(usize, f64)] = &[(4, 0.3), (16, 0.1), (usize::MAX, 0.02)];
 
 /// A fill-reducing ordering: `forward[new] = old`, `inverse[old] = new`.
 pub(crate) struct Ordering {
@@ -48,7 +55,7 @@ pub(crate) struct Ordering {
 
 impl Ordering {
     /// Approximate minimum degree on the pattern of `a`.
-    pub fn amd<T>(a: &LowerCsc<T>) -> Result<Self, ArapError> {
+    pub fn amd(a: &LowerPattern) -> Result<Self, ArapError> {
         let n = a.n;
         let mut forward = vec![0u32; n];
         let mut inverse = vec![0u32; n];
@@ -137,60 +144,42 @@ struct Supernode {
     values: usize,
 }
 
-/// `A = P·L·Lᴴ·Pᵀ` for a symmetric (Hermitian) positive definite `A`.
-pub(crate) struct Cholesky<T> {
+/// What both steps' factors share: they have one pattern and one ordering, so one
+/// symbolic analysis serves both.
+pub(crate) struct Structure {
+    symbolic: SymbolicCholesky<u32>,
+    layout: Arc<Layout>,
+}
+
+/// The factor's layout: the ordering and the supernodes.
+struct Layout {
     forward: Vec<u32>,
     inverse: Vec<u32>,
     supernodes: Vec<Supernode>,
     pattern: Vec<u32>,
-    values: Vec<T>,
+    /// The most rows below any supernode's diagonal block.
+    widest: usize,
 }
 
-impl<T: Entry> Cholesky<T> {
-    /// Factorises `a` under `ordering`.
-    ///
-    /// # Errors
-    /// [`ArapError::Factorization`] if `a` is not numerically positive definite or
-    /// memory runs out.
-    pub fn new(a: &LowerCsc<T::Faer>, ordering: &Ordering) -> Result<Self, ArapError> {
-        let failed = |e: &dyn std::fmt::Debug| ArapError::Factorization(format!("{e:?}"));
-        let perm = PermRef::new_checked(&ordering.forward, &ordering.inverse, a.n);
+fn failed(e: &dyn std::fmt::Debug) -> ArapError {
+    ArapError::Factorization(format!("{e:?}"))
+}
+
+impl Structure {
+    /// The symbolic factorisation of `pattern` under `ordering` (supernodal).
+    pub fn new(pattern: &LowerPattern, ordering: &Ordering) -> Result<Self, ArapError> {
+        let perm = PermRef::new_checked(&ordering.forward, &ordering.inverse, pattern.n);
         let symbolic = factorize_symbolic_cholesky(
-            a.symbolic(),
+            pattern.symbolic(),
             Side::Lower,
             SymmetricOrdering::Custom(perm),
             CholeskySymbolicParams {
                 supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+                supernodal_params: SymbolicSupernodalParams { relax: Some(RELAX) },
                 ..Default::default()
             },
         )
         .map_err(|e| failed(&e))?;
-        let mut values: Vec<T::Faer> = Vec::new();
-        values
-            .try_reserve_exact(symbolic.len_val())
-            .map_err(|e| failed(&e))?;
-        values.resize(symbolic.len_val(), T::Faer::zero_impl());
-        let par = if a.n >= 20_000 {
-            Par::rayon(0)
-        } else {
-            Par::Seq
-        };
-        let mut mem = MemBuffer::try_new(
-            symbolic.factorize_numeric_llt_scratch::<T::Faer>(par, Default::default()),
-        )
-        .map_err(|e| failed(&e))?;
-        symbolic
-            .factorize_numeric_llt::<T::Faer>(
-                &mut values,
-                SparseColMatRef::new(a.symbolic(), &a.values),
-                Side::Lower,
-                Default::default(),
-                par,
-                MemStack::new(&mut mem),
-                Default::default(),
-            )
-            .map_err(|e| failed(&e))?;
-
         let SymbolicCholeskyRaw::Supernodal(sn) = symbolic.raw() else {
             return Err(ArapError::Factorization(
                 "expected a supernodal factor".into(),
@@ -201,10 +190,13 @@ impl<T: Entry> Cholesky<T> {
                 let (f, i) = p.arrays();
                 (f.to_vec(), i.to_vec())
             }
-            None => ((0..a.n as u32).collect(), (0..a.n as u32).collect()),
+            None => (
+                (0..pattern.n as u32).collect(),
+                (0..pattern.n as u32).collect(),
+            ),
         };
         let mut supernodes = Vec::with_capacity(sn.n_supernodes());
-        let mut pattern = Vec::new();
+        let mut rows = Vec::new();
         for s in 0..sn.n_supernodes() {
             let node = sn.supernode(s);
             let start = sn.supernode_begin()[s] as usize;
@@ -212,69 +204,140 @@ impl<T: Entry> Cholesky<T> {
             supernodes.push(Supernode {
                 start: start as u32,
                 size: (end - start) as u32,
-                rows: pattern.len() as u32,
+                rows: rows.len() as u32,
                 rows_len: node.pattern().len() as u32,
                 values: sn.col_ptr_for_val()[s] as usize,
             });
-            pattern.extend_from_slice(node.pattern());
+            rows.extend_from_slice(node.pattern());
         }
+        let widest = supernodes
+            .iter()
+            .map(|s| s.rows_len as usize)
+            .max()
+            .unwrap_or(0);
         Ok(Self {
-            forward,
-            inverse,
-            supernodes,
-            pattern,
-            values: values.into_iter().map(T::from_faer).collect(),
+            symbolic,
+            layout: Arc::new(Layout {
+                forward,
+                inverse,
+                supernodes,
+                pattern: rows,
+                widest,
+            }),
+        })
+    }
+}
+
+/// `A = P·L·Lᴴ·Pᵀ` for a symmetric (Hermitian) positive definite `A`.
+pub(crate) struct Cholesky<T> {
+    layout: Arc<Layout>,
+    values: Vec<T>,
+}
+
+impl<T: Entry> Cholesky<T> {
+    /// Factorises the matrix with `structure`'s pattern and lower-triangle `values`.
+    ///
+    /// # Errors
+    /// [`ArapError::Factorization`] if it is not numerically positive definite or
+    /// memory runs out.
+    pub fn new(
+        structure: &Structure,
+        pattern: &LowerPattern,
+        values: &[T::Faer],
+    ) -> Result<Self, ArapError> {
+        let symbolic = &structure.symbolic;
+        let mut factor: Vec<T::Faer> = Vec::new();
+        factor
+            .try_reserve_exact(symbolic.len_val())
+            .map_err(|e| failed(&e))?;
+        factor.resize(symbolic.len_val(), T::Faer::zero_impl());
+        let par = Par::Seq;
+        let mut mem = MemBuffer::try_new(
+            symbolic.factorize_numeric_llt_scratch::<T::Faer>(par, Default::default()),
+        )
+        .map_err(|e| failed(&e))?;
+        symbolic
+            .factorize_numeric_llt::<T::Faer>(
+                &mut factor,
+                SparseColMatRef::new(pattern.symbolic(), values),
+                Side::Lower,
+                Default::default(),
+                par,
+                MemStack::new(&mut mem),
+                Default::default(),
+            )
+            .map_err(|e| failed(&e))?;
+        Ok(Self {
+            layout: Arc::clone(&structure.layout),
+            values: factor.into_iter().map(T::from_faer).collect(),
         })
     }
 
     /// Dimension of the matrix.
     pub fn n(&self) -> usize {
-        self.forward.len()
+        self.layout.forward.len()
     }
 
     /// Solves `A·x = b`: `b` in, `x` out; `work` is scratch of any content.
     pub fn solve_in_place(&self, b: &mut [DVec2], work: &mut Vec<DVec2>) {
+        let layout = &*self.layout;
         let n = self.n();
         work.clear();
-        work.extend(self.forward.iter().map(|&old| b[old as usize]));
-        let x = &mut work[..];
+        work.extend(layout.forward.iter().map(|&old| b[old as usize]));
+        // Room for one supernode's rows below its diagonal block.
+        work.resize(n + layout.widest, DVec2::ZERO);
+        let (x, tmp) = work.split_at_mut(n);
         let values = &self.values[..];
-        // L·y = Pᵀ·b, column by column.
-        for s in &self.supernodes {
+        // L·y = Pᵀ·b: per supernode, its diagonal block, then one update of the rows
+        // below it.
+        for s in &layout.supernodes {
             let (start, size, rows_len) = (s.start as usize, s.size as usize, s.rows_len as usize);
             let ld = size + rows_len;
-            let rows = &self.pattern[s.rows as usize..s.rows as usize + rows_len];
+            let block = &values[s.values..s.values + ld * size];
+            let rows = &layout.pattern[s.rows as usize..s.rows as usize + rows_len];
+            let tmp = &mut tmp[..rows_len];
+            tmp.fill(DVec2::ZERO);
+            let xs = &mut x[start..start + size];
             for c in 0..size {
-                let col = &values[s.values + c * ld..s.values + (c + 1) * ld];
-                let xc = T::div_diagonal(x[start + c], col[c]);
-                x[start + c] = xc;
-                for (r, &l) in col[c + 1..size].iter().enumerate() {
-                    x[start + c + 1 + r] -= l.mul(xc);
+                let col = &block[c * ld..(c + 1) * ld];
+                let xc = T::div_diagonal(xs[c], col[c]);
+                xs[c] = xc;
+                for (xr, &l) in xs[c + 1..].iter_mut().zip(&col[c + 1..size]) {
+                    *xr -= l.mul(xc);
                 }
-                for (&i, &l) in rows.iter().zip(&col[size..]) {
-                    x[i as usize] -= l.mul(xc);
+                for (t, &l) in tmp.iter_mut().zip(&col[size..]) {
+                    *t += l.mul(xc);
                 }
             }
+            for (&i, &t) in rows.iter().zip(tmp.iter()) {
+                x[i as usize] -= t;
+            }
         }
-        // Lᴴ·z = y, backwards.
-        for s in self.supernodes.iter().rev() {
+        // Lᴴ·z = y, backwards: the rows below each supernode gathered once.
+        for s in layout.supernodes.iter().rev() {
             let (start, size, rows_len) = (s.start as usize, s.size as usize, s.rows_len as usize);
             let ld = size + rows_len;
-            let rows = &self.pattern[s.rows as usize..s.rows as usize + rows_len];
+            let block = &values[s.values..s.values + ld * size];
+            let rows = &layout.pattern[s.rows as usize..s.rows as usize + rows_len];
+            let tmp = &mut tmp[..rows_len];
+            for (t, &i) in tmp.iter_mut().zip(rows) {
+                *t = x[i as usize];
+            }
+            let xs = &mut x[start..start + size];
             for c in (0..size).rev() {
-                let col = &values[s.values + c * ld..s.values + (c + 1) * ld];
-                let mut acc = x[start + c];
-                for (&i, &l) in rows.iter().zip(&col[size..]) {
-                    acc -= l.conj_mul(x[i as usize]);
+                let col = &block[c * ld..(c + 1) * ld];
+                let mut acc = xs[c];
+                for (&l, &t) in col[size..].iter().zip(tmp.iter()) {
+                    acc -= l.conj_mul(t);
                 }
-                for (r, &l) in col[c + 1..size].iter().enumerate() {
-                    acc -= l.conj_mul(x[start + c + 1 + r]);
+                for (&l, &xr) in col[c + 1..size].iter().zip(&xs[c + 1..]) {
+                    acc -= l.conj_mul(xr);
                 }
-                x[start + c] = T::div_diagonal(acc, col[c]);
+                xs[c] = T::div_diagonal(acc, col[c]);
             }
         }
         for (old, out) in b[..n].iter_mut().enumerate() {
-            *out = x[self.inverse[old] as usize];
+            *out = x[layout.inverse[old] as usize];
         }
     }
 }

@@ -1,7 +1,6 @@
 //! The mesh's connectivity, kept apart from its geometry: vertex adjacency (the
-//! sparsity pattern of both steps' matrices), the corners at each vertex, connected
-//! components, and the edge-connected pieces that decide where step one is
-//! determined.
+//! sparsity pattern of both steps' matrices), connected components, and the
+//! edge-connected pieces that decide where step one is determined.
 
 /// Compressed rows: row `r` is `items[ptr[r]..ptr[r + 1]]`.
 #[derive(Clone, Debug, Default)]
@@ -107,8 +106,6 @@ pub(crate) struct Topology {
     /// For each kept triangle (others: unused), the adjacency slot of each ordered
     /// pair of its corners: `slots[t][3 * a + b]` is where `(tri[a], tri[b])` lives.
     pub slots: Vec<[u32; 9]>,
-    /// For each vertex, the corners `3 * triangle + corner` of kept triangles at it.
-    pub corners: Rows<u32>,
     /// Connected component of each vertex (through kept triangles; a vertex in none is
     /// a component of its own).
     pub component: Vec<u32>,
@@ -170,6 +167,7 @@ impl Topology {
             }
         }
 
+        // The corners `3 * triangle + corner` of kept triangles at each vertex.
         let corners = Rows::from_pairs(
             vertices,
             kept_triangles().flat_map(|(t, tri)| (0..3).map(move |c| (tri[c], 3 * t + c as u32))),
@@ -232,7 +230,6 @@ impl Topology {
         Self {
             adjacency,
             slots,
-            corners,
             component,
             piece,
             piece_vertices,
@@ -270,6 +267,6 @@ mod tests {
         assert_eq!(t.piece[0], t.piece[1]);
         assert_eq!(t.piece[2], u32::MAX);
         assert_eq!(t.piece_vertices.row(t.piece[0] as usize), &[0, 1, 2, 3]);
-        assert_eq!(t.corners.row(5).len(), 0);
+        assert_eq!(t.vertex_pieces.row(5).len(), 0);
     }
 }

@@ -59,20 +59,32 @@ pub(crate) fn block_product(a: (f64, f64), b: (f64, f64)) -> (f64, f64) {
     (a.0 * b.0 + a.1 * b.1, a.0 * b.1 - a.1 * b.0)
 }
 
-/// Step two's fitting (§4.2.1) folded into one 2×6 matrix `M`: for the step-one
-/// corners `v' = (v0'x, v0'y, v1'x, v1'y, v2'x, v2'y)`, `M·v'` is the complex factor
-/// `z` (as `(re, im)`) of the similarity that fits the rest triangle to them, i.e.
-/// the fitted edge `v1,fitted − v0,fitted` divided (as complex numbers) by the rest
-/// edge `v1 − v0`. Its rotation `z/|z|` is the fitted triangle scaled back to its rest
-/// size.
+/// Step two's fitting (§4.2.1) folded into two complex coefficients `(c1, c2)`: for
+/// step-one corners `v0', v1', v2'` (as complex numbers `x + i·y`),
+/// `z = c1·(v1' − v0') + c2·(v2' − v0')` is the complex factor of the similarity
+/// that fits the rest triangle to them — the fitted edge `v1,fitted − v0,fitted`
+/// divided by the rest edge `v1 − v0` — and `z/|z|` is the rotation of the fitted
+/// triangle scaled back to its rest size.
 ///
 /// Built as the paper does: with `v2,fitted` written through `v0,fitted` and
 /// `v1,fitted` by the local coordinates `(x01, y01)` of corner 2 (eq. 10), the fitting
 /// functional (eq. 9) is a quadratic in `w = (v0,fitted, v1,fitted)` whose minimiser
-/// solves `F·w = Bᵀ·v'` (eq. 11, with `C = −Bᵀ·v'`); `F` is inverted here, once.
+/// solves `F·w = Bᵀ·v'` (eq. 11, with `C = −Bᵀ·v'`); `F` is inverted here, once, and
+/// the map `v' ↦ z` (a 2×6 matrix) is formed. Its 2×2 blocks are `p·I + q·R90`, the
+/// real form of complex numbers, so it is three complex coefficients; fitting a
+/// translated triangle gives the translated fit, so they sum to zero and two are kept.
 /// `F = I + Σ AᵢᵀAᵢ ≥ I` is always invertible, so this returns `None` only when the
 /// rest edge `v0 → v1` has zero length (a degenerate triangle).
-pub(crate) fn fitting_matrix(p: [DVec2; 3]) -> Option<[[f64; 6]; 2]> {
+pub(crate) fn fitting_coefficients(p: [DVec2; 3]) -> Option<[DVec2; 2]> {
+    let m = fitting_matrix(p)?;
+    // Block k is [[p, q], [−q, p]] = p·I + q·R90, i.e. the complex number p − i·q.
+    let c = |k: usize| DVec2::new(m[0][2 * k], -m[0][2 * k + 1]);
+    Some([c(1), c(2)])
+}
+
+/// The 2×6 matrix `M` with `z = M·(v0'x, v0'y, v1'x, v1'y, v2'x, v2'y)` (see
+/// [`fitting_coefficients`]).
+fn fitting_matrix(p: [DVec2; 3]) -> Option<[[f64; 6]; 2]> {
     let e = p[1] - p[0];
     let len2 = e.length_squared();
     if len2.is_nan() || len2 <= 0.0 {
@@ -123,21 +135,16 @@ pub(crate) fn fitting_matrix(p: [DVec2; 3]) -> Option<[[f64; 6]; 2]> {
     Some(m)
 }
 
-/// The rotation of step two's fitted-and-rescaled triangle from `z = M·v'`: `z/|z|`,
-/// or no rotation when the step-one triangle collapsed to a point (`z = 0` up to
-/// rounding).
+/// The rotation of step two's fitted-and-rescaled triangle: `z/|z|` for
+/// `z = c1·(v1' − v0') + c2·(v2' − v0')`, or no rotation when the step-one triangle
+/// collapsed to a point (`z = 0` up to the rounding of the positions).
 #[inline]
-pub(crate) fn fitted_rotation(m: &[[f64; 6]; 2], v: [DVec2; 3]) -> DVec2 {
-    let c = [v[0].x, v[0].y, v[1].x, v[1].y, v[2].x, v[2].y];
-    let mut z = DVec2::ZERO;
-    let mut magnitude = 0.0;
-    for k in 0..6 {
-        z.x += m[0][k] * c[k];
-        z.y += m[1][k] * c[k];
-        magnitude += (m[0][k].abs() + m[1][k].abs()) * c[k].abs();
-    }
-    // Below rounding noise of the sum, the triangle has collapsed to a point.
-    if z.length() <= 1e-13 * magnitude {
+pub(crate) fn fitted_rotation(c: &[DVec2; 2], v: [DVec2; 3]) -> DVec2 {
+    let (d1, d2) = (v[1] - v[0], v[2] - v[0]);
+    let z = rotate(c[0], d1) + rotate(c[1], d2);
+    let l1 = |p: DVec2| p.x.abs() + p.y.abs();
+    let magnitude = (l1(c[0]) + l1(c[1])) * (l1(v[0]) + l1(v[1]) + l1(v[2]));
+    if l1(z) <= 1e-13 * magnitude {
         return DVec2::X;
     }
     z.try_normalize().unwrap_or(DVec2::X)
@@ -269,19 +276,23 @@ mod tests {
     }
 
     /// The paper's 4×4 fit equals the textbook closed form (Procrustes about the
-    /// centroids, `z = Σ conj(rᵢ − r̄)(vᵢ' − v̄') / Σ |rᵢ − r̄|²`).
+    /// centroids, `z = Σ conj(rᵢ − r̄)(vᵢ' − v̄') / Σ |rᵢ − r̄|²`), and its matrix is
+    /// complex-linear and blind to translation.
     #[test]
-    fn fitting_matrix_is_the_similarity_procrustes_fit() {
+    fn fitting_is_the_similarity_procrustes_fit() {
         for seed in 0..50 {
             let p = tri(seed);
             let q = tri(seed + 1000);
             let m = fitting_matrix(p).expect("non-degenerate");
-            let c = [q[0].x, q[0].y, q[1].x, q[1].y, q[2].x, q[2].y];
-            let mut z = DVec2::ZERO;
-            for k in 0..6 {
-                z.x += m[0][k] * c[k];
-                z.y += m[1][k] * c[k];
+            let mut sum = DVec2::ZERO;
+            for k in 0..3 {
+                assert!((m[1][2 * k] + m[0][2 * k + 1]).abs() < 1e-12);
+                assert!((m[1][2 * k + 1] - m[0][2 * k]).abs() < 1e-12);
+                sum += DVec2::new(m[0][2 * k], m[0][2 * k + 1]);
             }
+            assert!(sum.length() < 1e-12, "{sum}");
+            let c = fitting_coefficients(p).expect("non-degenerate");
+            let z = rotate(c[0], q[1] - q[0]) + rotate(c[1], q[2] - q[0]);
             let (pc, qc) = ((p[0] + p[1] + p[2]) / 3.0, (q[0] + q[1] + q[2]) / 3.0);
             let mut num = DVec2::ZERO;
             let mut den = 0.0;
@@ -295,6 +306,7 @@ mod tests {
                 (z - expect).length() < 1e-9 * (1.0 + expect.length()),
                 "{z} vs {expect}"
             );
+            assert!((fitted_rotation(&c, q) - expect.normalize()).length() < 1e-9);
         }
     }
 
@@ -307,13 +319,15 @@ mod tests {
         assert!(is_degenerate([a, a, a]));
         assert!(is_degenerate([a, b, DVec2::new(0.5, f64::NAN)]));
         assert!(!is_degenerate([a, b, DVec2::new(0.5, 1e-3)]));
-        assert!(fitting_matrix([a, a, b]).is_none());
+        assert!(fitting_coefficients([a, a, b]).is_none());
     }
 
     #[test]
     fn collapsed_triangle_keeps_its_orientation() {
-        let m = fitting_matrix(tri(3)).expect("non-degenerate");
+        let c = fitting_coefficients(tri(3)).expect("non-degenerate");
         let p = DVec2::new(4.0, 4.0);
-        assert_eq!(fitted_rotation(&m, [p, p, p]), DVec2::X);
+        assert_eq!(fitted_rotation(&c, [p, p, p]), DVec2::X);
+        let q = p + DVec2::splat(1e-17);
+        assert_eq!(fitted_rotation(&c, [p, q, p]), DVec2::X);
     }
 }

@@ -2,15 +2,11 @@
 //! fit, and one back-substitution (x and y together) for step two.
 
 use glam::DVec2;
-use rayon::prelude::*;
 
 use crate::compile::Compiled;
 use crate::error::ArapError;
 use crate::solver::Entry;
 use crate::triangle::{fitted_rotation, rotate};
-
-/// Below this many triangles the per-triangle pass runs on one thread.
-const PARALLEL_TRIANGLES: usize = 16_384;
 
 /// The result of one pose: vertex positions, indexed like the rest positions.
 ///
@@ -50,7 +46,7 @@ impl std::fmt::Debug for Deformation {
 struct Scratch {
     step_one: Vec<DVec2>,
     step_two: Vec<DVec2>,
-    rotations: Vec<DVec2>,
+    linear: Vec<DVec2>,
     work: Vec<DVec2>,
 }
 
@@ -131,44 +127,28 @@ impl Compiled {
             out.step_one[v as usize] = p;
         }
 
-        // Step two, fitting (eqs. 9–11): each rest triangle's rotation onto its
-        // step-one triangle, scaled back to rest size.
-        let rotations = &mut scratch.rotations;
-        rotations.resize(self.active.len(), DVec2::X);
+        // Step two: fit each rest triangle to its step-one triangle (eqs. 9–11),
+        // keep the rotation (the fit scaled back to rest size), and add the fitted
+        // edges to the linear term f of the final solve (eqs. 12–16) at each corner:
+        // corner c ends edge c−1 → c and starts edge c → c+1.
+        let b = &mut scratch.linear;
+        b.clear();
+        b.resize(mesh.rest.len(), DVec2::ZERO);
         let step_one = &out.step_one;
-        let fit = |(r, &t): (&mut DVec2, &u32)| {
-            let tri = mesh.triangles[t as usize];
-            *r = fitted_rotation(&mesh.fit[t as usize], tri.map(|v| step_one[v as usize]));
-        };
-        if self.active.len() >= PARALLEL_TRIANGLES {
-            rotations
-                .par_iter_mut()
-                .zip(self.active.par_iter())
-                .with_min_len(1024)
-                .for_each(fit);
-        } else {
-            rotations.iter_mut().zip(self.active.iter()).for_each(fit);
+        for t in &self.triangles {
+            let [i, j, k] = t.vertices.map(|v| v as usize);
+            let rotation = fitted_rotation(&t.fit, [step_one[i], step_one[j], step_one[k]]);
+            let e01 = rotate(rotation, t.edges[0]);
+            let e12 = rotate(rotation, t.edges[1]);
+            let e20 = -(e01 + e12);
+            b[i] += e20 - e01;
+            b[j] += e01 - e12;
+            b[k] += e12 - e20;
         }
-
-        // Step two, final solve (eq. 16): H'u = −Dq − f_u, x and y together.
+        // Final solve (eq. 16): H'u = f_u − Dq, x and y together.
         let r2 = &mut scratch.step_two;
-        r2.resize(self.free.len(), DVec2::ZERO);
-        let rotations = &*rotations;
-        let gather = |(i, b): (usize, &mut DVec2)| {
-            let mut sum = DVec2::ZERO;
-            for &(t, d) in self.gather.row(i) {
-                sum += rotate(rotations[t as usize], d);
-            }
-            *b = sum;
-        };
-        if self.active.len() >= PARALLEL_TRIANGLES {
-            r2.par_iter_mut()
-                .enumerate()
-                .with_min_len(1024)
-                .for_each(gather);
-        } else {
-            r2.iter_mut().enumerate().for_each(gather);
-        }
+        r2.clear();
+        r2.extend(self.free.iter().map(|&v| b[v as usize]));
         for c in &self.couplings {
             r2[c.free as usize] -= c.h * targets[c.constraint as usize];
         }
