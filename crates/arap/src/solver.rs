@@ -166,6 +166,11 @@ fn failed(e: &dyn std::fmt::Debug) -> ArapError {
 }
 
 impl Structure {
+    /// The ordering the factors use: `(forward, inverse)` with `forward[new] = old`.
+    pub fn ordering(&self) -> (&[u32], &[u32]) {
+        (&self.layout.forward, &self.layout.inverse)
+    }
+
     /// The symbolic factorisation of `pattern` under `ordering` (supernodal).
     pub fn new(pattern: &LowerPattern, ordering: &Ordering) -> Result<Self, ArapError> {
         let perm = PermRef::new_checked(&ordering.forward, &ordering.inverse, pattern.n);
@@ -228,7 +233,8 @@ impl Structure {
     }
 }
 
-/// `A = P·L·Lᴴ·Pᵀ` for a symmetric (Hermitian) positive definite `A`.
+/// `P·A·Pᵀ = L·Lᴴ` for a symmetric (Hermitian) positive definite `A`; it solves in
+/// the permuted order ([`Structure::ordering`]).
 pub(crate) struct Cholesky<T> {
     layout: Arc<Layout>,
     values: Vec<T>,
@@ -273,20 +279,24 @@ impl<T: Entry> Cholesky<T> {
         })
     }
 
+    /// Number of stored entries of the factor.
+    pub fn len(&self) -> usize {
+        self.values.len()
+    }
+
     /// Dimension of the matrix.
     pub fn n(&self) -> usize {
         self.layout.forward.len()
     }
 
-    /// Solves `A·x = b`: `b` in, `x` out; `work` is scratch of any content.
-    pub fn solve_in_place(&self, b: &mut [DVec2], work: &mut Vec<DVec2>) {
+    /// Solves `L·Lᴴ·x = b` (unknowns in the factor's order): `b` in, `x` out;
+    /// `work` is scratch of any content.
+    pub fn solve_in_place(&self, x: &mut [DVec2], work: &mut Vec<DVec2>) {
         let layout = &*self.layout;
-        let n = self.n();
-        work.clear();
-        work.extend(layout.forward.iter().map(|&old| b[old as usize]));
+        debug_assert_eq!(x.len(), self.n());
         // Room for one supernode's rows below its diagonal block.
-        work.resize(n + layout.widest, DVec2::ZERO);
-        let (x, tmp) = work.split_at_mut(n);
+        work.resize(layout.widest, DVec2::ZERO);
+        let tmp = &mut work[..];
         let values = &self.values[..];
         // L·y = Pᵀ·b: per supernode, its diagonal block, then one update of the rows
         // below it.
@@ -335,9 +345,6 @@ impl<T: Entry> Cholesky<T> {
                 }
                 xs[c] = T::div_diagonal(acc, col[c]);
             }
-        }
-        for (old, out) in b[..n].iter_mut().enumerate() {
-            *out = x[layout.inverse[old] as usize];
         }
     }
 }

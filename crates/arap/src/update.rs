@@ -3,7 +3,7 @@
 
 use glam::DVec2;
 
-use crate::compile::Compiled;
+use crate::compile::{Compiled, StepOne};
 use crate::error::ArapError;
 use crate::solver::Entry;
 use crate::triangle::{fitted_rotation, rotate};
@@ -117,14 +117,28 @@ impl Compiled {
         let scratch = &mut out.scratch;
 
         // Step one (eq. 8): G'u = −Bq (+ the rest pull on loose pieces).
-        let r1 = &mut scratch.step_one;
-        r1.clone_from(&self.step_one_rhs);
-        for c in &self.couplings {
-            r1[c.free as usize] -= c.g.mul(targets[c.constraint as usize]);
-        }
-        one.solve_in_place(r1, &mut scratch.work);
-        for (&v, &p) in self.free.iter().zip(r1.iter()) {
-            out.step_one[v as usize] = p;
+        match one {
+            StepOne::Substitution(factor) => {
+                let r1 = &mut scratch.step_one;
+                r1.clone_from(&self.step_one_rhs);
+                for c in &self.couplings {
+                    r1[c.free as usize] -= c.g.mul(targets[c.constraint as usize]);
+                }
+                factor.solve_in_place(r1, &mut scratch.work);
+                for (&v, &p) in self.free.iter().zip(r1.iter()) {
+                    out.step_one[v as usize] = p;
+                }
+            }
+            StepOne::Product { base, columns } => {
+                let k = targets.len();
+                for ((&v, &u0), row) in self.free.iter().zip(base).zip(columns.chunks_exact(k)) {
+                    let mut u = u0;
+                    for (c, &q) in row.iter().zip(targets) {
+                        u += c.mul(q);
+                    }
+                    out.step_one[v as usize] = u;
+                }
+            }
         }
 
         // Step two: fit each rest triangle to its step-one triangle (eqs. 9–11),
