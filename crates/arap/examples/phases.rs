@@ -1,10 +1,9 @@
 //! Times the three phases on a cut-out mesh (as the benchmarks build it) and prints
 //! one line each: `cargo run --release -p arap --example phases [VERTICES]`.
 //!
-//! Besides wall time it prints this thread's time on a CPU (from
-//! `/proc/thread-self/schedstat`, Linux only), which a busy machine disturbs less.
-//! Work done on rayon's other threads (the per-triangle pass above 16k triangles, the
-//! numeric factorisation above 20k unknowns) is not in that figure.
+//! Besides wall time it prints the process's time on a CPU, all threads together
+//! (from `/proc/self/task/*/schedstat`, Linux only), which a busy machine disturbs
+//! less than wall time.
 
 #[path = "../tests/support/mod.rs"]
 mod support;
@@ -13,12 +12,21 @@ use std::time::Instant;
 
 use arap::{ArapError, Deformation, Registration};
 
-/// This thread's time on a CPU, in nanoseconds (0 where the kernel does not say).
+/// This process's time on a CPU over all its threads, in nanoseconds (0 where the
+/// kernel does not say).
 fn cpu_ns() -> u64 {
-    std::fs::read_to_string("/proc/thread-self/schedstat")
-        .ok()
-        .and_then(|s| s.split_whitespace().next().and_then(|t| t.parse().ok()))
-        .unwrap_or(0)
+    let Ok(tasks) = std::fs::read_dir("/proc/self/task") else {
+        return 0;
+    };
+    tasks
+        .flatten()
+        .filter_map(|task| std::fs::read_to_string(task.path().join("schedstat")).ok())
+        .filter_map(|s| {
+            s.split_whitespace()
+                .next()
+                .and_then(|t| t.parse::<u64>().ok())
+        })
+        .sum()
 }
 
 /// Runs `f`, returning its result with wall and CPU milliseconds.

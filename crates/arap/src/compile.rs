@@ -9,20 +9,19 @@ use glam::DVec2;
 
 use crate::error::ArapError;
 use crate::registration::{Mesh, Registration};
-use crate::solver::{Cholesky, Complex, LowerPattern, Ordering, Structure};
-use crate::triangle::{block_product, corner_error_coefficients};
+use crate::solver::{Cholesky, Complex, LowerPattern, Structure};
 
 /// A system compiled for one set of constrained vertices (handles) and rigidity
 /// weights: the paper's "compilation" (§4.3 step 2), a function from the handles'
 /// positions to the deformed mesh. Build it with [`Registration::compile`]; pose it
-/// with [`Compiled::update`] or [`Compiled::update_into`], which only
-/// back-substitute.
+/// with [`Compiled::update`] or [`Compiled::update_into`], which factorise nothing.
 ///
 /// It is `Send + Sync` and shares the registration's data.
 pub struct Compiled {
     pub(crate) mesh: Arc<Mesh>,
     pub(crate) constrained: Vec<u32>,
-    /// Free vertices in the factors' order: free unknown `i` is vertex `free[i]`.
+    /// Free vertices in the registration's fill-reducing order, which the factors
+    /// keep: free unknown `i` is vertex `free[i]`.
     pub(crate) free: Vec<u32>,
     /// The constant part of step one's right-hand side (non-zero only where step
     /// one's similarity is not pinned down, see [`Compiled::loose_triangles`]).
@@ -114,8 +113,13 @@ impl Registration {
     ///   translation. Everywhere else the systems are exactly the paper's.
     ///   [`Compiled::loose_triangles`] lists them.
     ///
-    /// Nothing here depends on the targets; [`Compiled::update`] only
-    /// back-substitutes.
+    /// Both systems are factorised here (faer's supernodal sparse Cholesky, one
+    /// approximate-minimum-degree ordering for both). When the constrained vertices
+    /// are few next to the mesh, step one is also solved for each of them, as the
+    /// paper does (§4.3, 2-1: `G'⁻¹B`), so that a pose's step one is one product
+    /// (3-1); otherwise a pose back-substitutes with `G'`'s factor. Either way a pose
+    /// ([`Compiled::update`]) factorises nothing and back-substitutes once for step
+    /// two, x and y together.
     ///
     /// # Errors
     /// [`ArapError::VertexOutOfRange`] for an index past the last vertex,
@@ -186,12 +190,14 @@ impl Registration {
 
         let pinned = pinned_pieces(mesh, constrained);
 
-        // Free unknowns: vertices of reached components that are not constrained.
-        // (A reached vertex in no kept triangle is a component of its own, reached
-        // only through its own constraint.)
+        // Free unknowns: vertices of reached components that are not constrained,
+        // numbered in the registration's fill-reducing order. (A reached vertex in
+        // no kept triangle is a component of its own, reached only through its own
+        // constraint.)
         let mut free_index = vec![u32::MAX; n];
         let mut free: Vec<u32> = Vec::new();
-        for v in 0..n {
+        for &v in &mesh.order {
+            let v = v as usize;
             if constraint_of[v] == u32::MAX && reached[topo.component[v] as usize] {
                 free_index[v] = free.len() as u32;
                 free.push(v as u32);
@@ -213,37 +219,31 @@ impl Registration {
             active.push(t as u32);
             let w = weight(t);
             let s = &topo.slots[t];
-            // Step one (eqs. 3–5): each corner predicted from the other two.
-            for c in 0..3 {
-                let coef = corner_error_coefficients(mesh.local[t][c]);
-                for k1 in 0..3 {
-                    for k2 in 0..3 {
-                        let (p, q) = block_product(coef[k1], coef[k2]);
-                        let slot = s[3 * ((c + k1) % 3) + (c + k2) % 3] as usize;
-                        g[slot].0 += w * p;
-                        g[slot].1 += w * q;
-                    }
-                }
-            }
-            // Step two (eqs. 12, 13): each directed edge i → j.
             let is_loose = !pinned[topo.piece[t] as usize];
             if is_loose {
                 loose.push(t as u32);
             }
-            for i in 0..3 {
-                let j = (i + 1) % 3;
-                for (slot, sign) in [
-                    (3 * i + i, 1.0),
-                    (3 * j + j, 1.0),
-                    (3 * i + j, -1.0),
-                    (3 * j + i, -1.0),
-                ] {
-                    h[s[slot] as usize] += sign * w;
-                    if is_loose {
-                        g[s[slot] as usize].0 += sign * w;
-                    }
-                }
-                if is_loose {
+            // Step one (eq. 5): the triangle's error matrix; on a loose piece also
+            // the rest edges. Step two (eq. 13): each edge once from this side, so
+            // 2 on the diagonal and −1 off it.
+            let e = &mesh.step_one[t];
+            let extra = if is_loose { w } else { 0.0 };
+            for a in 0..3 {
+                g[s[4 * a] as usize].0 += w * e[a] + 2.0 * extra;
+                h[s[4 * a] as usize] += 2.0 * w;
+            }
+            for (a, b, p, q) in [(0, 1, e[3], e[4]), (1, 2, e[5], e[6]), (0, 2, e[7], e[8])] {
+                let (ab, ba) = (s[3 * a + b] as usize, s[3 * b + a] as usize);
+                g[ab].0 += w * p - extra;
+                g[ab].1 += w * q;
+                g[ba].0 += w * p - extra;
+                g[ba].1 -= w * q;
+                h[ab] -= w;
+                h[ba] -= w;
+            }
+            if is_loose {
+                for i in 0..3 {
+                    let j = (i + 1) % 3;
                     let e = mesh.rest[tri[j] as usize] - mesh.rest[tri[i] as usize];
                     rest_pull[tri[i] as usize] -= w * e;
                     rest_pull[tri[j] as usize] += w * e;
@@ -255,57 +255,84 @@ impl Registration {
         // stored as the Hermitian matrix whose real form it is (see solver.rs): its
         // block p·I + q·R90 at (a, b) is p − i·q, and the entry below the diagonal,
         // at (b, a), is the conjugate p + i·q.
-        let mut col_ptr = Vec::with_capacity(m + 1);
-        let mut row_idx = Vec::new();
-        let mut h_values = Vec::new();
-        let mut g_values = Vec::new();
-        col_ptr.push(0u32);
+        // Vertices are visited in mesh order (neighbours near in memory), each
+        // free one filling its column; the columns are sorted by row afterwards.
+        let mut col_ptr = vec![0u32; m + 1];
         let mut couplings = Vec::new();
-        for (fa, &a) in free.iter().enumerate() {
-            let start = topo.adjacency.ptr[a as usize] as usize;
-            for (k, &b) in topo.adjacency.row(a as usize).iter().enumerate() {
-                let slot = start + k;
-                let (p, q) = g[slot];
+        for (a, &fa) in free_index.iter().enumerate() {
+            if fa == u32::MAX {
+                continue;
+            }
+            let start = topo.adjacency.ptr[a] as usize;
+            for (k, &b) in topo.adjacency.row(a).iter().enumerate() {
                 let fb = free_index[b as usize];
                 if fb != u32::MAX {
-                    if fb as usize >= fa {
-                        row_idx.push(fb);
-                        h_values.push(h[slot]);
-                        g_values.push(c64::new(p, q));
+                    if fb >= fa {
+                        col_ptr[fa as usize + 1] += 1;
                     }
                 } else if constraint_of[b as usize] != u32::MAX {
+                    let (p, q) = g[start + k];
                     couplings.push(Coupling {
-                        free: fa as u32,
+                        free: fa,
                         constraint: constraint_of[b as usize],
                         g: Complex(DVec2::new(p, -q)),
-                        h: h[slot],
+                        h: h[start + k],
                     });
                 }
             }
-            col_ptr.push(row_idx.len() as u32);
+        }
+        for i in 0..m {
+            col_ptr[i + 1] += col_ptr[i];
+        }
+        let entries = col_ptr[m] as usize;
+        let mut row_idx = vec![0u32; entries];
+        let mut h_values = vec![0.0; entries];
+        let mut g_values = vec![c64::new(0.0, 0.0); entries];
+        let mut next = col_ptr.clone();
+        for (a, &fa) in free_index.iter().enumerate() {
+            if fa == u32::MAX {
+                continue;
+            }
+            let start = topo.adjacency.ptr[a] as usize;
+            for (k, &b) in topo.adjacency.row(a).iter().enumerate() {
+                let fb = free_index[b as usize];
+                if fb != u32::MAX && fb >= fa {
+                    let at = next[fa as usize] as usize;
+                    next[fa as usize] += 1;
+                    let (p, q) = g[start + k];
+                    row_idx[at] = fb;
+                    h_values[at] = h[start + k];
+                    g_values[at] = c64::new(p, q);
+                }
+            }
+        }
+        for c in 0..m {
+            // Insertion sort: a column holds a handful of entries.
+            let (lo, hi) = (col_ptr[c] as usize, col_ptr[c + 1] as usize);
+            for i in lo + 1..hi {
+                let mut j = i;
+                while j > lo && row_idx[j - 1] > row_idx[j] {
+                    row_idx.swap(j - 1, j);
+                    h_values.swap(j - 1, j);
+                    g_values.swap(j - 1, j);
+                    j -= 1;
+                }
+            }
         }
 
         let (step_one, step_two) = if m == 0 {
             (None, None)
         } else {
-            // Factors work in their own (fill-reducing) order; renumber the free
-            // unknowns to it so that a pose needs no permuting.
             let pattern = LowerPattern {
                 n: m,
                 col_ptr,
                 row_idx,
             };
-            let ordering = Ordering::amd(&pattern)?;
-            let structure = Structure::new(&pattern, &ordering)?;
+            let structure = Structure::new(&pattern)?;
             let (one, two) = rayon::join(
                 || Cholesky::<Complex>::new(&structure, &pattern, &g_values),
                 || Cholesky::<f64>::new(&structure, &pattern, &h_values),
             );
-            let (forward, inverse) = structure.ordering();
-            free = forward.iter().map(|&old| free[old as usize]).collect();
-            for c in &mut couplings {
-                c.free = inverse[c.free as usize];
-            }
             (Some(one?), Some(two?))
         };
 

@@ -14,10 +14,11 @@
 //!    step one's system (`2m` unknowns, x and y interleaved) and step two's (`m`
 //!    unknowns, the same matrix for x and y), and factorise both with faer's sparse
 //!    Cholesky under one fill-reducing ordering.
-//! 3. **Update** ([`Compiled::update`], every drag): one back-substitution for step
-//!    one, a per-triangle pass fitting each rest triangle to its step-one triangle by
-//!    rotation (scale removed), and one back-substitution with two right-hand sides
-//!    for step two. Nothing is factorised.
+//! 3. **Update** ([`Compiled::update`], every drag): step one by one
+//!    back-substitution (or, with few handles, by the product with `G'⁻¹B` formed at
+//!    compilation, as the paper does), a per-triangle pass fitting each rest triangle
+//!    to its step-one triangle by rotation (scale removed), and one back-substitution
+//!    with two right-hand sides (x and y) for step two. Nothing is factorised.
 //!
 //! The error terms are the paper's, without area normalisation: step one sums, over
 //! every triangle, the squared distance of each of its three corners from where the

@@ -5,14 +5,15 @@ use std::sync::Arc;
 use glam::DVec2;
 
 use crate::error::ArapError;
+use crate::solver::{LowerPattern, amd_order};
 use crate::topology::Topology;
-use crate::triangle::{fitting_coefficients, is_degenerate, local_coordinates};
+use crate::triangle::{fitting_coefficients, is_degenerate, step_one_matrix};
 
 /// The rest mesh with what the paper computes once per rest shape ("registration",
-/// §4.3 step 1): each triangle's local coordinates `(x, y)` of every corner in the
-/// frame of the opposite edge — the rows of step one's error matrix `G` (eq. 5) and
-/// of `H` (eq. 13) — and each triangle's fitting matrix `F` of step two (eq. 11),
-/// inverted.
+/// §4.3 step 1): each triangle's share of step one's error matrix `G` (eq. 5), from
+/// the local coordinates `(x, y)` of every corner in the frame of the opposite edge,
+/// and each triangle's fitting matrix `F` of step two (eq. 11), inverted; also a
+/// fill-reducing order of the vertices for the factorisations.
 ///
 /// Positions are in any consistent unit (image pixels in C2Warp); nothing depends on
 /// where the origin is.
@@ -47,15 +48,40 @@ pub(crate) struct Mesh {
     /// Whether each triangle takes part (is not degenerate).
     pub kept: Vec<bool>,
     pub skipped: Vec<u32>,
-    /// Local coordinates of corner `c` in the frame `tri[c + 1] → tri[c + 2]`.
-    pub local: Vec<[DVec2; 3]>,
+    /// Step one's error matrix of each triangle, see
+    /// [`crate::triangle::step_one_matrix`].
+    pub step_one: Vec<[f64; 9]>,
     /// Step two's fitting (`F⁻¹` folded with `C`'s map) as two complex
     /// coefficients, see [`crate::triangle::fitting_coefficients`].
     pub fit: Vec<[DVec2; 2]>,
     pub topology: Topology,
+    /// A fill-reducing order of all vertices (approximate minimum degree on the
+    /// mesh graph): compilation numbers the free vertices in this order.
+    pub order: Vec<u32>,
     /// Two rest positions closer than this count as one point when deciding whether
     /// step one's similarity is pinned down.
     pub tolerance: f64,
+}
+
+/// Approximate minimum degree on the whole mesh graph. A compiled system's free
+/// vertices are a subset, numbered in this order: removing the constrained vertices
+/// (and any component left at rest) from a graph keeps this a good order for what
+/// remains, and one ordering per mesh spares every compilation its own.
+fn vertex_order(topology: &Topology) -> Result<Vec<u32>, ArapError> {
+    let adjacency = &topology.adjacency;
+    let n = adjacency.len();
+    let mut col_ptr = Vec::with_capacity(n + 1);
+    let mut row_idx = Vec::new();
+    col_ptr.push(0);
+    for v in 0..n {
+        row_idx.extend(adjacency.row(v).iter().filter(|&&u| u as usize >= v));
+        col_ptr.push(row_idx.len() as u32);
+    }
+    amd_order(&LowerPattern {
+        n,
+        col_ptr,
+        row_idx,
+    })
 }
 
 impl Registration {
@@ -86,7 +112,7 @@ impl Registration {
         }
         let corners = |tri: &[u32; 3]| tri.map(|v| rest[v as usize]);
         let mut kept = Vec::with_capacity(triangles.len());
-        let mut local = Vec::with_capacity(triangles.len());
+        let mut step_one = Vec::with_capacity(triangles.len());
         let mut fit = Vec::with_capacity(triangles.len());
         let mut skipped = Vec::new();
         for (t, tri) in triangles.iter().enumerate() {
@@ -99,20 +125,19 @@ impl Registration {
             match matrix {
                 Some(m) => {
                     kept.push(true);
-                    local.push(
-                        [0, 1, 2].map(|c| local_coordinates(p[c], p[(c + 1) % 3], p[(c + 2) % 3])),
-                    );
+                    step_one.push(step_one_matrix(p));
                     fit.push(m);
                 }
                 None => {
                     kept.push(false);
                     skipped.push(t as u32);
-                    local.push([DVec2::ZERO; 3]);
+                    step_one.push([0.0; 9]);
                     fit.push([DVec2::ZERO; 2]);
                 }
             }
         }
         let topology = Topology::new(rest.len(), triangles, &kept);
+        let order = vertex_order(&topology)?;
         let (lo, hi) = rest.iter().fold(
             (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
             |(lo, hi), &p| (lo.min(p), hi.max(p)),
@@ -128,7 +153,8 @@ impl Registration {
                 triangles: triangles.to_vec(),
                 kept,
                 skipped,
-                local,
+                step_one,
+                order,
                 fit,
                 topology,
                 tolerance: 1e-9 * diagonal,

@@ -47,31 +47,24 @@ impl LowerPattern {
 /// factorisation, done once, gains little from larger blocks on meshes.
 const RELAX: &[(usize, f64)] = &[(4, 0.3), (16, 0.1), (usize::MAX, 0.02)];
 
-/// A fill-reducing ordering: `forward[new] = old`, `inverse[old] = new`.
-pub(crate) struct Ordering {
-    pub forward: Vec<u32>,
-    pub inverse: Vec<u32>,
-}
-
-impl Ordering {
-    /// Approximate minimum degree on the pattern of `a`.
-    pub fn amd(a: &LowerPattern) -> Result<Self, ArapError> {
-        let n = a.n;
-        let mut forward = vec![0u32; n];
-        let mut inverse = vec![0u32; n];
-        let nnz = a.row_idx.len();
-        let mut mem = MemBuffer::try_new(amd::order_maybe_unsorted_scratch::<u32>(n, nnz))
-            .map_err(|_| ArapError::Factorization("out of memory".into()))?;
-        amd::order_maybe_unsorted(
-            &mut forward,
-            &mut inverse,
-            a.symbolic(),
-            amd::Control::default(),
-            MemStack::new(&mut mem),
-        )
-        .map_err(|e| ArapError::Factorization(format!("{e:?}")))?;
-        Ok(Self { forward, inverse })
-    }
+/// A fill-reducing order (approximate minimum degree) of the unknowns of a matrix
+/// with the pattern `a`: `order[new] = old`.
+pub(crate) fn amd_order(a: &LowerPattern) -> Result<Vec<u32>, ArapError> {
+    let n = a.n;
+    let mut forward = vec![0u32; n];
+    let mut inverse = vec![0u32; n];
+    let nnz = a.row_idx.len();
+    let mut mem = MemBuffer::try_new(amd::order_maybe_unsorted_scratch::<u32>(n, nnz))
+        .map_err(|_| ArapError::Factorization("out of memory".into()))?;
+    amd::order_maybe_unsorted(
+        &mut forward,
+        &mut inverse,
+        a.symbolic(),
+        amd::Control::default(),
+        MemStack::new(&mut mem),
+    )
+    .map_err(|e| failed(&e))?;
+    Ok(forward)
 }
 
 /// An entry of a Cholesky factor acting on a `DVec2` unknown: a real number scaling
@@ -151,10 +144,9 @@ pub(crate) struct Structure {
     layout: Arc<Layout>,
 }
 
-/// The factor's layout: the ordering and the supernodes.
+/// The factor's layout: its supernodes.
 struct Layout {
-    forward: Vec<u32>,
-    inverse: Vec<u32>,
+    n: usize,
     supernodes: Vec<Supernode>,
     pattern: Vec<u32>,
     /// The most rows below any supernode's diagonal block.
@@ -166,18 +158,16 @@ fn failed(e: &dyn std::fmt::Debug) -> ArapError {
 }
 
 impl Structure {
-    /// The ordering the factors use: `(forward, inverse)` with `forward[new] = old`.
-    pub fn ordering(&self) -> (&[u32], &[u32]) {
-        (&self.layout.forward, &self.layout.inverse)
-    }
-
-    /// The symbolic factorisation of `pattern` under `ordering` (supernodal).
-    pub fn new(pattern: &LowerPattern, ordering: &Ordering) -> Result<Self, ArapError> {
-        let perm = PermRef::new_checked(&ordering.forward, &ordering.inverse, pattern.n);
+    /// The symbolic factorisation of `pattern` (supernodal), unknowns in the order
+    /// given: they come numbered by a fill-reducing order already.
+    pub fn new(pattern: &LowerPattern) -> Result<Self, ArapError> {
+        // The identity as a custom ordering: faer 0.24's `SymmetricOrdering::Identity`
+        // reads a lower triangle as if it were the upper one.
+        let identity: Vec<u32> = (0..pattern.n as u32).collect();
         let symbolic = factorize_symbolic_cholesky(
             pattern.symbolic(),
             Side::Lower,
-            SymmetricOrdering::Custom(perm),
+            SymmetricOrdering::Custom(PermRef::new_checked(&identity, &identity, pattern.n)),
             CholeskySymbolicParams {
                 supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
                 supernodal_params: SymbolicSupernodalParams { relax: Some(RELAX) },
@@ -189,16 +179,6 @@ impl Structure {
             return Err(ArapError::Factorization(
                 "expected a supernodal factor".into(),
             ));
-        };
-        let (forward, inverse) = match symbolic.perm() {
-            Some(p) => {
-                let (f, i) = p.arrays();
-                (f.to_vec(), i.to_vec())
-            }
-            None => (
-                (0..pattern.n as u32).collect(),
-                (0..pattern.n as u32).collect(),
-            ),
         };
         let mut supernodes = Vec::with_capacity(sn.n_supernodes());
         let mut rows = Vec::new();
@@ -223,8 +203,7 @@ impl Structure {
         Ok(Self {
             symbolic,
             layout: Arc::new(Layout {
-                forward,
-                inverse,
+                n: pattern.n,
                 supernodes,
                 pattern: rows,
                 widest,
@@ -233,8 +212,8 @@ impl Structure {
     }
 }
 
-/// `P·A·Pᵀ = L·Lᴴ` for a symmetric (Hermitian) positive definite `A`; it solves in
-/// the permuted order ([`Structure::ordering`]).
+/// `A = L·Lᴴ` for a symmetric (Hermitian) positive definite `A` whose unknowns come
+/// in a fill-reducing order.
 pub(crate) struct Cholesky<T> {
     layout: Arc<Layout>,
     values: Vec<T>,
@@ -286,11 +265,10 @@ impl<T: Entry> Cholesky<T> {
 
     /// Dimension of the matrix.
     pub fn n(&self) -> usize {
-        self.layout.forward.len()
+        self.layout.n
     }
 
-    /// Solves `L·Lᴴ·x = b` (unknowns in the factor's order): `b` in, `x` out;
-    /// `work` is scratch of any content.
+    /// Solves `L·Lᴴ·x = b`: `b` in, `x` out; `work` is scratch of any content.
     pub fn solve_in_place(&self, x: &mut [DVec2], work: &mut Vec<DVec2>) {
         let layout = &*self.layout;
         debug_assert_eq!(x.len(), self.n());

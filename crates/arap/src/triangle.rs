@@ -50,6 +50,39 @@ pub(crate) fn corner_error_coefficients(local: DVec2) -> [(f64, f64); 3] {
     [(1.0, 0.0), (-(1.0 - x), y), (-x, -y)]
 }
 
+/// Step one's error matrix of one triangle (eq. 5 restricted to it): the sum over
+/// its three corners of `AᵀA`, `A` the 2×6 map from the triangle's corners to that
+/// corner's error (eqs. 2, 3). Its 3×3 blocks are `p·I + q·R90`; returned are the
+/// diagonal ones' `p` (their `q` is zero) and the blocks `(0, 1)`, `(1, 2)`, `(0, 2)`
+/// as `(p, q)`, the ones below the diagonal being their transposes `p·I − q·R90`:
+/// `[p00, p11, p22, p01, q01, p12, q12, p02, q02]`.
+pub(crate) fn step_one_matrix(p: [DVec2; 3]) -> [f64; 9] {
+    let mut blocks = [[(0.0, 0.0); 3]; 3];
+    for c in 0..3 {
+        let local = local_coordinates(p[c], p[(c + 1) % 3], p[(c + 2) % 3]);
+        let coef = corner_error_coefficients(local);
+        for k1 in 0..3 {
+            for k2 in 0..3 {
+                let (bp, bq) = block_product(coef[k1], coef[k2]);
+                let b = &mut blocks[(c + k1) % 3][(c + k2) % 3];
+                b.0 += bp;
+                b.1 += bq;
+            }
+        }
+    }
+    [
+        blocks[0][0].0,
+        blocks[1][1].0,
+        blocks[2][2].0,
+        blocks[0][1].0,
+        blocks[0][1].1,
+        blocks[1][2].0,
+        blocks[1][2].1,
+        blocks[0][2].0,
+        blocks[0][2].1,
+    ]
+}
+
 /// The block `A_aᵀ·A_b` for blocks `A_a = α_a·I + β_a·R90`, returned as `(p, q)`
 /// meaning `p·I + q·R90`.
 #[inline]
@@ -253,6 +286,51 @@ mod tests {
                 r += al * v + be * r90(v);
             }
             assert!(r.length() < 1e-12, "{r}");
+        }
+    }
+
+    /// The triangle's error matrix vanishes on similarities of the rest triangle and
+    /// is symmetric positive semidefinite.
+    #[test]
+    fn step_one_matrix_vanishes_on_similarities() {
+        for seed in 0..20 {
+            let p = tri(seed);
+            let m = step_one_matrix(p);
+            let block = |a: usize, b: usize| -> (f64, f64) {
+                match (a, b) {
+                    (0, 0) => (m[0], 0.0),
+                    (1, 1) => (m[1], 0.0),
+                    (2, 2) => (m[2], 0.0),
+                    (0, 1) => (m[3], m[4]),
+                    (1, 2) => (m[5], m[6]),
+                    (0, 2) => (m[7], m[8]),
+                    (a, b) => {
+                        let (p, q) = block_at(&m, b, a);
+                        (p, -q)
+                    }
+                }
+            };
+            fn block_at(m: &[f64; 9], a: usize, b: usize) -> (f64, f64) {
+                match (a, b) {
+                    (0, 1) => (m[3], m[4]),
+                    (1, 2) => (m[5], m[6]),
+                    _ => (m[7], m[8]),
+                }
+            }
+            let energy = |v: [DVec2; 3]| {
+                let mut e = 0.0;
+                for a in 0..3 {
+                    for b in 0..3 {
+                        let (bp, bq) = block(a, b);
+                        e += v[a].dot(bp * v[b] + bq * r90(v[b]));
+                    }
+                }
+                e
+            };
+            let z = DVec2::new(0.8, 0.6) * 1.7;
+            let t = DVec2::new(-3.0, 2.0);
+            assert!(energy(p.map(|v| rotate(z, v) + t)).abs() < 1e-9);
+            assert!(energy(tri(seed + 99)) > 0.0);
         }
     }
 
