@@ -381,3 +381,37 @@ fn bad_input_is_refused() {
     .to_string();
     assert!(message.contains("constrained twice"), "{message}");
 }
+
+/// Handles on two vertices that share one rest position (the two lips of a slit):
+/// step one's similarity is not pinned down by them, so the shape follows by its
+/// rest edges, and the slit opens.
+#[test]
+fn handles_sharing_one_rest_position() {
+    let mut mesh = grid(4, 2, 1.0, 0.0, Diagonals::Alternating, 0);
+    // Cut the edge (2, 0)–(2, 1): the cell right of it gets its own copy of (2, 0).
+    let lip = mesh.rest.len() as u32;
+    mesh.rest.push(mesh.rest[2]);
+    for t in &mut mesh.triangles[4..6] {
+        for v in t.iter_mut() {
+            if *v == 2 {
+                *v = lip;
+            }
+        }
+    }
+    let registration = Registration::new(&mesh.rest, &mesh.triangles).expect("valid");
+    let compiled = registration.compile(&[2, lip], None).expect("compiles");
+    assert_eq!(compiled.loose_triangles().len(), mesh.triangles.len());
+    let targets = [DVec2::new(1.5, -0.5), DVec2::new(2.5, -0.5)];
+    let out = compiled.update(&targets).expect("updates");
+    assert!(all_finite(&out.step_one) && all_finite(&out.positions));
+    assert_eq!(out.positions[2], targets[0]);
+    assert_eq!(out.positions[lip as usize], targets[1]);
+}
+
+#[test]
+fn compiled_systems_can_be_shared_between_threads() {
+    fn shareable<T: Send + Sync>() {}
+    shareable::<Registration>();
+    shareable::<arap::Compiled>();
+    shareable::<arap::Deformation>();
+}
