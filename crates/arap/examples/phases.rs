@@ -1,45 +1,31 @@
-//! Times the three phases on a cut-out mesh (as the benchmarks build it) and prints
-//! one line each: `cargo run --release -p arap --example phases [VERTICES]`.
+//! Times the three phases on a cut-out mesh (as the benchmarks build it) with four
+//! point handles, and with four turning handles (each pinning its one-ring), and
+//! prints the median and the fastest of several runs:
+//! `cargo run --release -p arap --example phases [VERTICES]`.
 //!
-//! Besides wall time it prints the process's time on a CPU, all threads together
-//! (from `/proc/self/task/*/schedstat`, Linux only), which a busy machine disturbs
-//! less than wall time.
+//! On a busy machine the fastest run says more about the code than the median.
 
 #[path = "../tests/support/mod.rs"]
 mod support;
 
 use std::time::Instant;
 
-use arap::{ArapError, Deformation, Registration};
+use arap::{ArapError, Deformation, Registration, Similarity, ring_constraints};
+use glam::DVec2;
 
-/// This process's time on a CPU over all its threads, in nanoseconds (0 where the
-/// kernel does not say).
-fn cpu_ns() -> u64 {
-    let Ok(tasks) = std::fs::read_dir("/proc/self/task") else {
-        return 0;
-    };
-    tasks
-        .flatten()
-        .filter_map(|task| std::fs::read_to_string(task.path().join("schedstat")).ok())
-        .filter_map(|s| {
-            s.split_whitespace()
-                .next()
-                .and_then(|t| t.parse::<u64>().ok())
-        })
-        .sum()
-}
-
-/// Runs `f`, returning its result with wall and CPU milliseconds.
-fn timed<T>(f: impl FnOnce() -> T) -> (T, f64, f64) {
-    let (wall, cpu) = (Instant::now(), cpu_ns());
-    let out = f();
-    let cpu = (cpu_ns() - cpu) as f64 / 1e6;
-    (out, wall.elapsed().as_secs_f64() * 1e3, cpu)
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
+/// Runs `f` `times` times; returns the last result with the median and the fastest
+/// run in milliseconds.
+fn timed<T>(times: usize, mut f: impl FnMut() -> T) -> (T, f64, f64) {
+    let mut runs = Vec::with_capacity(times);
+    let mut out = None;
+    for _ in 0..times {
+        let start = Instant::now();
+        out = Some(f());
+        runs.push(start.elapsed().as_secs_f64() * 1e3);
+    }
+    runs.sort_by(f64::total_cmp);
+    let out = out.expect("at least one run");
+    (out, runs[runs.len() / 2], runs[0])
 }
 
 fn main() -> Result<(), ArapError> {
@@ -49,30 +35,61 @@ fn main() -> Result<(), ArapError> {
         .unwrap_or(100_000);
     let mesh = support::cut_out(n, 7);
     println!(
-        "{} vertices, {} triangles",
+        "{} vertices, {} triangles (median / fastest)",
         mesh.rest.len(),
         mesh.triangles.len()
     );
-    let (registration, wall, cpu) = timed(|| Registration::new(&mesh.rest, &mesh.triangles));
+    let (registration, median, fastest) =
+        timed(3, || Registration::new(&mesh.rest, &mesh.triangles));
     let registration = registration?;
-    println!("registration  {wall:8.3} ms wall  {cpu:8.3} ms cpu");
+    println!("registration           {median:9.3} / {fastest:9.3} ms");
+
     let handles = support::spread_handles(&mesh);
-    let (compiled, wall, cpu) = timed(|| registration.compile(&handles, None));
+    let (compiled, median, fastest) = timed(5, || registration.compile(&handles, None));
     let compiled = compiled?;
-    println!("compilation   {wall:8.3} ms wall  {cpu:8.3} ms cpu");
+    println!("compilation            {median:9.3} / {fastest:9.3} ms");
+    let poses: Vec<Vec<DVec2>> = (0..31)
+        .map(|k| support::drag_pose(&mesh, &handles, k as f64 / 30.0))
+        .collect();
     let mut out = Deformation::default();
-    let (mut walls, mut cpus) = (Vec::new(), Vec::new());
-    for k in 0..31 {
-        let targets = support::drag_pose(&mesh, &handles, k as f64 / 30.0);
-        let (result, wall, cpu) = timed(|| compiled.update_into(&targets, &mut out));
-        result?;
-        walls.push(wall);
-        cpus.push(cpu);
-    }
+    let mut k = 0;
+    let (result, median, fastest) = timed(31, || {
+        k = (k + 1) % poses.len();
+        compiled.update_into(&poses[k], &mut out)
+    });
+    result?;
+    println!("update                 {median:9.3} / {fastest:9.3} ms");
+
+    // Turning handles: each pins its one-ring by a similarity.
+    let pins = |t: f64| -> Result<Vec<(u32, DVec2)>, ArapError> {
+        let moved = support::drag_pose(&mesh, &handles, t);
+        let mut all = Vec::new();
+        for (&h, to) in handles.iter().zip(moved) {
+            let turn = Similarity {
+                translation: to - mesh.rest[h as usize],
+                rotation: 0.5 * t,
+                scale: 1.0,
+            };
+            all.extend(ring_constraints(&registration, h, &turn)?);
+        }
+        Ok(all)
+    };
+    let vertices: Vec<u32> = pins(0.0)?.iter().map(|p| p.0).collect();
+    let (compiled, median, fastest) = timed(5, || registration.compile(&vertices, None));
+    let compiled = compiled?;
     println!(
-        "update        {:8.3} ms wall  {:8.3} ms cpu  (median of 31 poses)",
-        median(walls),
-        median(cpus)
+        "compilation, turning   {median:9.3} / {fastest:9.3} ms  ({} constrained vertices)",
+        vertices.len()
     );
+    let poses = (0..31)
+        .map(|k| Ok(pins(k as f64 / 30.0)?.iter().map(|p| p.1).collect()))
+        .collect::<Result<Vec<Vec<DVec2>>, ArapError>>()?;
+    let mut k = 0;
+    let (result, median, fastest) = timed(31, || {
+        k = (k + 1) % poses.len();
+        compiled.update_into(&poses[k], &mut out)
+    });
+    result?;
+    println!("update, turning        {median:9.3} / {fastest:9.3} ms");
     Ok(())
 }

@@ -6,6 +6,7 @@ use std::sync::Arc;
 
 use faer::c64;
 use glam::DVec2;
+use rayon::prelude::*;
 
 use crate::error::ArapError;
 use crate::registration::{Mesh, Registration};
@@ -377,7 +378,8 @@ impl Registration {
     }
 }
 
-/// `G'⁻¹B` and `G'⁻¹·(constant part)` by one substitution per constraint.
+/// `G'⁻¹B` and `G'⁻¹·(constant part)` by one substitution per constraint, the
+/// constraints side by side.
 fn product_form(
     factor: &Cholesky<Complex>,
     k: usize,
@@ -385,19 +387,23 @@ fn product_form(
     constant: &[DVec2],
 ) -> StepOne {
     let m = factor.n();
-    let mut work = Vec::new();
     let mut base = constant.to_vec();
     if base.iter().any(|p| *p != DVec2::ZERO) {
-        factor.solve_in_place(&mut base, &mut work);
+        factor.solve_in_place(&mut base, &mut Vec::new());
     }
+    let solved: Vec<Vec<DVec2>> = (0..k)
+        .into_par_iter()
+        .map(|j| {
+            let mut column = vec![DVec2::ZERO; m];
+            for c in couplings.iter().filter(|c| c.constraint as usize == j) {
+                column[c.free as usize] -= c.g.0;
+            }
+            factor.solve_in_place(&mut column, &mut Vec::new());
+            column
+        })
+        .collect();
     let mut columns = vec![Complex(DVec2::ZERO); m * k];
-    let mut column = vec![DVec2::ZERO; m];
-    for j in 0..k {
-        column.fill(DVec2::ZERO);
-        for c in couplings.iter().filter(|c| c.constraint as usize == j) {
-            column[c.free as usize] -= c.g.0;
-        }
-        factor.solve_in_place(&mut column, &mut work);
+    for (j, column) in solved.iter().enumerate() {
         for (i, &u) in column.iter().enumerate() {
             columns[i * k + j] = Complex(u);
         }
