@@ -161,8 +161,9 @@ impl Structure {
     /// The symbolic factorisation of `pattern` (supernodal), unknowns in the order
     /// given: they come numbered by a fill-reducing order already.
     pub fn new(pattern: &LowerPattern) -> Result<Self, ArapError> {
-        // The identity as a custom ordering: faer 0.24's `SymmetricOrdering::Identity`
-        // reads a lower triangle as if it were the upper one.
+        // The identity as a custom ordering: with `SymmetricOrdering::Identity` and
+        // a lower triangle, faer 0.24's numeric factorisation panicked on an index;
+        // a custom ordering goes through its usual path.
         let identity: Vec<u32> = (0..pattern.n as u32).collect();
         let symbolic = factorize_symbolic_cholesky(
             pattern.symbolic(),
