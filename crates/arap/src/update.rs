@@ -1,0 +1,177 @@
+//! Manipulation (§4.3, step 3): one back-substitution for step one, the per-triangle
+//! fit, and one back-substitution (x and y together) for step two.
+
+use glam::DVec2;
+
+use crate::compile::{Compiled, StepOne};
+use crate::error::ArapError;
+use crate::solver::Entry;
+use crate::triangle::{fitted_rotation, rotate};
+
+/// The result of one pose: vertex positions, indexed like the rest positions.
+///
+/// Keep one around and pass it to [`Compiled::update_into`] to reuse its buffers
+/// across drag frames.
+#[derive(Default)]
+pub struct Deformation {
+    /// Step one's intermediate result (§4.1): the scale-free fit, which lets triangles
+    /// grow and shrink.
+    pub step_one: Vec<DVec2>,
+    /// The final result (§4.2): step two's scale-adjusted positions.
+    pub positions: Vec<DVec2>,
+    scratch: Scratch,
+}
+
+impl Clone for Deformation {
+    fn clone(&self) -> Self {
+        Self {
+            step_one: self.step_one.clone(),
+            positions: self.positions.clone(),
+            scratch: Scratch::default(),
+        }
+    }
+}
+
+impl std::fmt::Debug for Deformation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Deformation")
+            .field("step_one", &self.step_one)
+            .field("positions", &self.positions)
+            .finish_non_exhaustive()
+    }
+}
+
+/// Buffers reused between updates.
+#[derive(Default)]
+struct Scratch {
+    step_one: Vec<DVec2>,
+    step_two: Vec<DVec2>,
+    linear: Vec<DVec2>,
+    work: Vec<DVec2>,
+}
+
+impl Compiled {
+    /// Poses the mesh: `targets[i]` is where constrained vertex
+    /// [`constrained()[i]`](Compiled::constrained) goes. Returns step one's result and
+    /// the final one; constrained vertices sit exactly on their targets in both.
+    ///
+    /// ```
+    /// use arap::Registration;
+    /// use glam::DVec2;
+    ///
+    /// // A 3 × 2 strip of unit squares, each split along a diagonal.
+    /// let rest: Vec<DVec2> = (0..3)
+    ///     .flat_map(|y| (0..4).map(move |x| DVec2::new(x as f64, y as f64)))
+    ///     .collect();
+    /// let mut triangles = Vec::new();
+    /// for y in 0..2u32 {
+    ///     for x in 0..3u32 {
+    ///         let v = y * 4 + x;
+    ///         triangles.push([v, v + 1, v + 5]);
+    ///         triangles.push([v, v + 5, v + 4]);
+    ///     }
+    /// }
+    /// let registration = Registration::new(&rest, &triangles)?;
+    /// // Pin the two ends of the middle row; drag the right one up.
+    /// let compiled = registration.compile(&[4, 7], None)?;
+    /// let pose = compiled.update(&[DVec2::new(0.0, 1.0), DVec2::new(3.0, 2.5)])?;
+    /// assert_eq!(pose.positions[7], DVec2::new(3.0, 2.5));
+    /// assert!(pose.positions.iter().all(|p| p.is_finite()));
+    /// # Ok::<(), arap::ArapError>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`ArapError::TargetCount`] if `targets` is not as long as the constraint list,
+    /// [`ArapError::NonFiniteTarget`] for a NaN or infinite target.
+    pub fn update(&self, targets: &[DVec2]) -> Result<Deformation, ArapError> {
+        let mut out = Deformation::default();
+        self.update_into(targets, &mut out)?;
+        Ok(out)
+    }
+
+    /// [`Compiled::update`] into `out`, reusing its buffers: a drag frame allocates
+    /// nothing after the first.
+    ///
+    /// # Errors
+    /// As [`Compiled::update`]; `out` is left unchanged on error.
+    pub fn update_into(&self, targets: &[DVec2], out: &mut Deformation) -> Result<(), ArapError> {
+        if targets.len() != self.constrained.len() {
+            return Err(ArapError::TargetCount {
+                got: targets.len(),
+                expected: self.constrained.len(),
+            });
+        }
+        if let Some(constraint) = targets.iter().position(|t| !t.is_finite()) {
+            return Err(ArapError::NonFiniteTarget { constraint });
+        }
+        let mesh = &*self.mesh;
+        out.step_one.clear();
+        out.step_one.extend_from_slice(&mesh.rest);
+        for (&v, &t) in self.constrained.iter().zip(targets) {
+            out.step_one[v as usize] = t;
+        }
+        let (Some(one), Some(two)) = (&self.step_one, &self.step_two) else {
+            out.positions.clone_from(&out.step_one);
+            return Ok(());
+        };
+        let scratch = &mut out.scratch;
+
+        // Step one (eq. 8): G'u = −Bq (+ the rest pull on loose pieces).
+        match one {
+            StepOne::Substitution(factor) => {
+                let r1 = &mut scratch.step_one;
+                r1.clone_from(&self.step_one_rhs);
+                for c in &self.couplings {
+                    r1[c.free as usize] -= c.g.mul(targets[c.constraint as usize]);
+                }
+                factor.solve_in_place(r1, &mut scratch.work);
+                for (&v, &p) in self.free.iter().zip(r1.iter()) {
+                    out.step_one[v as usize] = p;
+                }
+            }
+            StepOne::Product { base, columns } => {
+                let k = targets.len();
+                for ((&v, &u0), row) in self.free.iter().zip(base).zip(columns.chunks_exact(k)) {
+                    let mut u = u0;
+                    for (c, &q) in row.iter().zip(targets) {
+                        u += c.mul(q);
+                    }
+                    out.step_one[v as usize] = u;
+                }
+            }
+        }
+
+        // Step two: fit each rest triangle to its step-one triangle (eqs. 9–11),
+        // keep the rotation (the fit scaled back to rest size), and add the fitted
+        // edges to the linear term f of the final solve (eqs. 12–16) at each corner:
+        // corner c ends edge c−1 → c and starts edge c → c+1.
+        let b = &mut scratch.linear;
+        b.clear();
+        b.resize(mesh.rest.len(), DVec2::ZERO);
+        let step_one = &out.step_one;
+        for t in &self.triangles {
+            let [i, j, k] = t.vertices.map(|v| v as usize);
+            let rotation = fitted_rotation(&t.fit, [step_one[i], step_one[j], step_one[k]]);
+            let e01 = rotate(rotation, t.edges[0]);
+            let e12 = rotate(rotation, t.edges[1]);
+            let e20 = -(e01 + e12);
+            b[i] += e20 - e01;
+            b[j] += e01 - e12;
+            b[k] += e12 - e20;
+        }
+        // Final solve (eq. 16): H'u = f_u − Dq, x and y together.
+        let r2 = &mut scratch.step_two;
+        r2.clear();
+        r2.extend(self.free.iter().map(|&v| b[v as usize]));
+        for c in &self.couplings {
+            r2[c.free as usize] -= c.h * targets[c.constraint as usize];
+        }
+        two.solve_in_place(r2, &mut scratch.work);
+
+        out.positions.clone_from(&out.step_one);
+        for (&v, &p) in self.free.iter().zip(r2.iter()) {
+            out.positions[v as usize] = p;
+        }
+        Ok(())
+    }
+}
