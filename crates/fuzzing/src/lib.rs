@@ -52,19 +52,33 @@ pub fn obj_mesh(data: &[u8]) {
 }
 
 /// Image decoding and meshing: any bytes either decode (under small limits) into a
-/// picture that meshes into a valid mesh, or are refused; the first byte picks the
-/// mesh density.
+/// picture that meshes into a valid mesh covering every visible pixel, or are refused.
+/// The first byte picks the mesh density; after it, bytes that start with `M` are a
+/// raw alpha mask (width and height from the next two bytes, then one alpha per
+/// pixel), so the fuzzer can draw shapes directly; anything else is an image file.
 pub fn image_mesh(data: &[u8]) {
     let Some((&density, bytes)) = data.split_first() else {
         return;
     };
-    let limits = render::ImageLimits {
-        max_width: 512,
-        max_height: 512,
-        max_alloc_bytes: 64 << 20,
-    };
-    let Ok(picture) = render::decode_image(bytes, &limits) else {
-        return;
+    let picture = match bytes {
+        [b'M', w, h, alphas @ ..] => {
+            let (w, h) = (u32::from(*w % 64) + 1, u32::from(*h % 64) + 1);
+            image::RgbaImage::from_fn(w, h, |x, y| {
+                let a = alphas.get((y * w + x) as usize).copied().unwrap_or(0);
+                image::Rgba([200, 100, 50, a])
+            })
+        }
+        _ => {
+            let limits = render::ImageLimits {
+                max_width: 512,
+                max_height: 512,
+                max_alloc_bytes: 64 << 20,
+            };
+            let Ok(picture) = render::decode_image(bytes, &limits) else {
+                return;
+            };
+            picture
+        }
     };
     assert!(picture.width() <= 512 && picture.height() <= 512);
     let options = mesh::MeshOptions {
@@ -81,9 +95,47 @@ pub fn image_mesh(data: &[u8]) {
         &options,
         &constraints,
     ) else {
+        assert!(
+            picture.pixels().all(|p| p.0[3] == 0),
+            "only a picture with nothing visible may fail to mesh"
+        );
         return;
     };
     meshed.mesh.sanity_check().expect("a valid mesh");
+    // Every visible pixel's centre is inside the mesh.
+    let covered = coverage(&meshed.mesh, picture.width(), picture.height());
+    for (x, y, p) in picture.enumerate_pixels() {
+        assert!(
+            p.0[3] == 0 || covered[(y * picture.width() + x) as usize],
+            "visible pixel ({x}, {y}) is not meshed"
+        );
+    }
+}
+
+/// Which pixel centres of a `width` × `height` picture lie in a triangle of `mesh`
+/// (boundary included).
+fn coverage(mesh: &mesh::Mesh, width: u32, height: u32) -> Vec<bool> {
+    let mut covered = vec![false; (width * height) as usize];
+    for t in 0..mesh.triangles.len() {
+        let [a, b, c] = mesh.triangle_positions(t);
+        let area = (b - a).perp_dot(c - a);
+        if area == 0.0 {
+            continue;
+        }
+        let lo = a.min(b).min(c).floor().max(DVec2::ZERO);
+        let hi = a.max(b).max(c).ceil();
+        for y in lo.y as u32..(hi.y as u32).min(height) {
+            for x in lo.x as u32..(hi.x as u32).min(width) {
+                let p = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+                let u = (b - p).perp_dot(c - p) / area;
+                let v = (c - p).perp_dot(a - p) / area;
+                if u >= -1e-9 && v >= -1e-9 && u + v <= 1.0 + 1e-9 {
+                    covered[(y * width + x) as usize] = true;
+                }
+            }
+        }
+    }
+    covered
 }
 
 /// A small cut-out to put handles on: a 40 × 30 rectangle with a square hole and a
