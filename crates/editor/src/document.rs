@@ -414,10 +414,7 @@ impl Document {
                 NodeKind::Point { handle: h } | NodeKind::BarSample { handle: h, .. } => {
                     f64::from(u8::from(h == handle))
                 }
-                NodeKind::Virtual => rig
-                    .harmonic_coordinates(k)
-                    .and_then(|c| c.get(handle).copied())
-                    .unwrap_or(0.0),
+                NodeKind::Virtual => rig.harmonic_coordinate(k, handle),
                 NodeKind::Boundary => 0.0,
             })
             .collect();

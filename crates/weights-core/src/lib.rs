@@ -20,6 +20,8 @@ mod basis;
 mod domain;
 mod error;
 mod harmonic;
+mod ldl;
+mod nearest;
 mod queue;
 mod rig;
 mod transform;

@@ -10,7 +10,8 @@ use glam::{DAffine2, DVec2};
 use crate::basis::Basis;
 use crate::domain::{Domain, Metric};
 use crate::error::RigError;
-use crate::harmonic::{dual_edges, harmonic_coordinates};
+use crate::harmonic::{Coefficients, dual_edges, harmonic_coordinates};
+use crate::nearest::segment_distance;
 use crate::transform::Similarity;
 use crate::virtual_handles::insert_virtual_handles;
 use crate::voronoi::{CellStats, NONE, Partition};
@@ -199,22 +200,20 @@ fn group_of(n: &Node, handle_count: usize) -> Option<usize> {
     }
 }
 
-/// Harmonic coordinates of the virtual nodes over `groups` groups, on the dual graph of
+/// Harmonic coordinates of the virtual nodes over the groups, on the dual graph of
 /// `partition`.
 fn harmonic_of(
     domain: &Domain,
     partition: &Partition,
     nodes: &[Node],
     handle_count: usize,
-    groups: usize,
-) -> Vec<Option<Vec<f64>>> {
+) -> Vec<Option<Coefficients>> {
     let edges = dual_edges(domain, partition);
     let node_group: Vec<Option<usize>> = nodes.iter().map(|n| group_of(n, handle_count)).collect();
     harmonic_coordinates(
         domain.positions(),
         &partition.node_vertex,
         &node_group,
-        groups,
         &edges,
     )
 }
@@ -278,7 +277,7 @@ pub struct Rig {
     partition: Partition,
     radii: Vec<f64>,
     weights: Weights,
-    harmonic: Vec<Option<Vec<f64>>>,
+    harmonic: Vec<Option<Coefficients>>,
     affines: Vec<DAffine2>,
     resolution: f64,
     timings: BuildTimings,
@@ -613,7 +612,6 @@ impl Rig {
             .collect();
         let mut map: Vec<u32> = (0..self.nodes.len() as u32).collect();
         let handle_count = self.handles.len();
-        let groups = handle_count + usize::from(self.options.fixed_boundary);
         let Self {
             domain,
             options,
@@ -727,7 +725,7 @@ impl Rig {
             let transforms = &transforms;
             scope.spawn(move |_| {
                 let clock = Instant::now();
-                let harmonic = harmonic_of(domain, partition, nodes, handle_count, groups);
+                let harmonic = harmonic_of(domain, partition, nodes, handle_count);
                 *transforms.lock().expect("not poisoned") = Some((harmonic, ms(clock)));
             });
         });
@@ -775,18 +773,13 @@ impl Rig {
     }
 
     /// The virtual handles' harmonic coordinates on the current dual graph.
-    fn harmonic_coordinates_now(&self) -> Vec<Option<Vec<f64>>> {
+    fn harmonic_coordinates_now(&self) -> Vec<Option<Coefficients>> {
         harmonic_of(
             &self.domain,
             &self.partition,
             &self.nodes,
             self.handles.len(),
-            self.group_count(),
         )
-    }
-
-    fn group_count(&self) -> usize {
-        self.handles.len() + usize::from(self.options.fixed_boundary)
     }
 
     fn group_of(&self, n: &Node) -> Option<usize> {
@@ -795,11 +788,13 @@ impl Rig {
 
     /// Node transforms from the handles' poses (virtual ones blended harmonically).
     fn update_affines(&mut self) {
-        // Per group: the similarity, its centre, and its rotation as a unit complex.
-        let mut groups: Vec<(Similarity, DVec2)> =
-            self.handles.iter().map(Handle::similarity).collect();
+        let mut groups: Vec<GroupPose> = self
+            .handles
+            .iter()
+            .map(|h| GroupPose::new(h.similarity()))
+            .collect();
         if self.options.fixed_boundary {
-            groups.push((Similarity::IDENTITY, DVec2::ZERO));
+            groups.push(GroupPose::new((Similarity::IDENTITY, DVec2::ZERO)));
         }
         let positions = self.domain.positions();
         self.affines = self
@@ -807,7 +802,7 @@ impl Rig {
             .iter()
             .enumerate()
             .map(|(k, n)| match self.group_of(n) {
-                Some(g) => groups[g].0.to_affine(groups[g].1),
+                Some(g) => groups[g].affine,
                 None => {
                     let c = positions[n.vertex as usize];
                     let Some(coefficients) = self.harmonic.get(k).and_then(Option::as_ref) else {
@@ -942,10 +937,22 @@ impl Rig {
         dual_edges(&self.domain, &self.partition)
     }
 
-    /// Harmonic coordinates of node `k` over the real handles (and, last, the fixed
-    /// border): `None` for the nodes of real handles.
-    pub fn harmonic_coordinates(&self, k: usize) -> Option<&[f64]> {
+    /// Harmonic coordinates of virtual node `k` over the real handles (and, numbered
+    /// after them, the fixed border) as `(handle, coefficient)` pairs: handles
+    /// ascending, coefficients positive and summing to one; the handles left out have
+    /// coefficient zero (those out of reach of the node's part of the dual graph), and
+    /// the list is empty when no real handle is reachable. `None` for the nodes of real
+    /// handles.
+    pub fn harmonic_coordinates(&self, k: usize) -> Option<&[(u32, f64)]> {
         self.harmonic.get(k).and_then(|c| c.as_deref())
+    }
+
+    /// The harmonic coordinate of virtual node `k` for handle `handle` (zero when the
+    /// node is not virtual or the handle has no share in it).
+    pub fn harmonic_coordinate(&self, k: usize, handle: usize) -> f64 {
+        self.harmonic_coordinates(k)
+            .and_then(|c| c.iter().find(|e| e.0 as usize == handle))
+            .map_or(0.0, |e| e.1)
     }
 
     /// The transform of node `k` as an affine map of image coordinates.
@@ -961,11 +968,9 @@ impl Rig {
             NodeKind::Boundary => None,
             NodeKind::Virtual => self.harmonic_coordinates(k).and_then(|c| {
                 c.iter()
-                    .take(self.handles.len())
-                    .enumerate()
-                    .filter(|(_, w)| **w > 0.0)
-                    .max_by(|a, b| a.1.total_cmp(b.1))
-                    .map(|(i, _)| i)
+                    .filter(|e| (e.0 as usize) < self.handles.len())
+                    .max_by(|a, b| a.1.total_cmp(&b.1))
+                    .map(|e| e.0 as usize)
             }),
         }
     }
@@ -1066,17 +1071,44 @@ fn round_up_f32(x: f64) -> f64 {
     }
 }
 
+/// A group's pose, worked out once for all the nodes that blend it.
+struct GroupPose {
+    /// The similarity and the centre it is taken about.
+    similarity: Similarity,
+    centre: DVec2,
+    /// Its rotation as a unit complex number.
+    rotation: DVec2,
+    /// Its linear part.
+    linear: glam::DMat2,
+    /// The whole map in image coordinates.
+    affine: DAffine2,
+}
+
+impl GroupPose {
+    fn new((similarity, centre): (Similarity, DVec2)) -> Self {
+        Self {
+            similarity,
+            centre,
+            rotation: DVec2::from_angle(similarity.rotation),
+            linear: similarity.linear(),
+            affine: similarity.to_affine(centre),
+        }
+    }
+}
+
 /// The virtual handle at `c`: the groups' rotations (unit complex numbers), scales and
 /// the images of `c` blended with the harmonic coefficients.
-fn blend(groups: &[(Similarity, DVec2)], coefficients: &[f64], c: DVec2) -> DAffine2 {
+fn blend(groups: &[GroupPose], coefficients: &[(u32, f64)], c: DVec2) -> DAffine2 {
     let (mut rot, mut scale, mut pos, mut total) = (DVec2::ZERO, 0.0, DVec2::ZERO, 0.0);
-    for ((s, centre), &w) in groups.iter().zip(coefficients) {
-        if w == 0.0 {
+    for &(g, w) in coefficients {
+        let Some(group) = groups.get(g as usize) else {
             continue;
-        }
-        rot += w * DVec2::from_angle(s.rotation);
-        scale += w * s.scale;
-        pos += w * s.apply(*centre, c);
+        };
+        rot += w * group.rotation;
+        scale += w * group.similarity.scale;
+        // As Similarity::apply, with the linear part worked out once.
+        pos +=
+            w * (group.centre + group.similarity.translation + group.linear * (c - group.centre));
         total += w;
     }
     if total <= 0.0 {
@@ -1134,43 +1166,11 @@ fn check_handles(handles: &[Handle]) -> Result<(), RigError> {
         .try_for_each(|(i, h)| check_handle(i, h))
 }
 
-fn segment_distance(a: [DVec2; 2], b: [DVec2; 2]) -> f64 {
-    let point_seg = |p: DVec2, s: [DVec2; 2]| {
-        let d = s[1] - s[0];
-        let t = if d.length_squared() > 0.0 {
-            ((p - s[0]).dot(d) / d.length_squared()).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        (p - (s[0] + d * t)).length()
-    };
-    let (da, db) = (a[1] - a[0], b[1] - b[0]);
-    let cross = |u: DVec2, v: DVec2| u.perp_dot(v);
-    let o1 = cross(da, b[0] - a[0]);
-    let o2 = cross(da, b[1] - a[0]);
-    let o3 = cross(db, a[0] - b[0]);
-    let o4 = cross(db, a[1] - b[0]);
-    if o1 * o2 < 0.0 && o3 * o4 < 0.0 {
-        return 0.0;
-    }
-    point_seg(a[0], b)
-        .min(point_seg(a[1], b))
-        .min(point_seg(b[0], a))
-        .min(point_seg(b[1], a))
-}
-
-/// The closest two handles `(a, b, distance)` with `a < b`, by segment distance.
+/// The closest two handles `(a, b, distance)` with `a < b`, by segment distance (of
+/// equally close pairs, the lowest `b`, then the lowest `a`).
 fn closest_pair(handles: &[Handle]) -> Option<(usize, usize, f64)> {
-    let mut best: Option<(usize, usize, f64)> = None;
-    for i in 0..handles.len() {
-        for j in 0..i {
-            let d = segment_distance(segment_of(&handles[i]), segment_of(&handles[j]));
-            if best.is_none_or(|b| d < b.2) {
-                best = Some((j, i, d));
-            }
-        }
-    }
-    best
+    let segments: Vec<[DVec2; 2]> = handles.iter().map(segment_of).collect();
+    crate::nearest::closest_pair(&segments)
 }
 
 /// The finest a bar is cut: into this many pieces.
@@ -1189,11 +1189,16 @@ pub const MAX_BAR_PIECES: f64 = 16.0;
 /// length. (For a point handle: the distance to the nearest other handle.)
 pub fn bar_spacing(handles: &[Handle], bar: usize) -> f64 {
     let own = segment_of(&handles[bar]);
-    let length = (own[1] - own[0]).length();
     let nearest = (0..handles.len())
         .filter(|&j| j != bar)
         .map(|j| segment_distance(own, segment_of(&handles[j])))
         .fold(f64::INFINITY, f64::min);
+    spacing_of(own, nearest)
+}
+
+/// [`bar_spacing`] of the bar `own` with its nearest other handle `nearest` away.
+fn spacing_of(own: [DVec2; 2], nearest: f64) -> f64 {
+    let length = (own[1] - own[0]).length();
     if nearest.is_finite() {
         nearest.max(length / MAX_BAR_PIECES)
     } else {
@@ -1271,6 +1276,9 @@ fn real_nodes(
             .unwrap_or(0);
         Ok(tri[best])
     };
+    // The nearest other handle of each bar, through a grid of the handles.
+    let segments: Vec<[DVec2; 2]> = handles.iter().map(segment_of).collect();
+    let bars = crate::nearest::SegmentGrid::new(&segments);
     let mut nodes: Vec<Node> = Vec::new();
     let mut used: HashMap<u32, usize> = HashMap::new();
     for (i, h) in handles.iter().enumerate() {
@@ -1294,7 +1302,7 @@ fn real_nodes(
                         y: p.y,
                     });
                 }
-                let spacing = bar_spacing(handles, i).max(resolution);
+                let spacing = spacing_of(rest, bars.nearest(i)).max(resolution);
                 for (t, p) in bar_samples(rest, spacing) {
                     let v = snap(i, p)?;
                     if own.iter().all(|n| n.vertex != v) {

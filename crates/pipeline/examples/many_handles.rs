@@ -1,0 +1,148 @@
+//! How the build time grows with the number of handles: N random point handles on the
+//! built-in lizard (a cut-out, so intrinsic distances), meshed and weighted as
+//! `c2warp render` would, timed by phase.
+//!
+//! ```sh
+//! cargo run --release -p pipeline --example many_handles [density] [N...]
+//! ```
+//!
+//! Defaults: density 20000, N = 10 100 500 1000 2000 5000 10000. The handles are
+//! opaque pixels drawn at random (seeded), no two closer than `GAP` pixels (default 2),
+//! so that close pairs (timed by the `close_pair` examples) do not blur the picture.
+//! `LIMIT=0` builds past the handle limit (what the limit protects against).
+
+use std::time::Instant;
+
+use pipeline::{DEFAULT_IMAGE, DEFAULT_RIG};
+use project::{HandleSpec, Project};
+
+/// A small seeded generator (xorshift), so runs are comparable.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        self.0
+    }
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n as u64) as usize
+    }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let density: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(20_000);
+    let counts: Vec<usize> = if args.len() > 2 {
+        args[2..].iter().filter_map(|s| s.parse().ok()).collect()
+    } else {
+        vec![10, 100, 500, 1000, 2000, 5000, 10_000]
+    };
+    let gap: f64 = std::env::var("GAP")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(2.0);
+    let image = image::load_from_memory(DEFAULT_IMAGE)
+        .expect("the built-in picture decodes")
+        .to_rgba8();
+    let (w, h) = image.dimensions();
+    // Pixels well inside the shape: opaque with an opaque 7 × 7 neighbourhood.
+    let opaque = |x: i64, y: i64| {
+        x >= 0
+            && y >= 0
+            && x < i64::from(w)
+            && y < i64::from(h)
+            && image.get_pixel(x as u32, y as u32)[3] > 128
+    };
+    let inside: Vec<(u32, u32)> = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            (-3..=3).all(|dy| (-3..=3).all(|dx| opaque(i64::from(x) + dx, i64::from(y) + dy)))
+        })
+        .collect();
+    println!(
+        "lizard {w} x {h}, {} pixels well inside, density {density}, gap {gap} px",
+        inside.len()
+    );
+    println!(
+        "{:>6} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9}",
+        "N",
+        "samples",
+        "virtual",
+        "mesh ms",
+        "dist ms",
+        "voron ms",
+        "virt ms",
+        "weigh ms",
+        "total s"
+    );
+    let base = Project::from_json(DEFAULT_RIG).expect("the built-in rig parses");
+    for &n in &counts {
+        let mut rng = Rng(0x9E37_79B9_7F4A_7C15 ^ n as u64);
+        // A grid of cells `gap` wide finds a too-close point among a few neighbours.
+        let cell = gap.max(1.0);
+        let mut grid: std::collections::HashMap<(i64, i64), Vec<[f64; 2]>> =
+            std::collections::HashMap::new();
+        let mut points: Vec<[f64; 2]> = Vec::new();
+        let mut tries = 0;
+        while points.len() < n && tries < 100 * n {
+            tries += 1;
+            let (x, y) = inside[rng.below(inside.len())];
+            let p = [f64::from(x) + 0.5, f64::from(y) + 0.5];
+            let key = ((p[0] / cell) as i64, (p[1] / cell) as i64);
+            let crowded = (-1..=1).any(|dy| {
+                (-1..=1).any(|dx| {
+                    grid.get(&(key.0 + dx, key.1 + dy)).is_some_and(|list| {
+                        list.iter().any(|q| (q[0] - p[0]).hypot(q[1] - p[1]) < gap)
+                    })
+                })
+            });
+            if !crowded {
+                grid.entry(key).or_default().push(p);
+                points.push(p);
+            }
+        }
+        if std::env::var_os("PRINT").is_some() {
+            println!("{points:?}");
+        }
+        let project = Project {
+            handles: points
+                .iter()
+                .map(|&rest| HandleSpec::Point {
+                    rest,
+                    translate: [0.0, 0.0],
+                    rotate: 0.0,
+                    scale: 1.0,
+                })
+                .collect(),
+            density: Some(density),
+            ..base.clone()
+        };
+        let clock = Instant::now();
+        match pipeline::prepare(&image, &project, None) {
+            Ok(prepared) => {
+                let total = clock.elapsed().as_secs_f64();
+                let t = prepared.rig.timings();
+                let s = prepared.rig.stats();
+                println!(
+                    "{:>6} {:>8} {:>8} {:>9.0} {:>9.0} {:>9.0} {:>9.0} {:>9.0} {:>9.2}",
+                    points.len(),
+                    s.samples,
+                    s.virtual_nodes,
+                    total * 1e3 - t.total_ms(),
+                    t.distances_ms,
+                    t.voronoi_ms,
+                    t.virtual_ms,
+                    t.weights_ms,
+                    total
+                );
+            }
+            Err(e) => println!(
+                "{:>6} refused after {:.2} s: {e:#}",
+                points.len(),
+                clock.elapsed().as_secs_f64()
+            ),
+        }
+    }
+}
