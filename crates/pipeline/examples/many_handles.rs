@@ -103,9 +103,6 @@ fn main() {
                 points.push(p);
             }
         }
-        if std::env::var_os("PRINT").is_some() {
-            println!("{points:?}");
-        }
         let project = Project {
             handles: points
                 .iter()
@@ -125,6 +122,14 @@ fn main() {
                 let total = clock.elapsed().as_secs_f64();
                 let t = prepared.rig.timings();
                 let s = prepared.rig.stats();
+                if std::env::var_os("PRINT").is_some() {
+                    let rig = &prepared.rig;
+                    let entries: usize = (0..rig.nodes().len())
+                        .filter_map(|k| rig.harmonic_coordinates(k))
+                        .map(<[_]>::len)
+                        .sum();
+                    println!("harmonic coefficients: {entries}");
+                }
                 println!(
                     "{:>6} {:>8} {:>8} {:>9.0} {:>9.0} {:>9.0} {:>9.0} {:>9.0} {:>9.2}",
                     points.len(),

@@ -1,6 +1,7 @@
 //! Harmonic coordinates of the virtual handles with respect to the real handles, on
 //! the dual (Delaunay) graph of the Voronoi cells: one harmonic field per real handle,
-//! 1 on that handle's nodes and 0 on every other real node.
+//! 1 on that handle's nodes and 0 on every other real node, solved directly per
+//! component of the virtual handles and stored sparse.
 
 use glam::DVec2;
 use rayon::prelude::*;
@@ -145,9 +146,20 @@ fn triangle_pairs(domain: &Domain, partition: &Partition) -> PairsAndTies {
         )
 }
 
+/// Coefficients below this are left out (and the others scaled to sum to one).
+///
+/// A group's field falls off exponentially with the real nodes between it and a
+/// virtual one; where thousands of virtual handles surround thousands of handles,
+/// keeping every coefficient would cost a number per handle per virtual handle (25
+/// million for 2,000 random handles on the lizard at 20k samples; 2.3 million, 180 a
+/// virtual handle, at this threshold). Even with 10,000 handles the mass left out is under 1e-6 of a node's,
+/// and it moves a virtual handle by less than a millionth of the largest difference
+/// between two handles' motions.
+pub(crate) const NEGLIGIBLE: f64 = 1e-10;
+
 /// The harmonic coefficients of one virtual node: `(group, coefficient)` pairs, groups
-/// ascending, coefficients positive and summing to 1; empty when no real handle is
-/// connected to the node.
+/// ascending, coefficients at least [`NEGLIGIBLE`] and summing to 1; empty when no real
+/// handle is connected to the node.
 pub(crate) type Coefficients = Box<[(u32, f64)]>;
 
 /// Harmonic coefficients: for every node, `None` for a real node (it has a group of its
@@ -307,7 +319,7 @@ fn solve_component(
                 ldl.solve(b, x, work);
                 x.iter()
                     .enumerate()
-                    .filter(|(_, v)| **v > 0.0)
+                    .filter(|(_, v)| **v >= NEGLIGIBLE)
                     .map(|(l, v)| (l as u32, *v))
                     .collect()
             },

@@ -939,10 +939,11 @@ impl Rig {
 
     /// Harmonic coordinates of virtual node `k` over the real handles (and, numbered
     /// after them, the fixed border) as `(handle, coefficient)` pairs: handles
-    /// ascending, coefficients positive and summing to one; the handles left out have
-    /// coefficient zero (those out of reach of the node's part of the dual graph), and
-    /// the list is empty when no real handle is reachable. `None` for the nodes of real
-    /// handles.
+    /// ascending, coefficients positive and summing to one. The handles left out have
+    /// coefficient zero: those out of reach of the node's part of the dual graph, and
+    /// those below 1e-10 (dropped, so that thousands of handles do not cost a number
+    /// each per virtual handle). The list is empty when no real handle is reachable.
+    /// `None` for the nodes of real handles.
     pub fn harmonic_coordinates(&self, k: usize) -> Option<&[(u32, f64)]> {
         self.harmonic.get(k).and_then(|c| c.as_deref())
     }
