@@ -177,6 +177,7 @@ pub(crate) fn harmonic_coordinates(
     node_vertex: &[u32],
     node_group: &[Option<usize>],
     edges: &[(u32, u32)],
+    progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Vec<Option<Coefficients>> {
     let n = node_vertex.len();
     // Free nodes in a canonical order (by sample), so results do not depend on how the
@@ -228,17 +229,43 @@ pub(crate) fn harmonic_coordinates(
         members.sort_unstable();
         components.push(members);
     }
-    let solved: Vec<Vec<Coefficients>> = components
+    // The groups each component touches, and a solve per group and component.
+    let touched: Vec<Vec<u32>> = components
         .par_iter()
         .map(|members| {
+            let mut groups: Vec<u32> = members
+                .iter()
+                .flat_map(|&i| adjacency[free[i as usize]].iter())
+                .filter_map(|&(j, _)| node_group[j].map(|g| g as u32))
+                .collect();
+            groups.sort_unstable();
+            groups.dedup();
+            groups
+        })
+        .collect();
+    let total: usize = touched.iter().map(Vec::len).sum();
+    progress(0, total);
+    // Solves done so far, told in order.
+    let done = std::sync::Mutex::new(0usize);
+    let solved_one = || {
+        let mut done = done
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        *done += 1;
+        progress(*done, total);
+    };
+    let solved: Vec<Vec<Coefficients>> = components
+        .par_iter()
+        .zip(&touched)
+        .map(|(members, groups)| {
             solve_component(
                 positions,
                 node_vertex,
                 node_group,
-                &free,
-                &index,
-                &adjacency,
+                (&free, &index, &adjacency),
                 members,
+                groups,
+                &solved_one,
             )
         })
         .collect();
@@ -251,27 +278,25 @@ pub(crate) fn harmonic_coordinates(
     out
 }
 
+/// The free nodes in canonical order, each node's index among them, and the dual graph
+/// with edge weights.
+type FreeGraph<'a> = (&'a [usize], &'a [u32], &'a [Vec<(usize, f64)>]);
+
 /// The coefficients of one component of free nodes (`members`: free indices,
-/// ascending), in the members' order.
+/// ascending), in the members' order, over the groups it touches (`groups`,
+/// ascending); `solved` is called after each group's solve.
 fn solve_component(
     positions: &[DVec2],
     node_vertex: &[u32],
     node_group: &[Option<usize>],
-    free: &[usize],
-    index: &[u32],
-    adjacency: &[Vec<(usize, f64)>],
+    (free, index, adjacency): FreeGraph,
     members: &[u32],
+    groups: &[u32],
+    solved: &(dyn Fn() + Sync),
 ) -> Vec<Coefficients> {
     let m = members.len();
     // Local numbering: position in `members`.
     let local = |fj: u32| members.binary_search(&fj).map(|l| l as u32).ok();
-    let mut groups: Vec<u32> = members
-        .iter()
-        .flat_map(|&i| adjacency[free[i as usize]].iter())
-        .filter_map(|&(j, _)| node_group[j].map(|g| g as u32))
-        .collect();
-    groups.sort_unstable();
-    groups.dedup();
     if groups.is_empty() {
         return vec![Box::default(); m];
     }
@@ -308,6 +333,7 @@ fn solve_component(
     let order = dissection_order(&points, &inner);
     let Some(ldl) = Ldl::factor(&diagonal, &inner, order) else {
         // Not reached: a component with an edge to a real node is positive definite.
+        groups.iter().for_each(|_| solved());
         return vec![Box::default(); m];
     };
     // One solve per group, in parallel; each group's values kept where positive.
@@ -317,11 +343,14 @@ fn solve_component(
             || (vec![0.0; m], vec![0.0; m]),
             |(x, work), b| {
                 ldl.solve(b, x, work);
-                x.iter()
+                let column = x
+                    .iter()
                     .enumerate()
                     .filter(|(_, v)| **v >= NEGLIGIBLE)
                     .map(|(l, v)| (l as u32, *v))
-                    .collect()
+                    .collect();
+                solved();
+                column
             },
         )
         .collect();
@@ -353,7 +382,7 @@ mod tests {
         let node_vertex: Vec<u32> = (0..5).collect();
         let groups = [Some(0), None, None, None, Some(1)];
         let edges = [(0, 1), (1, 2), (2, 3), (3, 4)];
-        let h = harmonic_coordinates(&positions, &node_vertex, &groups, &edges);
+        let h = harmonic_coordinates(&positions, &node_vertex, &groups, &edges, &|_, _| {});
         for (i, c) in h.iter().enumerate().take(4).skip(1) {
             let c = c.as_ref().expect("free");
             assert_eq!((c[0].0, c[1].0), (0, 1));
@@ -369,7 +398,7 @@ mod tests {
         let node_vertex: Vec<u32> = (0..4).collect();
         let groups = [Some(0), None, None, None];
         let edges = [(0, 1), (2, 3)];
-        let h = harmonic_coordinates(&positions, &node_vertex, &groups, &edges);
+        let h = harmonic_coordinates(&positions, &node_vertex, &groups, &edges, &|_, _| {});
         assert_eq!(h[1].as_deref(), Some(&[(0, 1.0)][..]));
         assert_eq!(h[2].as_deref(), Some(&[][..]));
     }
@@ -381,7 +410,7 @@ mod tests {
         let node_vertex: Vec<u32> = (0..6).collect();
         let node_group = [Some(0), None, None, Some(1), None, Some(2)];
         let edges = [(0, 1), (1, 2), (2, 3), (4, 5)];
-        let h = harmonic_coordinates(&positions, &node_vertex, &node_group, &edges);
+        let h = harmonic_coordinates(&positions, &node_vertex, &node_group, &edges, &|_, _| {});
         let groups_of =
             |k: usize| -> Vec<u32> { h[k].as_deref().expect("free").iter().map(|e| e.0).collect() };
         assert_eq!(groups_of(1), vec![0, 1]);
@@ -417,7 +446,7 @@ mod tests {
                 }
             }
         }
-        let h = harmonic_coordinates(&p, &node_vertex, &node_group, &edges);
+        let h = harmonic_coordinates(&p, &node_vertex, &node_group, &edges, &|_, _| {});
         let value = |k: usize, g: u32| -> f64 {
             match node_group[k] {
                 Some(own) => f64::from(u8::from(own as u32 == g)),

@@ -33,7 +33,7 @@ pub use basis::{Basis, MAX_DEGREE, MIN_DEGREE, MiddleControls};
 pub use domain::{Domain, Metric};
 pub use error::{DomainError, RigError};
 pub use rig::{
-    BuildTimings, Handle, MAX_BAR_PIECES, Node, NodeKind, NodeRadii, Rig, RigOptions, RigStats,
-    UpdateTimings, bar_samples, bar_spacing,
+    BuildTimings, Handle, MAX_BAR_PIECES, MAX_HANDLES, Node, NodeKind, NodeRadii, Phase, Progress,
+    Rig, RigOptions, RigStats, UpdateTimings, VirtualHandle, bar_samples, bar_spacing,
 };
 pub use transform::Similarity;

@@ -202,11 +202,14 @@ fn group_of(n: &Node, handle_count: usize) -> Option<usize> {
 
 /// Harmonic coordinates of the virtual nodes over the groups, on the dual graph of
 /// `partition`.
+/// `progress(done, total)` is told of the solves (one per group and part of the dual
+/// graph), in order.
 fn harmonic_of(
     domain: &Domain,
     partition: &Partition,
     nodes: &[Node],
     handle_count: usize,
+    progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Vec<Option<Coefficients>> {
     let edges = dual_edges(domain, partition);
     let node_group: Vec<Option<usize>> = nodes.iter().map(|n| group_of(n, handle_count)).collect();
@@ -215,7 +218,98 @@ fn harmonic_of(
         &partition.node_vertex,
         &node_group,
         &edges,
+        progress,
     )
+}
+
+/// The most handles a rig takes. The build stays within seconds up to here on a mesh
+/// of the default 20,000 samples, however the handles lie (measured with the
+/// `many_handles` example of the pipeline crate: 2 s at worst, with every handle one
+/// pixel from another); more are refused up front.
+pub const MAX_HANDLES: usize = 10_000;
+
+/// A virtual handle to build a rig with: its sample, and the handle it was placed for
+/// (whose removal takes it along), if any.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct VirtualHandle {
+    /// The sample it sits on.
+    pub vertex: u32,
+    /// Index of the handle it was placed for.
+    pub placed_for: Option<usize>,
+}
+
+/// A phase of a rig build, in the order they run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Phase {
+    /// Every sample's nearest node, the Voronoi cells and their radii.
+    Partition,
+    /// Virtual handles placed by Algorithm 1; how many it needs is known only at the
+    /// end (up to one a sample, where two handles are a mesh edge apart).
+    VirtualHandles,
+    /// Supports and sparse weights.
+    Weights,
+    /// Harmonic coordinates of the virtual handles: one solve per real handle and part
+    /// of the dual graph it touches.
+    Transforms,
+}
+
+/// How far a build has come, as told to the callback of [`Rig::with_progress`].
+///
+/// Reports come in order: by phase, and within a phase by `done`; the last one is
+/// [`Phase::Transforms`] with `done == total`, at [`Progress::fraction`] 1.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Progress {
+    /// The phase under way.
+    pub phase: Phase,
+    /// Steps of the phase done.
+    pub done: usize,
+    /// Steps of the phase, when known (`None` while Algorithm 1 runs).
+    pub total: Option<usize>,
+}
+
+impl Progress {
+    /// The build's progress in [0, 1], never lower than at an earlier report: each
+    /// phase has a share of the scale (a rough guess at its share of the time; the
+    /// virtual handles' is filled ever more slowly, as their number is not known).
+    pub fn fraction(&self) -> f64 {
+        let (start, end) = match self.phase {
+            Phase::Partition => (0.0, 0.1),
+            Phase::VirtualHandles => (0.1, 0.4),
+            Phase::Weights => (0.4, 0.6),
+            Phase::Transforms => (0.6, 1.0),
+        };
+        let within = match self.total {
+            Some(0) => 1.0,
+            Some(total) => (self.done as f64 / total as f64).min(1.0),
+            None => self.done as f64 / (self.done as f64 + 1000.0),
+        };
+        if within >= 1.0 {
+            end
+        } else {
+            (start + (end - start) * within).min(end)
+        }
+    }
+}
+
+/// Algorithm 1 reports its progress once every this many virtual handles.
+const PROGRESS_STEP: usize = 64;
+
+/// For each of the `old` handles, its index among `new` if it is there (the same rest
+/// geometry; equal handles are matched in order), `None` if it left.
+fn match_handles(old: &[Handle], new: &[Handle]) -> Vec<Option<usize>> {
+    // Rest geometry as bits (+ 0.0 makes −0 and 0 alike, as == has them).
+    let bits = |x: f64| (x + 0.0).to_bits();
+    let key = |h: &Handle| match *h {
+        Handle::Point { rest, .. } => (false, [bits(rest.x), bits(rest.y), 0, 0]),
+        Handle::Bar { rest: [a, b], .. } => (true, [bits(a.x), bits(a.y), bits(b.x), bits(b.y)]),
+    };
+    let mut waiting: HashMap<(bool, [u64; 4]), std::collections::VecDeque<usize>> = HashMap::new();
+    for (j, h) in new.iter().enumerate() {
+        waiting.entry(key(h)).or_default().push_back(j);
+    }
+    old.iter()
+        .map(|h| waiting.get_mut(&key(h)).and_then(|q| q.pop_front()))
+        .collect()
 }
 
 /// Sizes of a rig.
@@ -282,11 +376,12 @@ pub struct Rig {
     resolution: f64,
     timings: BuildTimings,
     update_timings: UpdateTimings,
-    /// The virtual handles placed while real nodes arrived, by sample, with the sample
-    /// of one of those real nodes: they go when it goes, so inserting and removing
-    /// handles does not leave ever more virtual handles behind. (Virtual handles from a
-    /// build, or placed while nodes only left, stay until crowded out.)
-    placed_for: HashMap<u32, u32>,
+    /// The virtual handles placed while a handle arrived, by sample, with that handle's
+    /// index (renumbered when handles before it go): they go when it goes, so inserting
+    /// and removing handles does not leave ever more virtual handles behind. (Virtual
+    /// handles from a build, or placed while handles only left, stay until crowded
+    /// out.)
+    placed_for: HashMap<u32, usize>,
 }
 
 impl Rig {
@@ -308,29 +403,114 @@ impl Rig {
     /// the weights it had.
     ///
     /// # Errors
-    /// As [`Rig::new`], and a virtual handle on a sample that does not exist.
+    /// As [`Rig::new`], a virtual handle on a sample that does not exist, and more
+    /// virtual handles than samples.
     pub fn with_virtual_handles(
         domain: Domain,
         handles: Vec<Handle>,
         virtual_vertices: &[u32],
         options: RigOptions,
     ) -> Result<Self, RigError> {
+        let placed: Vec<VirtualHandle> = virtual_vertices
+            .iter()
+            .map(|&vertex| VirtualHandle {
+                vertex,
+                placed_for: None,
+            })
+            .collect();
+        Self::with_progress(domain, handles, &placed, options, &|_| {})
+    }
+
+    /// As [`Rig::with_virtual_handles`], with the handle each virtual handle was placed
+    /// for (as [`Rig::placed_virtual_handles`] lists them): removing that handle later
+    /// takes them along, as it would have in the rig they were saved from.
+    ///
+    /// # Errors
+    /// As [`Rig::with_virtual_handles`], and a `placed_for` that names no handle.
+    pub fn with_placed_virtual_handles(
+        domain: Domain,
+        handles: Vec<Handle>,
+        virtual_handles: &[VirtualHandle],
+        options: RigOptions,
+    ) -> Result<Self, RigError> {
+        Self::with_progress(domain, handles, virtual_handles, options, &|_| {})
+    }
+
+    /// As [`Rig::with_placed_virtual_handles`], telling `progress` how far the build
+    /// has come (see [`Progress`]); it is called from the building threads, often, so
+    /// it should be quick (store the figure; draw elsewhere).
+    ///
+    /// ```
+    /// use std::sync::Mutex;
+    /// use glam::DVec2;
+    /// use weights_core::{Domain, Handle, Metric, Progress, Rig, RigOptions};
+    ///
+    /// let positions: Vec<DVec2> =
+    ///     (0..400).map(|i| DVec2::new((i % 20) as f64, (i / 20) as f64)).collect();
+    /// let mut triangles = Vec::new();
+    /// for y in 0..19u32 {
+    ///     for x in 0..19u32 {
+    ///         let a = y * 20 + x;
+    ///         triangles.push([a, a + 1, a + 21]);
+    ///         triangles.push([a, a + 21, a + 20]);
+    ///     }
+    /// }
+    /// let domain = Domain::new(positions, triangles, Metric::Intrinsic).unwrap();
+    /// let handles = vec![Handle::point(DVec2::new(2.0, 2.0)), Handle::point(DVec2::new(4.0, 2.0))];
+    /// let last = Mutex::new(0.0);
+    /// let rig = Rig::with_progress(domain, handles, &[], RigOptions::default(), &|p: Progress| {
+    ///     *last.lock().unwrap() = p.fraction();
+    /// })
+    /// .unwrap();
+    /// assert_eq!(*last.lock().unwrap(), 1.0);
+    /// assert!(rig.stats().virtual_nodes > 0);
+    /// ```
+    ///
+    /// # Errors
+    /// As [`Rig::with_placed_virtual_handles`].
+    pub fn with_progress(
+        domain: Domain,
+        handles: Vec<Handle>,
+        virtual_handles: &[VirtualHandle],
+        options: RigOptions,
+        progress: &(dyn Fn(Progress) + Sync),
+    ) -> Result<Self, RigError> {
         check_options(&options)?;
+        if virtual_handles.len() > domain.len() {
+            return Err(RigError::TooManyVirtual {
+                count: virtual_handles.len(),
+                samples: domain.len(),
+            });
+        }
         domain.prepare();
         let resolution = domain.mean_edge_length();
         let mut nodes = real_nodes(&domain, &handles, &options, resolution)?;
         let mut taken: std::collections::HashSet<u32> = nodes.iter().map(|n| n.vertex).collect();
-        for &v in virtual_vertices {
-            if v as usize >= domain.len() {
-                return Err(RigError::BadVirtual(v));
+        let mut placed_for = HashMap::new();
+        for (i, v) in virtual_handles.iter().enumerate() {
+            if v.vertex as usize >= domain.len() {
+                return Err(RigError::BadVirtual(v.vertex));
             }
-            if taken.insert(v) {
-                nodes.push(Node {
-                    vertex: v,
-                    kind: NodeKind::Virtual,
+            if let Some(h) = v.placed_for.filter(|&h| h >= handles.len()) {
+                return Err(RigError::BadPlacedFor {
+                    index: i,
+                    handle: h,
                 });
             }
+            if taken.insert(v.vertex) {
+                nodes.push(Node {
+                    vertex: v.vertex,
+                    kind: NodeKind::Virtual,
+                });
+                if let Some(h) = v.placed_for {
+                    placed_for.insert(v.vertex, h);
+                }
+            }
         }
+        let report = |phase, done, total| {
+            progress(Progress { phase, done, total });
+        };
+        report(Phase::Partition, 0, Some(1));
         let mut timings = BuildTimings::default();
         let clock = Instant::now();
         let mut partition = Partition::distances(&domain, nodes.iter().map(|n| n.vertex).collect());
@@ -338,17 +518,27 @@ impl Rig {
         let clock = Instant::now();
         partition.decompose(&domain);
         timings.voronoi_ms = ms(clock);
+        report(Phase::Partition, 1, Some(1));
+        report(Phase::VirtualHandles, 0, None);
         let clock = Instant::now();
-        for v in insert_virtual_handles(&domain, &mut partition, |_, _| {}) {
-            nodes.push(Node {
-                vertex: v,
-                kind: NodeKind::Virtual,
-            });
-        }
+        let mut placed = 0;
+        let added = insert_virtual_handles(&domain, &mut partition, |_, _| {
+            placed += 1;
+            if placed % PROGRESS_STEP == 0 {
+                report(Phase::VirtualHandles, placed, None);
+            }
+        });
+        report(Phase::VirtualHandles, added.len(), Some(added.len()));
+        nodes.extend(added.into_iter().map(|v| Node {
+            vertex: v,
+            kind: NodeKind::Virtual,
+        }));
         timings.virtual_ms = ms(clock);
+        report(Phase::Weights, 0, Some(1));
         let clock = Instant::now();
         let radii = support_radii(&partition, options.alpha);
         let weights = Weights::build(&domain, &partition, &radii, &options.basis);
+        report(Phase::Weights, 1, Some(1));
         let mut rig = Self {
             domain,
             options,
@@ -362,9 +552,16 @@ impl Rig {
             resolution,
             timings,
             update_timings: UpdateTimings::default(),
-            placed_for: HashMap::new(),
+            placed_for,
         };
-        rig.update_transforms();
+        rig.harmonic = harmonic_of(
+            &rig.domain,
+            &rig.partition,
+            &rig.nodes,
+            rig.handles.len(),
+            &|done, total| report(Phase::Transforms, done, Some(total)),
+        );
+        rig.update_affines();
         rig.timings.weights_ms = ms(clock);
         Ok(rig)
     }
@@ -433,10 +630,11 @@ impl Rig {
         }
         let clock = Instant::now();
         let target = real_nodes(&self.domain, &handles, &self.options, self.resolution)?;
+        let kept = match_handles(&self.handles, &handles);
         self.update_timings = UpdateTimings::default();
         self.update_timings.plan_ms = ms(clock);
         self.handles = handles;
-        self.apply(target);
+        self.apply(target, &kept);
         let clock = Instant::now();
         self.update_affines();
         self.update_timings.transforms_ms += ms(clock);
@@ -501,7 +699,9 @@ impl Rig {
 
     /// Moves the node set to `target` real nodes (virtual nodes kept unless a real node
     /// takes their sample), updating partition, virtual handles and weights locally.
-    fn apply(&mut self, target: Vec<Node>) {
+    /// `kept[i]` is the new index of the old handle `i`, `None` if it left; the
+    /// handles no old one became arrived.
+    fn apply(&mut self, target: Vec<Node>, kept: &[Option<usize>]) {
         let clock = Instant::now();
         let target_vertices: std::collections::HashSet<u32> =
             target.iter().map(|n| n.vertex).collect();
@@ -533,30 +733,33 @@ impl Rig {
             })
             .map(|(_, n)| n.vertex)
             .collect();
-        // Real nodes that leave take the virtual handles placed for them along.
-        let leaving_real: std::collections::HashSet<u32> = self
-            .nodes
-            .iter()
-            .filter(|n| n.kind != NodeKind::Virtual && !target_vertices.contains(&n.vertex))
-            .map(|n| n.vertex)
-            .collect();
+        // Handles that leave take the virtual handles placed for them along.
         let doomed: Vec<usize> = (0..self.nodes.len())
             .filter(|&k| {
                 let n = self.nodes[k];
                 if n.kind != NodeKind::Virtual {
-                    return leaving_real.contains(&n.vertex);
+                    return !target_vertices.contains(&n.vertex);
                 }
                 target_vertices.contains(&n.vertex)
                     || replaced.contains(&n.vertex)
                     || self
                         .placed_for
                         .get(&n.vertex)
-                        .is_some_and(|r| leaving_real.contains(r))
+                        .is_some_and(|&h| kept.get(h).copied().flatten().is_none())
             })
             .collect();
         for &k in &doomed {
             self.placed_for.remove(&self.nodes[k].vertex);
         }
+        for h in self.placed_for.values_mut() {
+            *h = kept.get(*h).copied().flatten().unwrap_or(*h);
+        }
+        // The first handle that arrives gets the virtual handles placed now.
+        let mut stays = vec![false; self.handles.len()];
+        for &i in kept.iter().flatten() {
+            stays[i] = true;
+        }
+        let first_arrival = stays.iter().position(|s| !s);
         // Radii of the surviving nodes, by sample (node numbers change below).
         let old_radius: HashMap<u32, f64> = (0..self.nodes.len())
             .filter(|k| doomed.binary_search(k).is_err())
@@ -709,7 +912,7 @@ impl Rig {
                     Some(Ball::compute_from(domain, v, radius, inner))
                 });
             });
-            if let Some(&first) = arriving.first() {
+            if let Some(first) = first_arrival {
                 placed_for.extend(added.iter().map(|&v| (v, first)));
             }
             nodes.extend(added.into_iter().map(|v| Node {
@@ -725,7 +928,7 @@ impl Rig {
             let transforms = &transforms;
             scope.spawn(move |_| {
                 let clock = Instant::now();
-                let harmonic = harmonic_of(domain, partition, nodes, handle_count);
+                let harmonic = harmonic_of(domain, partition, nodes, handle_count, &|_, _| {});
                 *transforms.lock().expect("not poisoned") = Some((harmonic, ms(clock)));
             });
         });
@@ -763,23 +966,6 @@ impl Rig {
         self.harmonic = harmonic;
         self.update_timings.weights_ms = ms(clock);
         self.update_timings.transforms_ms = transforms_ms;
-    }
-
-    /// Recomputes the dual graph, the virtual handles' harmonic coordinates and all
-    /// node transforms.
-    fn update_transforms(&mut self) {
-        self.harmonic = self.harmonic_coordinates_now();
-        self.update_affines();
-    }
-
-    /// The virtual handles' harmonic coordinates on the current dual graph.
-    fn harmonic_coordinates_now(&self) -> Vec<Option<Coefficients>> {
-        harmonic_of(
-            &self.domain,
-            &self.partition,
-            &self.nodes,
-            self.handles.len(),
-        )
     }
 
     fn group_of(&self, n: &Node) -> Option<usize> {
@@ -1008,6 +1194,22 @@ impl Rig {
             .iter()
             .filter(|n| n.kind == NodeKind::Virtual)
             .map(|n| n.vertex)
+            .collect()
+    }
+
+    /// The virtual handles in node order (as [`Rig::virtual_vertices`]), each with the
+    /// handle it was placed for, if any: the handle whose insertion placed it, which
+    /// takes it along when removed. Save this and rebuild with
+    /// [`Rig::with_placed_virtual_handles`] to get back a rig that also removes the
+    /// same virtual handles with each handle.
+    pub fn placed_virtual_handles(&self) -> Vec<VirtualHandle> {
+        self.nodes
+            .iter()
+            .filter(|n| n.kind == NodeKind::Virtual)
+            .map(|n| VirtualHandle {
+                vertex: n.vertex,
+                placed_for: self.placed_for.get(&n.vertex).copied(),
+            })
             .collect()
     }
 
@@ -1256,6 +1458,12 @@ fn real_nodes(
     options: &RigOptions,
     resolution: f64,
 ) -> Result<Vec<Node>, RigError> {
+    if handles.len() > MAX_HANDLES {
+        return Err(RigError::TooManyHandles {
+            count: handles.len(),
+            max: MAX_HANDLES,
+        });
+    }
     check_handles(handles)?;
     let (lo, hi) = domain.bounds();
     let tiny = 1e-9 * (hi - lo).length().max(1.0);
