@@ -45,6 +45,15 @@ pub fn build(source: &Source, project: &Project) -> Result<Built> {
         .with_context(|| format!("mesh {}", path.display()))?;
     project.validate(None)?;
     let file_vertices = mesh.vertices.len();
+    // Each virtual handle takes a vertex of its own; more than the mesh has cannot have
+    // been saved on it (and would each be inserted into it, one by one).
+    anyhow::ensure!(
+        project.virtual_handles.len() <= file_vertices,
+        "the rig lists {} virtual handles, more than the {file_vertices} vertices of mesh {} \
+         (at most one a vertex); leave out \"virtual_handles\" to have them placed afresh",
+        project.virtual_handles.len(),
+        path.display()
+    );
     let handles = pipeline::handles(project);
     let mut points: Vec<DVec2> = Vec::new();
     for (i, h) in handles.iter().enumerate() {

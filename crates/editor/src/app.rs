@@ -794,6 +794,7 @@ fn open_outcome(path: PathBuf) -> Outcome {
 fn without_virtuals(project: &project::Project) -> project::Project {
     project::Project {
         virtual_handles: Vec::new(),
+        virtual_placed_for: Vec::new(),
         ..project.clone()
     }
 }

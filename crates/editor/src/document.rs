@@ -116,6 +116,7 @@ impl Document {
         let prepared = pipeline::prepare(&image, &project, None)?;
         // Virtual handles live in the rig while editing; they are written out on save.
         project.virtual_handles.clear();
+        project.virtual_placed_for.clear();
         Ok(Self {
             project,
             image,
@@ -293,6 +294,7 @@ impl Document {
 
     fn restore_with(&mut self, mut project: Project, exact: bool) -> Result<()> {
         let virtuals = std::mem::take(&mut project.virtual_handles);
+        let placed_for = std::mem::take(&mut project.virtual_placed_for);
         let clock = Instant::now();
         let old = self.settings();
         let new = Settings::of(&project);
@@ -307,6 +309,7 @@ impl Document {
             let mut with_virtuals = project.clone();
             if exact {
                 with_virtuals.virtual_handles = virtuals;
+                with_virtuals.virtual_placed_for = placed_for;
             }
             self.rig = pipeline::prepare(&self.image, &with_virtuals, None)?.rig;
         } else if new == old && exact && !same_rest {

@@ -9,6 +9,9 @@
 //! Defaults: density 20000, N = 10 100 500 1000 2000 5000 10000. The handles are
 //! opaque pixels drawn at random (seeded), no two closer than `GAP` pixels (default 2),
 //! so that close pairs (timed by the `close_pair` examples) do not blur the picture.
+//! `PAIRS=1` puts a second handle one pixel right of each (gap at least 3 between
+//! pairs): the worst case, where nearly every sample becomes a virtual handle.
+//! `VIRTUAL=n` adds n virtual handles at random pixels, as a rig file may list them.
 //! `LIMIT=0` builds past the handle limit (what the limit protects against).
 
 use std::time::Instant;
@@ -43,6 +46,11 @@ fn main() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(2.0);
+    let pairs = std::env::var_os("PAIRS").is_some_and(|v| v == "1");
+    let virtuals: usize = std::env::var("VIRTUAL")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(0);
     let image = image::load_from_memory(DEFAULT_IMAGE)
         .expect("the built-in picture decodes")
         .to_rgba8();
@@ -82,6 +90,7 @@ fn main() {
         let mut rng = Rng(0x9E37_79B9_7F4A_7C15 ^ n as u64);
         // A grid of cells `gap` wide finds a too-close point among a few neighbours.
         let cell = gap.max(1.0);
+        let gap = if pairs { gap.max(3.0) } else { gap };
         let mut grid: std::collections::HashMap<(i64, i64), Vec<[f64; 2]>> =
             std::collections::HashMap::new();
         let mut points: Vec<[f64; 2]> = Vec::new();
@@ -98,10 +107,33 @@ fn main() {
                     })
                 })
             });
-            if !crowded {
+            // With PAIRS=1 every handle gets a partner one pixel to its right: the
+            // worst case, where Algorithm 1 must make nearly every sample a node.
+            let partner = [p[0] + 1.0, p[1]];
+            if !crowded && (!pairs || opaque(i64::from(x) + 4, i64::from(y))) {
                 grid.entry(key).or_default().push(p);
                 points.push(p);
+                if pairs && points.len() < n {
+                    points.push(partner);
+                }
             }
+        }
+        if std::env::var_os("CLUMP").is_some() {
+            // Every pixel nearest the centre of the shape: a solid block of handles.
+            let c = inside.iter().fold((0.0, 0.0), |a, &(x, y)| {
+                (a.0 + f64::from(x), a.1 + f64::from(y))
+            });
+            let c = (c.0 / inside.len() as f64, c.1 / inside.len() as f64);
+            let mut near = inside.clone();
+            near.sort_by(|a, b| {
+                let d = |p: &(u32, u32)| (f64::from(p.0) - c.0).hypot(f64::from(p.1) - c.1);
+                d(a).total_cmp(&d(b))
+            });
+            points = near
+                .iter()
+                .take(n)
+                .map(|&(x, y)| [f64::from(x) + 0.5, f64::from(y) + 0.5])
+                .collect();
         }
         let project = Project {
             handles: points
@@ -114,6 +146,16 @@ fn main() {
                 })
                 .collect(),
             density: Some(density),
+            virtual_handles: (0..virtuals)
+                .map(|_| {
+                    let (x, y) = inside[rng.below(inside.len())];
+                    let (dx, dy) = (rng.below(1000), rng.below(1000));
+                    [
+                        f64::from(x) + dx as f64 / 1000.0,
+                        f64::from(y) + dy as f64 / 1000.0,
+                    ]
+                })
+                .collect(),
             ..base.clone()
         };
         let clock = Instant::now();

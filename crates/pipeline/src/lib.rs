@@ -6,7 +6,9 @@ use glam::{DVec2, Vec2};
 use image::RgbaImage;
 use mesh::{Constraints, DomainOptions, MeshOptions};
 use project::{HandleSpec, MetricChoice, Middle, Project};
-use weights_core::{Basis, Domain, Handle, Metric, MiddleControls, Rig, RigOptions, Similarity};
+use weights_core::{
+    Basis, Domain, Handle, Metric, MiddleControls, Rig, RigOptions, Similarity, VirtualHandle,
+};
 
 /// The picture the editor opens with and the demo warps (public domain, see
 /// `assets/LICENSES.md`).
@@ -34,6 +36,13 @@ pub fn load_image(path: &std::path::Path) -> Result<RgbaImage> {
 
 /// Target vertex count of the mesh when neither the project nor the command says.
 pub const DEFAULT_DENSITY: usize = 20_000;
+
+/// The most virtual handles a rig file may list for each vertex the mesh aims at
+/// (its density): each virtual handle takes a vertex of its own, and a mesh lands
+/// within about 30% of its target, so a file with more was not saved from a rig at
+/// this density. Such a file is refused before meshing (2.5 million virtual handles
+/// would take minutes and gigabytes).
+pub const MAX_VIRTUAL_PER_VERTEX: usize = 2;
 
 /// The user handles of a project.
 pub fn handles(project: &Project) -> Vec<Handle> {
@@ -122,14 +131,40 @@ pub struct Prepared {
 /// default) and builds the rig.
 ///
 /// # Errors
-/// Handles off the image or the shape, coincident handles, an image with no opaque
-/// pixel, and the like, each as one sentence.
+/// Handles off the image or the shape, coincident handles, more handles than
+/// [`project::MAX_HANDLES`], more virtual handles than [`MAX_VIRTUAL_PER_VERTEX`] times
+/// the density, an image with no opaque pixel, and the like, each as one sentence.
 pub fn prepare(image: &RgbaImage, project: &Project, density: Option<usize>) -> Result<Prepared> {
+    prepare_with_progress(image, project, density, &|_| {})
+}
+
+/// As [`prepare`], telling `progress` how far the rig build has come (see
+/// [`weights_core::Progress`]; meshing, before it, is not reported). It is called from
+/// the building threads, often: it should only store the figure.
+///
+/// # Errors
+/// As [`prepare`].
+pub fn prepare_with_progress(
+    image: &RgbaImage,
+    project: &Project,
+    density: Option<usize>,
+    progress: &(dyn Fn(weights_core::Progress) + Sync),
+) -> Result<Prepared> {
     project.validate(Some(image.dimensions()))?;
+    let target_vertices = density.or(project.density).unwrap_or(DEFAULT_DENSITY);
+    let most = MAX_VIRTUAL_PER_VERTEX.saturating_mul(target_vertices);
+    if project.virtual_handles.len() > most {
+        bail!(
+            "the rig lists {} virtual handles, more than a mesh of {target_vertices} vertices \
+             can carry: C2Warp takes at most {most} ({MAX_VIRTUAL_PER_VERTEX} per vertex of \
+             the density); leave out \"virtual_handles\" to have them placed afresh",
+            project.virtual_handles.len()
+        );
+    }
     let handles = handles(project);
     let (points, bars) = constraints(project, &handles);
     let options = MeshOptions {
-        target_vertices: density.or(project.density).unwrap_or(DEFAULT_DENSITY),
+        target_vertices,
         ..MeshOptions::default()
     };
     let mesh = mesh::mesh_image(
@@ -142,14 +177,27 @@ pub fn prepare(image: &RgbaImage, project: &Project, density: Option<usize>) -> 
         },
     )
     .context("cannot mesh the image")?;
-    let virtual_vertices: Vec<u32> =
-        mesh.point_vertices[points.len() - project.virtual_handles.len()..].to_vec();
+    let first_virtual = points.len() - project.virtual_handles.len();
+    let virtual_handles: Vec<VirtualHandle> = mesh.point_vertices[first_virtual..]
+        .iter()
+        .enumerate()
+        .map(|(i, &vertex)| VirtualHandle {
+            vertex,
+            placed_for: project.virtual_placed_for.get(i).copied().flatten(),
+        })
+        .collect();
     let domain = Domain::new(
         mesh.mesh.vertices.clone(),
         mesh.mesh.triangles.clone(),
         metric(project.metric, mesh.is_convex),
     )?;
-    let rig = Rig::with_virtual_handles(domain, handles, &virtual_vertices, rig_options(project)?)?;
+    let rig = Rig::with_progress(
+        domain,
+        handles,
+        &virtual_handles,
+        rig_options(project)?,
+        progress,
+    )?;
     Ok(Prepared { rig })
 }
 
@@ -206,4 +254,100 @@ pub fn warp(image: &RgbaImage, rig: &Rig) -> Result<RgbaImage> {
         h,
         &render::RasterOptions::default(),
     )?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lizard() -> RgbaImage {
+        image::load_from_memory(DEFAULT_IMAGE)
+            .expect("the built-in picture decodes")
+            .to_rgba8()
+    }
+
+    #[test]
+    fn the_handle_limits_agree() {
+        assert_eq!(project::MAX_HANDLES, weights_core::MAX_HANDLES);
+    }
+
+    #[test]
+    fn a_rig_with_more_virtual_handles_than_its_mesh_can_carry_is_refused_before_meshing() {
+        let mut project = Project::from_json(DEFAULT_RIG).expect("the built-in rig");
+        project.density = Some(2000);
+        project.virtual_handles = (0..4001)
+            .map(|i| [300.0 + (i % 50) as f64 * 0.1, 250.0])
+            .collect();
+        let clock = std::time::Instant::now();
+        let err = prepare(&lizard(), &project, None)
+            .err()
+            .expect("too many virtual handles")
+            .to_string();
+        assert!(
+            err.contains("4001 virtual handles") && err.contains("at most 4000"),
+            "{err}"
+        );
+        assert!(clock.elapsed().as_secs_f64() < 1.0);
+    }
+
+    #[test]
+    fn virtual_handles_keep_the_handle_they_were_placed_for_through_a_file() {
+        let image = lizard();
+        let mut project = Project::from_json(DEFAULT_RIG).expect("the built-in rig");
+        project.density = Some(5000);
+        let mut rig = prepare(&image, &project, None).expect("builds").rig;
+        // A handle beside another: virtual handles placed for it.
+        let new = rig
+            .insert_handle(Handle::point(DVec2::new(446.0, 238.0)))
+            .expect("room");
+        let placed = rig.placed_virtual_handles();
+        let positions = rig.domain().positions();
+        assert!(
+            placed.iter().any(|v| v.placed_for == Some(new)),
+            "{placed:?}"
+        );
+        let point = |p: DVec2| project::HandleSpec::Point {
+            rest: p.to_array(),
+            translate: [0.0, 0.0],
+            rotate: 0.0,
+            scale: 1.0,
+        };
+        project.handles.push(point(DVec2::new(446.0, 238.0)));
+        project.virtual_handles = placed
+            .iter()
+            .map(|v| positions[v.vertex as usize].to_array())
+            .collect();
+        project.virtual_placed_for = placed.iter().map(|v| v.placed_for).collect();
+        let saved = Project::from_json(&project.to_json()).expect("round trip");
+        let mut reloaded = prepare(&image, &saved, None).expect("builds").rig;
+        let at = |rig: &Rig, v: &VirtualHandle| {
+            let p = rig.domain().positions()[v.vertex as usize];
+            ((p.x * 1e6).round() as i64, (p.y * 1e6).round() as i64)
+        };
+        let theirs: Vec<_> = placed
+            .iter()
+            .filter(|v| v.placed_for == Some(new))
+            .map(|v| at(&rig, v))
+            .collect();
+        let reloaded_theirs: Vec<_> = reloaded
+            .placed_virtual_handles()
+            .iter()
+            .filter(|v| v.placed_for == Some(new))
+            .map(|v| at(&reloaded, v))
+            .collect();
+        assert_eq!(reloaded_theirs, theirs);
+        reloaded.remove_handle(new).expect("exists");
+        let left: Vec<_> = reloaded
+            .placed_virtual_handles()
+            .iter()
+            .map(|v| at(&reloaded, v))
+            .collect();
+        assert!(theirs.iter().all(|p| !left.contains(p)), "{left:?}");
+        assert!(
+            reloaded
+                .placed_virtual_handles()
+                .iter()
+                .all(|v| v.placed_for.is_none())
+        );
+    }
 }

@@ -20,6 +20,12 @@ use serde::{Deserialize, Serialize};
 /// The file format version this crate reads and writes.
 pub const VERSION: u32 = 1;
 
+/// The most handles a rig file may have: the weights are built for up to this many
+/// (`weights_core::MAX_HANDLES`; this crate does not depend on it, and the pipeline's
+/// tests check that the two agree). A larger rig is refused with a message naming the
+/// limit before anything is computed.
+pub const MAX_HANDLES: usize = 10_000;
+
 /// Which distance the weights use.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "lowercase")]
@@ -115,6 +121,13 @@ pub struct Project {
     /// exactly the weights it had. Omit to let them be computed afresh.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub virtual_handles: Vec<[f64; 2]>,
+    /// For each of [`Project::virtual_handles`], in the same order, the index into
+    /// [`Project::handles`] of the handle it was placed for (`null` for none), so that
+    /// removing that handle after a reload takes it along, as it would have before.
+    /// Either empty (omitted: no virtual handle was placed for a handle, as in files
+    /// from before this field) or as long as `virtual_handles`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub virtual_placed_for: Vec<Option<usize>>,
 }
 
 impl Default for Project {
@@ -130,6 +143,7 @@ impl Default for Project {
             density: None,
             handles: Vec::new(),
             virtual_handles: Vec::new(),
+            virtual_placed_for: Vec::new(),
         }
     }
 }
@@ -177,13 +191,42 @@ impl Project {
         s
     }
 
-    /// Checks ranges and finiteness, and with `image_size = Some((w, h))` that every
-    /// handle lies on the image.
+    /// Checks ranges and finiteness, the number of handles (at most [`MAX_HANDLES`]),
+    /// that [`Project::virtual_placed_for`] matches the virtual handles and names
+    /// handles that exist, and with `image_size = Some((w, h))` that every handle lies
+    /// on the image.
     ///
     /// # Errors
     /// The first problem found, naming the handle.
     pub fn validate(&self, image_size: Option<(u32, u32)>) -> Result<(), ProjectError> {
         let bad = |m: String| Err(ProjectError::Invalid(m));
+        if self.handles.len() > MAX_HANDLES {
+            return bad(format!(
+                "{} handles; C2Warp is built for up to {MAX_HANDLES} handles",
+                self.handles.len()
+            ));
+        }
+        if !self.virtual_placed_for.is_empty() {
+            if self.virtual_placed_for.len() != self.virtual_handles.len() {
+                return bad(format!(
+                    "virtual_placed_for has {} entries for {} virtual handles (one each, or \
+                     leave it out)",
+                    self.virtual_placed_for.len(),
+                    self.virtual_handles.len()
+                ));
+            }
+            if let Some((i, h)) = self
+                .virtual_placed_for
+                .iter()
+                .enumerate()
+                .find_map(|(i, h)| h.filter(|&h| h >= self.handles.len()).map(|h| (i, h)))
+            {
+                return bad(format!(
+                    "virtual handle {i} was placed for handle {h}, but there are {} handles",
+                    self.handles.len()
+                ));
+            }
+        }
         if !(0.0..=1.0).contains(&self.alpha) {
             return bad(format!("alpha must be in [0, 1], got {}", self.alpha));
         }
@@ -282,6 +325,7 @@ mod tests {
                 },
             ],
             virtual_handles: vec![[5.0, 6.0], [0.1, 0.2]],
+            virtual_placed_for: vec![Some(1), None],
             ..Project::default()
         }
     }
@@ -342,6 +386,14 @@ mod tests {
                 "scale",
             ),
             (r#"{"version":1,"handels":[]}"#, "malformed"),
+            (
+                r#"{"version":1,"handles":[],"virtual_handles":[[1,1]],"virtual_placed_for":[null,0]}"#,
+                "2 entries for 1 virtual handles",
+            ),
+            (
+                r#"{"version":1,"handles":[{"type":"point","rest":[1,1]}],"virtual_handles":[[1,2]],"virtual_placed_for":[1]}"#,
+                "placed for handle 1, but there are 1 handles",
+            ),
         ];
         for (text, expected) in cases {
             let err = Project::from_json(text).expect_err(text).to_string();
@@ -357,5 +409,41 @@ mod tests {
             .validate(Some((20, 20)))
             .expect_err("bar end off the image");
         assert!(err.to_string().contains("outside the image"), "{err}");
+    }
+
+    #[test]
+    fn files_without_virtual_placed_for_still_load_and_files_with_it_round_trip() {
+        let old = r#"{"version":1,"handles":[{"type":"point","rest":[1,2]}],"virtual_handles":[[3,4],[5,6]]}"#;
+        let p = Project::from_json(old).expect("an older file");
+        assert!(p.virtual_placed_for.is_empty());
+        assert!(!p.to_json().contains("virtual_placed_for"));
+        let with = Project {
+            virtual_placed_for: vec![None, Some(0)],
+            ..p
+        };
+        let text = with.to_json();
+        assert!(text.contains("\"virtual_placed_for\""), "{text}");
+        assert_eq!(Project::from_json(&text).expect("parses"), with);
+    }
+
+    #[test]
+    fn too_many_handles_are_refused_naming_the_limit() {
+        let point = HandleSpec::Point {
+            rest: [1.0, 1.0],
+            translate: [0.0, 0.0],
+            rotate: 0.0,
+            scale: 1.0,
+        };
+        let mut p = Project {
+            handles: vec![point; MAX_HANDLES],
+            ..Project::default()
+        };
+        assert!(p.validate(None).is_ok());
+        p.handles.push(p.handles[0].clone());
+        let err = p.validate(None).expect_err("one too many").to_string();
+        assert!(
+            err.contains("10001 handles; C2Warp is built for up to 10000 handles"),
+            "{err}"
+        );
     }
 }
