@@ -15,6 +15,11 @@
 //! its support (Algorithm 1); their transforms blend the real handles' by harmonic
 //! coordinates on the dual graph. Inserting or removing a handle updates only what it
 //! changes and gives the same weights as a rebuild with the same nodes.
+//!
+//! A rig takes up to [`MAX_HANDLES`] handles; [`Rig::with_progress`] tells a caller how
+//! far a long build has come, and [`Rig::placed_virtual_handles`] with
+//! [`Rig::with_placed_virtual_handles`] save and restore the virtual handles together
+//! with the handle each was placed for.
 
 mod basis;
 mod domain;

@@ -699,8 +699,8 @@ impl Rig {
 
     /// Moves the node set to `target` real nodes (virtual nodes kept unless a real node
     /// takes their sample), updating partition, virtual handles and weights locally.
-    /// `kept[i]` is the new index of the old handle `i`, `None` if it left; the
-    /// handles no old one became arrived.
+    /// `kept[i]` is the new index of the old handle `i`, `None` if it left; new
+    /// handles that no old one became have arrived.
     fn apply(&mut self, target: Vec<Node>, kept: &[Option<usize>]) {
         let clock = Instant::now();
         let target_vertices: std::collections::HashSet<u32> =

@@ -7,7 +7,7 @@
 //! none (the farthest sample of a cell with r_d > 0), so the loop ends after at most as
 //! many insertions as there are samples.
 
-use std::collections::{BinaryHeap, HashMap};
+use std::collections::{BinaryHeap, HashMap, HashSet};
 
 use crate::domain::{Domain, Metric};
 use crate::voronoi::Partition;
@@ -44,6 +44,12 @@ impl std::hash::Hasher for SquareHasher {
         }
     }
     fn write_i64(&mut self, x: i64) {
+        self.write_u64(x as u64);
+    }
+    fn write_u32(&mut self, x: u32) {
+        self.write_u64(u64::from(x));
+    }
+    fn write_usize(&mut self, x: usize) {
         self.write_u64(x as u64);
     }
     fn write_u64(&mut self, x: u64) {
@@ -125,6 +131,10 @@ pub(crate) fn insert_virtual_handles(
         })
         .collect();
     let mut taken = vec![false; partition.len()];
+    // Each cell's farthest samples (up to MAX_TIED_PER_CELL), kept until add_node says
+    // the cell changed: where thousands of cells tie, most of a round's violators are
+    // merged and come up again unchanged next round.
+    let mut farthest: Vec<Option<Vec<u32>>> = vec![None; partition.len()];
     loop {
         let round_start = added.len();
         // The current violators within TIE of the worst, worst first, then by sample.
@@ -147,7 +157,7 @@ pub(crate) fn insert_virtual_handles(
         if violators.is_empty() {
             break;
         }
-        let mut touched: Vec<usize> = violators.iter().map(|v| v.1).collect();
+        let mut touched: Vec<usize> = Vec::new();
         for &(_, k) in &violators {
             taken[k] = false;
         }
@@ -176,13 +186,17 @@ pub(crate) fn insert_virtual_handles(
             }
         };
         let mut grid: HashMap<(i64, i64), Vec<(u32, usize)>, SquareHash> = HashMap::default();
+        // (group, sample) pairs already in, so that a group that draws hundreds of
+        // candidates does not search its member list for each.
+        let mut joined: HashSet<(usize, u32), SquareHash> = HashSet::default();
         for &(_, k) in &violators {
             let r_h = partition.stats[k].r_h;
-            for far in partition
-                .farthest_samples(domain, k)
-                .into_iter()
-                .take(MAX_TIED_PER_CELL)
-            {
+            let samples = farthest[k].get_or_insert_with(|| {
+                let mut all = partition.farthest_samples(domain, k);
+                all.truncate(MAX_TIED_PER_CELL);
+                all
+            });
+            for &far in samples.iter() {
                 let p = positions[far as usize];
                 let (sx, sy) = square(p);
                 // The first group (in order of creation) with a member closer than the
@@ -196,12 +210,13 @@ pub(crate) fn insert_virtual_handles(
                     .min();
                 match near {
                     Some(g) => {
-                        if !groups[g].0.contains(&far) {
+                        if joined.insert((g, far)) {
                             groups[g].0.push(far);
                             grid.entry((sx, sy)).or_default().push((far, g));
                         }
                     }
                     None => {
+                        joined.insert((groups.len(), far));
                         grid.entry((sx, sy)).or_default().push((far, groups.len()));
                         groups.push((vec![far], r_h));
                     }
@@ -250,6 +265,13 @@ pub(crate) fn insert_virtual_handles(
         // The violators of this round that are left, and every cell whose radii may
         // have changed, come up again with their current ratio.
         taken.resize(partition.len(), false);
+        farthest.resize(partition.len(), None);
+        touched.sort_unstable();
+        touched.dedup();
+        for &k in &touched {
+            farthest[k] = None;
+        }
+        touched.extend(violators.iter().map(|v| v.1));
         touched.sort_unstable();
         touched.dedup();
         heap.extend(touched.into_iter().filter_map(|k| {
