@@ -12,6 +12,8 @@
 //! `PAIRS=1` puts a second handle one pixel right of each (gap at least 3 between
 //! pairs): the worst case, where nearly every sample becomes a virtual handle.
 //! `VIRTUAL=n` adds n virtual handles at random pixels, as a rig file may list them.
+//! `INSERTS=k` also times inserting a point handle at k random places (each removed
+//! again), as a click in the editor does. `PRINT=1` counts the harmonic coefficients.
 //! `LIMIT=0` builds past the handle limit (what the limit protects against).
 
 use std::time::Instant;
@@ -171,6 +173,43 @@ fn main() {
                         .map(<[_]>::len)
                         .sum();
                     println!("harmonic coefficients: {entries}");
+                }
+                // With INSERTS=k: insert a point handle at k random places (each
+                // removed again), as the editor does on a click; the median times.
+                let inserts: usize = std::env::var("INSERTS")
+                    .ok()
+                    .and_then(|s| s.parse().ok())
+                    .unwrap_or(0);
+                let mut rig = prepared.rig.clone();
+                let (mut ins, mut rem) = (Vec::new(), Vec::new());
+                let mut refused = 0;
+                while ins.len() < inserts && refused < 100 * inserts {
+                    let (x, y) = inside[rng.below(inside.len())];
+                    let p = glam::DVec2::new(f64::from(x) + 0.25, f64::from(y) + 0.25);
+                    let clock = Instant::now();
+                    let i = match rig.insert_handle(weights_core::Handle::point(p)) {
+                        Ok(i) => i,
+                        Err(e) => {
+                            refused += 1;
+                            if refused == 1 {
+                                println!("insertion refused: {e}");
+                            }
+                            continue;
+                        }
+                    };
+                    ins.push(clock.elapsed().as_secs_f64() * 1e3);
+                    let clock = Instant::now();
+                    rig.remove_handle(i).expect("just inserted");
+                    rem.push(clock.elapsed().as_secs_f64() * 1e3);
+                }
+                if !ins.is_empty() {
+                    ins.sort_by(f64::total_cmp);
+                    rem.sort_by(f64::total_cmp);
+                    println!(
+                        "insert a handle: median {:.1} ms, remove it: median {:.1} ms",
+                        ins[ins.len() / 2],
+                        rem[rem.len() / 2]
+                    );
                 }
                 println!(
                     "{:>6} {:>8} {:>8} {:>9.0} {:>9.0} {:>9.0} {:>9.0} {:>9.0} {:>9.2}",

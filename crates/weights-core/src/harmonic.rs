@@ -7,7 +7,7 @@ use glam::DVec2;
 use rayon::prelude::*;
 
 use crate::domain::{Domain, Metric};
-use crate::ldl::{Ldl, dissection_order};
+use crate::ldl::{BLOCK, Ldl, dissection_order};
 use crate::voronoi::{NONE, Partition};
 
 /// The dual graph: pairs of nodes whose closed cells share a mesh edge, each pair once
@@ -178,7 +178,8 @@ pub(crate) fn harmonic_coordinates(
     node_group: &[Option<usize>],
     edges: &[(u32, u32)],
     progress: &(dyn Fn(usize, usize) + Sync),
-) -> Vec<Option<Coefficients>> {
+    earlier: &Solved,
+) -> (Vec<Option<Coefficients>>, Solved) {
     let n = node_vertex.len();
     // Free nodes in a canonical order (by sample), so results do not depend on how the
     // nodes happen to be numbered.
@@ -247,35 +248,95 @@ pub(crate) fn harmonic_coordinates(
     progress(0, total);
     // Solves done so far, told in order.
     let done = std::sync::Mutex::new(0usize);
-    let solved_one = || {
+    let solved_some = |count: usize| {
         let mut done = done
             .lock()
             .unwrap_or_else(std::sync::PoisonError::into_inner);
-        *done += 1;
-        progress(*done, total);
+        for _ in 0..count {
+            *done += 1;
+            progress(*done, total);
+        }
     };
-    let solved: Vec<Vec<Coefficients>> = components
+    // A component solved before, with the same inputs, is taken as it was.
+    let solved: Vec<(Vec<u64>, SolvedRows)> = components
         .par_iter()
         .zip(&touched)
         .map(|(members, groups)| {
-            solve_component(
+            let key = component_key(
+                node_vertex,
+                node_group,
+                (&free, &index, &adjacency),
+                members,
+                groups,
+            );
+            if let Some(rows) = earlier.0.get(&key) {
+                solved_some(groups.len());
+                return (key, rows.clone());
+            }
+            let rows = solve_component(
                 positions,
                 node_vertex,
                 node_group,
                 (&free, &index, &adjacency),
                 members,
                 groups,
-                &solved_one,
-            )
+                &solved_some,
+            );
+            (key, rows.into())
         })
         .collect();
     let mut out: Vec<Option<Coefficients>> = vec![None; n];
-    for (members, rows) in components.iter().zip(solved) {
-        for (&i, row) in members.iter().zip(rows) {
-            out[free[i as usize]] = Some(row);
+    for ((members, groups), (_, rows)) in components.iter().zip(&touched).zip(&solved) {
+        for (&i, row) in members.iter().zip(rows.iter()) {
+            let named: Coefficients = row
+                .iter()
+                .map(|&(rank, v)| (groups[rank as usize], v))
+                .collect();
+            out[free[i as usize]] = Some(named);
         }
     }
-    out
+    (out, Solved(solved.into_iter().collect()))
+}
+
+/// A component's rows, each coefficient with the rank of its group among those the
+/// component touches.
+type SolvedRows = std::sync::Arc<[Coefficients]>;
+
+/// The components solved by a call of [`harmonic_coordinates`], by their inputs: the
+/// next call takes those it meets again as they are. An insertion changes the dual
+/// graph only near the new handle, so with thousands of handles it re-solves a few
+/// components instead of all.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Solved(std::collections::HashMap<Vec<u64>, SolvedRows>);
+
+/// Everything a component's solution depends on: its members' samples, and for each
+/// member its neighbours in order, free ones by sample, real ones by sample and the
+/// rank of their group among those the component touches (ranks, not group numbers,
+/// so that handles renumbered after a removal do not count as a change). The edge
+/// weights and the ordering follow from the samples' positions.
+fn component_key(
+    node_vertex: &[u32],
+    node_group: &[Option<usize>],
+    (free, _, adjacency): FreeGraph,
+    members: &[u32],
+    groups: &[u32],
+) -> Vec<u64> {
+    let mut key = Vec::with_capacity(members.len() * 8);
+    for &i in members {
+        let k = free[i as usize];
+        key.push(u64::from(node_vertex[k]) | (adjacency[k].len() as u64) << 32);
+        for &(j, _) in &adjacency[k] {
+            let sample = u64::from(node_vertex[j]);
+            key.push(match node_group[j] {
+                None => sample,
+                Some(g) => {
+                    let rank = groups.binary_search(&(g as u32)).unwrap_or(0) as u64;
+                    1 << 63 | rank << 32 | sample
+                }
+            });
+        }
+    }
+    key
 }
 
 /// The free nodes in canonical order, each node's index among them, and the dual graph
@@ -284,7 +345,8 @@ type FreeGraph<'a> = (&'a [usize], &'a [u32], &'a [Vec<(usize, f64)>]);
 
 /// The coefficients of one component of free nodes (`members`: free indices,
 /// ascending), in the members' order, over the groups it touches (`groups`,
-/// ascending); `solved` is called after each group's solve.
+/// ascending), each named by its rank among them; `solved` is called after each
+/// group's solve.
 fn solve_component(
     positions: &[DVec2],
     node_vertex: &[u32],
@@ -292,7 +354,7 @@ fn solve_component(
     (free, index, adjacency): FreeGraph,
     members: &[u32],
     groups: &[u32],
-    solved: &(dyn Fn() + Sync),
+    solved: &(dyn Fn(usize) + Sync),
 ) -> Vec<Coefficients> {
     let m = members.len();
     // Local numbering: position in `members`.
@@ -333,31 +395,36 @@ fn solve_component(
     let order = dissection_order(&points, &inner);
     let Some(ldl) = Ldl::factor(&diagonal, &inner, order) else {
         // Not reached: a component with an edge to a real node is positive definite.
-        groups.iter().for_each(|_| solved());
+        solved(groups.len());
         return vec![Box::default(); m];
     };
     // One solve per group, in parallel; each group's values kept where positive.
     let columns: Vec<Vec<(u32, f64)>> = rhs
-        .par_iter()
+        .par_chunks(BLOCK)
         .map_init(
-            || (vec![0.0; m], vec![0.0; m]),
-            |(x, work), b| {
-                ldl.solve(b, x, work);
-                let column = x
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, v)| **v >= NEGLIGIBLE)
-                    .map(|(l, v)| (l as u32, *v))
+            || (vec![[0.0; BLOCK]; m], vec![[0.0; BLOCK]; m]),
+            |(x, work), block| {
+                let bs: Vec<&[(u32, f64)]> = block.iter().map(Vec::as_slice).collect();
+                ldl.solve_block(&bs, x, work);
+                let columns: Vec<Vec<(u32, f64)>> = (0..block.len())
+                    .map(|r| {
+                        x.iter()
+                            .enumerate()
+                            .filter(|(_, v)| v[r] >= NEGLIGIBLE)
+                            .map(|(l, v)| (l as u32, v[r]))
+                            .collect()
+                    })
                     .collect();
-                solved();
-                column
+                solved(block.len());
+                columns
             },
         )
+        .flatten()
         .collect();
     let mut rows: Vec<Vec<(u32, f64)>> = vec![Vec::new(); m];
     for (c, column) in columns.iter().enumerate() {
         for &(l, v) in column {
-            rows[l as usize].push((groups[c], v));
+            rows[l as usize].push((c as u32, v));
         }
     }
     rows.into_iter()
@@ -382,7 +449,15 @@ mod tests {
         let node_vertex: Vec<u32> = (0..5).collect();
         let groups = [Some(0), None, None, None, Some(1)];
         let edges = [(0, 1), (1, 2), (2, 3), (3, 4)];
-        let h = harmonic_coordinates(&positions, &node_vertex, &groups, &edges, &|_, _| {});
+        let h = harmonic_coordinates(
+            &positions,
+            &node_vertex,
+            &groups,
+            &edges,
+            &|_, _| {},
+            &Solved::default(),
+        )
+        .0;
         for (i, c) in h.iter().enumerate().take(4).skip(1) {
             let c = c.as_ref().expect("free");
             assert_eq!((c[0].0, c[1].0), (0, 1));
@@ -398,7 +473,15 @@ mod tests {
         let node_vertex: Vec<u32> = (0..4).collect();
         let groups = [Some(0), None, None, None];
         let edges = [(0, 1), (2, 3)];
-        let h = harmonic_coordinates(&positions, &node_vertex, &groups, &edges, &|_, _| {});
+        let h = harmonic_coordinates(
+            &positions,
+            &node_vertex,
+            &groups,
+            &edges,
+            &|_, _| {},
+            &Solved::default(),
+        )
+        .0;
         assert_eq!(h[1].as_deref(), Some(&[(0, 1.0)][..]));
         assert_eq!(h[2].as_deref(), Some(&[][..]));
     }
@@ -410,7 +493,15 @@ mod tests {
         let node_vertex: Vec<u32> = (0..6).collect();
         let node_group = [Some(0), None, None, Some(1), None, Some(2)];
         let edges = [(0, 1), (1, 2), (2, 3), (4, 5)];
-        let h = harmonic_coordinates(&positions, &node_vertex, &node_group, &edges, &|_, _| {});
+        let h = harmonic_coordinates(
+            &positions,
+            &node_vertex,
+            &node_group,
+            &edges,
+            &|_, _| {},
+            &Solved::default(),
+        )
+        .0;
         let groups_of =
             |k: usize| -> Vec<u32> { h[k].as_deref().expect("free").iter().map(|e| e.0).collect() };
         assert_eq!(groups_of(1), vec![0, 1]);
@@ -446,7 +537,15 @@ mod tests {
                 }
             }
         }
-        let h = harmonic_coordinates(&p, &node_vertex, &node_group, &edges, &|_, _| {});
+        let h = harmonic_coordinates(
+            &p,
+            &node_vertex,
+            &node_group,
+            &edges,
+            &|_, _| {},
+            &Solved::default(),
+        )
+        .0;
         let value = |k: usize, g: u32| -> f64 {
             match node_group[k] {
                 Some(own) => f64::from(u8::from(own as u32 == g)),

@@ -211,7 +211,9 @@ impl Ldl {
     }
 
     /// Solves `A x = b` for `b` given as `(unknown, value)` pairs (repeats add up),
-    /// into `x` (length [`Ldl::len`]); `work` is scratch of the same length.
+    /// into `x` (length [`Ldl::len`]); `work` is scratch of the same length. (The
+    /// reference that [`Ldl::solve_block`], which the crate uses, is tested against.)
+    #[cfg(test)]
     pub(crate) fn solve(&self, b: &[(u32, f64)], x: &mut [f64], work: &mut [f64]) {
         let n = self.len();
         let y = work;
@@ -246,7 +248,64 @@ impl Ldl {
             x[v as usize] = y[k];
         }
     }
+
+    /// As [`Ldl::solve`] for up to [`BLOCK`] right-hand sides at once (`x[v][r]` for
+    /// the r-th): one pass over the factor serves them all, and each gets exactly the
+    /// values [`Ldl::solve`] would give it.
+    pub(crate) fn solve_block(
+        &self,
+        bs: &[&[(u32, f64)]],
+        x: &mut [[f64; BLOCK]],
+        work: &mut [[f64; BLOCK]],
+    ) {
+        debug_assert!(bs.len() <= BLOCK);
+        let n = self.len();
+        let y = work;
+        y.fill([0.0; BLOCK]);
+        let mut position = n;
+        for (r, b) in bs.iter().enumerate() {
+            for &(i, v) in *b {
+                let k = self.position[i as usize] as usize;
+                y[k][r] += v;
+                position = position.min(k);
+            }
+        }
+        for j in position..n {
+            let yj = y[j];
+            if yj != [0.0; BLOCK] {
+                let (start, end) = (self.col_start[j], self.col_start[j + 1]);
+                for (&i, &value) in self.rows[start..end].iter().zip(&self.values[start..end]) {
+                    let row = &mut y[i as usize];
+                    for r in 0..BLOCK {
+                        row[r] -= value * yj[r];
+                    }
+                }
+            }
+        }
+        for (yj, d) in y.iter_mut().zip(&self.diag) {
+            for v in yj.iter_mut() {
+                *v /= d;
+            }
+        }
+        for j in (0..n).rev() {
+            let mut s = y[j];
+            let (start, end) = (self.col_start[j], self.col_start[j + 1]);
+            for (&i, &value) in self.rows[start..end].iter().zip(&self.values[start..end]) {
+                let row = y[i as usize];
+                for r in 0..BLOCK {
+                    s[r] -= value * row[r];
+                }
+            }
+            y[j] = s;
+        }
+        for (k, &v) in self.order.iter().enumerate() {
+            x[v as usize] = y[k];
+        }
+    }
 }
+
+/// Right-hand sides [`Ldl::solve_block`] takes at once.
+pub(crate) const BLOCK: usize = 8;
 
 #[cfg(test)]
 mod tests {
@@ -308,6 +367,18 @@ mod tests {
                 "row {i}: {ax} vs {}",
                 dense_b[i]
             );
+        }
+        // Blocks of right-hand sides give each exactly what a solve of its own gives.
+        let others = [(7u32, 1.0), (2000, -0.5)];
+        let bs: [&[(u32, f64)]; 3] = [&b, &others, &[(1500, 3.0)]];
+        let mut block = vec![[0.0; BLOCK]; n];
+        let mut block_work = vec![[0.0; BLOCK]; n];
+        ldl.solve_block(&bs, &mut block, &mut block_work);
+        for (r, rhs) in bs.iter().enumerate() {
+            ldl.solve(rhs, &mut x, &mut work);
+            for v in 0..n {
+                assert_eq!(block[v][r].to_bits(), x[v].to_bits(), "right-hand side {r}");
+            }
         }
     }
 }

@@ -10,7 +10,7 @@ use glam::{DAffine2, DVec2};
 use crate::basis::Basis;
 use crate::domain::{Domain, Metric};
 use crate::error::RigError;
-use crate::harmonic::{Coefficients, dual_edges, harmonic_coordinates};
+use crate::harmonic::{Coefficients, Solved, dual_edges, harmonic_coordinates};
 use crate::nearest::segment_distance;
 use crate::transform::Similarity;
 use crate::virtual_handles::insert_virtual_handles;
@@ -203,14 +203,16 @@ fn group_of(n: &Node, handle_count: usize) -> Option<usize> {
 /// Harmonic coordinates of the virtual nodes over the groups, on the dual graph of
 /// `partition`.
 /// `progress(done, total)` is told of the solves (one per group and part of the dual
-/// graph), in order.
+/// graph), in order; parts solved `earlier` with the same inputs are taken as they
+/// were. Returns the coordinates and the parts solved, for the next call.
 fn harmonic_of(
     domain: &Domain,
     partition: &Partition,
     nodes: &[Node],
     handle_count: usize,
     progress: &(dyn Fn(usize, usize) + Sync),
-) -> Vec<Option<Coefficients>> {
+    earlier: &Solved,
+) -> (Vec<Option<Coefficients>>, Solved) {
     let edges = dual_edges(domain, partition);
     let node_group: Vec<Option<usize>> = nodes.iter().map(|n| group_of(n, handle_count)).collect();
     harmonic_coordinates(
@@ -219,6 +221,7 @@ fn harmonic_of(
         &node_group,
         &edges,
         progress,
+        earlier,
     )
 }
 
@@ -372,6 +375,9 @@ pub struct Rig {
     radii: Vec<f64>,
     weights: Weights,
     harmonic: Vec<Option<Coefficients>>,
+    /// The parts of the dual graph the harmonic coordinates were solved on, kept for
+    /// the next update.
+    solved: Solved,
     affines: Vec<DAffine2>,
     resolution: f64,
     timings: BuildTimings,
@@ -548,18 +554,20 @@ impl Rig {
             radii,
             weights,
             harmonic: Vec::new(),
+            solved: Solved::default(),
             affines: Vec::new(),
             resolution,
             timings,
             update_timings: UpdateTimings::default(),
             placed_for,
         };
-        rig.harmonic = harmonic_of(
+        (rig.harmonic, rig.solved) = harmonic_of(
             &rig.domain,
             &rig.partition,
             &rig.nodes,
             rig.handles.len(),
             &|done, total| report(Phase::Transforms, done, Some(total)),
+            &Solved::default(),
         );
         rig.update_affines();
         rig.timings.weights_ms = ms(clock);
@@ -823,6 +831,7 @@ impl Rig {
             weights,
             update_timings,
             placed_for,
+            solved,
             ..
         } = &mut *self;
         let (domain, weights, alpha) = (&*domain, &*weights, options.alpha);
@@ -925,10 +934,11 @@ impl Rig {
             // only: worked out by whichever core is free while the last fields are
             // searched.
             let (partition, nodes): (&Partition, &Vec<Node>) = (&*partition, &*nodes);
-            let transforms = &transforms;
+            let (transforms, solved) = (&transforms, &*solved);
             scope.spawn(move |_| {
                 let clock = Instant::now();
-                let harmonic = harmonic_of(domain, partition, nodes, handle_count, &|_, _| {});
+                let harmonic =
+                    harmonic_of(domain, partition, nodes, handle_count, &|_, _| {}, solved);
                 *transforms.lock().expect("not poisoned") = Some((harmonic, ms(clock)));
             });
         });
@@ -959,11 +969,12 @@ impl Rig {
             &map,
             &dirty,
         );
-        let (harmonic, transforms_ms) = transforms
+        let ((harmonic, solved), transforms_ms) = transforms
             .into_inner()
             .expect("not poisoned")
             .expect("computed in the scope");
         self.harmonic = harmonic;
+        self.solved = solved;
         self.update_timings.weights_ms = ms(clock);
         self.update_timings.transforms_ms = transforms_ms;
     }

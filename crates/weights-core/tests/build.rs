@@ -161,6 +161,63 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 16, .. ProptestConfig::default() })]
+
+    /// After insertions and removals (which take the parts of the dual graph they did
+    /// not change from the previous solve), the virtual handles' harmonic coordinates and
+    /// the node transforms equal a rebuild's, bit for bit.
+    #[test]
+    fn harmonic_coordinates_after_updates_equal_a_rebuild(seed in any::<u64>(), convex in any::<bool>()) {
+        let shape = if convex { Shape::Rectangle } else { Shape::Holed };
+        let domain = grid_domain(44, 32, 1.0, 0.3, shape, seed);
+        let mut rng = Rng(seed);
+        let mut rig = Rig::new(
+            domain.clone(),
+            vec![
+                Handle::point(at(&domain, 30.0, 6.0)),
+                Handle::bar(at(&domain, 5.0, 25.0), at(&domain, 15.0, 27.0)),
+            ],
+            RigOptions::default(),
+        )
+        .expect("valid");
+        for step in 0..8 {
+            if step % 3 == 2 && rig.handles().len() > 1 {
+                rig.remove_handle(rng.below(rig.handles().len())).expect("exists");
+            } else {
+                let p = domain.positions()[rng.below(domain.len())];
+                if rig.insert_handle(Handle::point(p)).is_err() {
+                    continue;
+                }
+            }
+            // Pose the handles, so that the transforms blend different motions.
+            for i in 0..rig.handles().len() {
+                if let Handle::Point { .. } = rig.handles()[i] {
+                    let t = weights_core::Similarity {
+                        translation: DVec2::new(i as f64, -(i as f64) * 0.5),
+                        rotation: 0.1 * i as f64,
+                        scale: 1.0 + 0.01 * i as f64,
+                    };
+                    rig.set_point_transform(i, t).expect("a point");
+                }
+            }
+            let mut rebuilt = rebuild_with_placed(&rig);
+            rebuilt.set_handles(rig.handles().to_vec()).expect("same rest");
+            let index: std::collections::HashMap<u32, usize> = rebuilt
+                .nodes()
+                .iter()
+                .enumerate()
+                .map(|(k, n)| (n.vertex, k))
+                .collect();
+            for (k, n) in rig.nodes().iter().enumerate() {
+                let j = index[&n.vertex];
+                prop_assert_eq!(rig.harmonic_coordinates(k), rebuilt.harmonic_coordinates(j));
+                prop_assert_eq!(rig.node_transform(k), rebuilt.node_transform(j));
+            }
+        }
+    }
+}
+
 #[test]
 fn a_removed_handle_takes_its_virtual_handles_along_after_a_reload() {
     let domain = grid_domain(60, 45, 1.0, 0.3, Shape::Holed, 9);
