@@ -155,9 +155,9 @@ pub fn prepare_with_progress(
     let most = MAX_VIRTUAL_PER_VERTEX.saturating_mul(target_vertices);
     if project.virtual_handles.len() > most {
         bail!(
-            "the rig lists {} virtual handles, more than a mesh of {target_vertices} vertices \
-             can carry: C2Warp takes at most {most} ({MAX_VIRTUAL_PER_VERTEX} per vertex of \
-             the density); leave out \"virtual_handles\" to have them placed afresh",
+            "the rig lists {} virtual handles, more than a mesh of about {target_vertices} \
+             vertices can carry (each takes a vertex; C2Warp accepts up to twice the \
+             density, {most}); leave out \"virtual_handles\" to have them placed afresh",
             project.virtual_handles.len()
         );
     }
@@ -284,7 +284,7 @@ mod tests {
             .expect("too many virtual handles")
             .to_string();
         assert!(
-            err.contains("4001 virtual handles") && err.contains("at most 4000"),
+            err.contains("4001 virtual handles") && err.contains("up to twice the density, 4000"),
             "{err}"
         );
         assert!(clock.elapsed().as_secs_f64() < 1.0);
