@@ -152,9 +152,9 @@ fn triangle_pairs(domain: &Domain, partition: &Partition) -> PairsAndTies {
 /// virtual one; where thousands of virtual handles surround thousands of handles,
 /// keeping every coefficient would cost a number per handle per virtual handle (25
 /// million for 2,000 random handles on the lizard at 20k samples; 2.3 million, 180 a
-/// virtual handle, at this threshold). Even with 10,000 handles the mass left out is under 1e-6 of a node's,
-/// and it moves a virtual handle by less than a millionth of the largest difference
-/// between two handles' motions.
+/// virtual handle, at this threshold). Even with 10,000 handles the mass left out is
+/// under 1e-6 of a node's, and it moves a virtual handle by less than a millionth of
+/// the largest difference between two handles' motions.
 pub(crate) const NEGLIGIBLE: f64 = 1e-10;
 
 /// The harmonic coefficients of one virtual node: `(group, coefficient)` pairs, groups
