@@ -8,7 +8,7 @@ use serde::Serialize;
 use weights_core::Handle;
 
 use crate::{Source, export};
-use pipeline::load_project;
+use pipeline::{ArapRig, Deformer, Method, load_project};
 
 #[derive(Serialize)]
 struct Phases {
@@ -54,10 +54,110 @@ fn ms(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
 }
 
-/// Runs `c2warp bench`.
-pub fn run(source: &Source, rig_path: &Path, positions: usize) -> Result<()> {
+/// ARAP's steps, timed.
+#[derive(Serialize)]
+struct ArapReport {
+    method: &'static str,
+    samples: usize,
+    triangles: usize,
+    real_handles: usize,
+    /// Vertices the handles pin.
+    pinned_vertices: usize,
+    /// Registration (once per mesh), ms.
+    registration_ms: f64,
+    /// Median compilation (factorising both steps' systems), ms.
+    compile_ms_median: f64,
+    /// Median update (a new pose: step one, the fit, step two), ms.
+    update_ms_median: f64,
+    /// 90th percentile of the updates, ms.
+    update_ms_p90: f64,
+    /// Poses timed.
+    poses: usize,
+}
+
+/// Runs `c2warp bench` for `method` (else the rig's).
+pub fn run(
+    source: &Source,
+    rig_path: &Path,
+    positions: usize,
+    method: Option<Method>,
+) -> Result<()> {
     let project = load_project(rig_path)?;
-    let mut rig = export::build(source, &project)?.rig;
+    let built = export::build(source, &project, &|_| {})?;
+    match method.unwrap_or(project.method) {
+        Method::C2 => c2(built.rig, positions),
+        Method::Arap => arap(built.rig, &project, positions),
+    }
+}
+
+/// Times ARAP on the rig's mesh and handles: registration once, compilation by
+/// dropping and restoring the last handle, updates over `poses` random poses.
+fn arap(rig: weights_core::Rig, project: &project::Project, poses: usize) -> Result<()> {
+    let handles = rig.handles().to_vec();
+    let mut arap = ArapRig::new(rig.domain().clone(), &handles, &project.rigidity)?;
+    let registration_ms = arap.times().registration_ms;
+    let mut compile = vec![arap.times().compile_ms];
+    if let Some((_, fewer)) = handles.split_last() {
+        for _ in 0..4 {
+            arap.set_handles(fewer)?;
+            arap.set_handles(&handles)?;
+            compile.push(arap.times().compile_ms);
+        }
+    }
+    let pinned_vertices = arap.pinned();
+    let scale = rig.domain().mean_edge_length() * 10.0;
+    let mut state = 0x2545F4914F6CDD1Du64;
+    let mut random = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    let mut update = Vec::new();
+    for _ in 0..poses.max(1) {
+        let posed: Vec<Handle> = handles
+            .iter()
+            .map(|h| match *h {
+                Handle::Point {
+                    rest,
+                    mut transform,
+                } => {
+                    transform.translation += glam::DVec2::new(random(), random()) * scale;
+                    Handle::Point { rest, transform }
+                }
+                Handle::Bar { rest, pose } => {
+                    let d = glam::DVec2::new(random(), random()) * scale;
+                    Handle::Bar {
+                        rest,
+                        pose: [pose[0] + d, pose[1] + d],
+                    }
+                }
+            })
+            .collect();
+        arap.set_handles(&posed)?;
+        update.push(arap.times().update_ms);
+    }
+    let mut sorted = update.clone();
+    sorted.sort_by(f64::total_cmp);
+    let report = ArapReport {
+        method: "arap",
+        samples: rig.domain().len(),
+        triangles: rig.domain().triangles().len(),
+        real_handles: handles.len(),
+        pinned_vertices,
+        registration_ms,
+        compile_ms_median: median(compile),
+        update_ms_p90: sorted[(sorted.len() * 9 / 10).min(sorted.len() - 1)],
+        update_ms_median: median(update),
+        poses: sorted.len(),
+    };
+    println!("{}", serde_json::to_string_pretty(&report)?);
+    Ok(())
+}
+
+/// Times the C² rig: the build's phases, insertions and removals at `positions`
+/// random samples, deformation.
+fn c2(mut rig: weights_core::Rig, positions: usize) -> Result<()> {
     let timings = rig.timings();
     let stats = rig.stats();
     let mut deform = Vec::new();

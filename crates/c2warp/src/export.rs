@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 use glam::DVec2;
 use project::Project;
 use serde::Serialize;
-use weights_core::{Domain, Handle, NodeKind, Rig};
+use weights_core::{Domain, Handle, NodeKind, Rig, VirtualHandle};
 
 use crate::Source;
 use pipeline::{load_image, load_project};
@@ -26,13 +26,20 @@ pub struct Built {
 /// bar sample) that coincides with a vertex uses it, and one that does not is inserted
 /// as a new vertex, splitting the triangle (or edge) it lies on. Inserted vertices come
 /// after the file's.
-pub fn build(source: &Source, project: &Project) -> Result<Built> {
+///
+/// `progress` hears how far the rig build has come (see [`weights_core::Progress`]).
+pub fn build(
+    source: &Source,
+    project: &Project,
+    progress: &(dyn Fn(weights_core::Progress) + Sync),
+) -> Result<Built> {
     if let Some(density) = source.density {
         project::validate_density(density)?;
     }
     if let Some(path) = &source.image {
         let picture = load_image(path)?;
-        let prepared = pipeline::prepare(&picture, project, source.density)?;
+        let prepared =
+            pipeline::prepare_with_progress(&picture, project, source.density, progress)?;
         let file_vertices = prepared.rig.domain().len();
         return Ok(Built {
             rig: prepared.rig,
@@ -45,6 +52,15 @@ pub fn build(source: &Source, project: &Project) -> Result<Built> {
         .with_context(|| format!("mesh {}", path.display()))?;
     project.validate(None)?;
     let file_vertices = mesh.vertices.len();
+    // Each virtual handle takes a vertex of its own; more than the mesh has cannot have
+    // been saved on it (and would each be inserted into it, one by one).
+    anyhow::ensure!(
+        project.virtual_handles.len() <= file_vertices,
+        "the rig lists {} virtual handles, more than the {file_vertices} vertices of mesh {} \
+         (at most one a vertex); leave out \"virtual_handles\" to have them placed afresh",
+        project.virtual_handles.len(),
+        path.display()
+    );
     let handles = pipeline::handles(project);
     let mut points: Vec<DVec2> = Vec::new();
     for (i, h) in handles.iter().enumerate() {
@@ -58,14 +74,21 @@ pub fn build(source: &Source, project: &Project) -> Result<Built> {
         }
     }
     points.extend(project.virtual_handles.iter().map(|&p| DVec2::from(p)));
-    let mut virtual_vertices = Vec::new();
+    let mut virtual_handles = Vec::new();
     let first_virtual = points.len() - project.virtual_handles.len();
     for (i, p) in points.into_iter().enumerate() {
         let v = mesh
             .insert_point(p)
             .with_context(|| format!("handle point ({}, {}) is not on the mesh", p.x, p.y))?;
         if i >= first_virtual {
-            virtual_vertices.push(v);
+            virtual_handles.push(VirtualHandle {
+                vertex: v,
+                placed_for: project
+                    .virtual_placed_for
+                    .get(i - first_virtual)
+                    .copied()
+                    .flatten(),
+            });
         }
     }
     let provisional = Domain::new(
@@ -75,11 +98,12 @@ pub fn build(source: &Source, project: &Project) -> Result<Built> {
     )?;
     let metric = pipeline::metric(project.metric, provisional.is_convex());
     let domain = Domain::new(mesh.vertices, mesh.triangles, metric)?;
-    let rig = Rig::with_virtual_handles(
+    let rig = Rig::with_progress(
         domain,
         handles,
-        &virtual_vertices,
+        &virtual_handles,
         pipeline::rig_options(project)?,
+        progress,
     )?;
     Ok(Built { rig, file_vertices })
 }
@@ -119,7 +143,7 @@ pub fn weights(source: &Source, rig_path: &Path, output: &Path) -> Result<()> {
     let project = load_project(rig_path)?;
     let progress = crate::progress::Steps::new(2);
     progress.step("meshing and weighting");
-    let Built { rig, file_vertices } = build(source, &project)?;
+    let Built { rig, file_vertices } = build(source, &project, &progress.weighting())?;
     progress.step("writing");
     let positions = rig.domain().positions();
     let nodes = rig

@@ -1,6 +1,7 @@
 //! `c2warp`: warp images with C² handle weights from the command line.
 
 mod bench;
+mod deform;
 mod export;
 mod progress;
 mod runtime_dir;
@@ -11,7 +12,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand};
-use pipeline::{DEFAULT_IMAGE, DEFAULT_RIG, load_picture, load_project};
+use pipeline::{DEFAULT_IMAGE, DEFAULT_RIG, Deformer, Method, load_picture, load_project};
 use project::Project;
 use render::Picture;
 
@@ -59,6 +60,24 @@ enum Command {
         /// bits per channel: a 16-bit source gives an 8-bit PNG.
         #[arg(long)]
         gpu: bool,
+        /// The warping method: c2 or arap (overrides the rig's `method`).
+        #[arg(long)]
+        method: Option<Method>,
+    },
+    /// Write the deformed mesh as Wavefront OBJ: one `v x y 0` line per vertex (the
+    /// input's order, inserted vertices after), then the faces.
+    Deform {
+        #[command(flatten)]
+        source: Source,
+        /// The rig file (RIG.json).
+        #[arg(long)]
+        rig: PathBuf,
+        /// The warping method: c2 or arap (overrides the rig's `method`).
+        #[arg(long)]
+        method: Option<Method>,
+        /// Where to write the OBJ (`-`: standard output).
+        #[arg(short, long)]
+        output: PathBuf,
     },
     /// Write the nodes actually used and every mesh vertex's non-zero weights as JSON.
     Weights {
@@ -71,7 +90,8 @@ enum Command {
         #[arg(short, long)]
         output: PathBuf,
     },
-    /// Time the rig build, handle insertion and removal, and deformation; print JSON.
+    /// Time the method's steps and print JSON: for C², the rig build, handle insertion
+    /// and removal, and deformation; for ARAP, registration, compilation and update.
     Bench {
         #[command(flatten)]
         source: Source,
@@ -81,6 +101,9 @@ enum Command {
         /// Random positions to insert and remove a handle at.
         #[arg(long, default_value_t = 31)]
         positions: usize,
+        /// The method to time: c2 or arap (overrides the rig's `method`).
+        #[arg(long)]
+        method: Option<Method>,
     },
     /// Render the sample rig on the built-in image and say where the PNG went.
     Demo {
@@ -137,7 +160,14 @@ fn run(command: Command) -> Result<()> {
             output,
             density,
             gpu,
-        } => render(&image, &rig, &output, density, gpu),
+            method,
+        } => render(&image, &rig, &output, density, gpu, method),
+        Command::Deform {
+            source,
+            rig,
+            method,
+            output,
+        } => deform::run(&source, &rig, method, &output),
         Command::Weights {
             source,
             rig,
@@ -147,7 +177,8 @@ fn run(command: Command) -> Result<()> {
             source,
             rig,
             positions,
-        } => bench::run(&source, &rig, positions),
+            method,
+        } => bench::run(&source, &rig, positions, method),
         Command::Demo { output } => demo(&output),
     }
 }
@@ -158,19 +189,23 @@ fn render(
     output: &Path,
     density: Option<usize>,
     gpu: bool,
+    method: Option<Method>,
 ) -> Result<()> {
     if let Some(density) = density {
         // Before the slow part: the rule and the message of a rig file's density.
         project::validate_density(density)?;
     }
-    let project = load_project(rig)?;
+    let mut project = load_project(rig)?;
+    if let Some(method) = method {
+        project.method = method;
+    }
     let picture = load_picture(image)?;
     warp_and_save(&picture, &project, density, output, gpu)?;
     Ok(())
 }
 
-/// Meshes, weights, warps and writes `picture` by `project`, with a progress counter;
-/// returns the rig.
+/// Meshes, weights, warps and writes `picture` by `project` (with its method), with a
+/// progress counter; returns the method's deformer.
 ///
 /// The CPU draws in the picture's depth (a 16-bit picture gives a 16-bit PNG); the
 /// GPU draws in 8 bits per channel, so with `gpu` the PNG has 8.
@@ -180,22 +215,24 @@ fn warp_and_save(
     density: Option<usize>,
     output: &Path,
     gpu: bool,
-) -> Result<weights_core::Rig> {
+) -> Result<Box<dyn Deformer>> {
     let progress = progress::Steps::new(3);
     progress.step("meshing and weighting");
     let rgba8 = picture.to_rgba8();
-    let prepared = pipeline::prepare(&rgba8, project, density)?;
+    let prepared =
+        pipeline::prepare_with_progress(&rgba8, project, density, &progress.weighting())?;
+    let deformer = pipeline::deformer(project.method, prepared.rig, &project.rigidity)?;
     progress.step("rendering");
     let warped = if gpu {
-        Picture::Rgba8(pipeline::warp_gpu(&rgba8, &prepared.rig)?)
+        Picture::Rgba8(pipeline::warp_gpu(&rgba8, deformer.as_ref())?)
     } else {
         drop(rgba8);
-        pipeline::warp_picture(picture, &prepared.rig)?
+        pipeline::warp_picture(picture, deformer.as_ref())?
     };
     progress.step("writing");
     write_png(output, &warped)?;
     progress.finish();
-    Ok(prepared.rig)
+    Ok(deformer)
 }
 
 /// Whether `output` names standard output (`-`).
@@ -224,7 +261,10 @@ fn write_png(output: &Path, picture: &Picture) -> Result<()> {
 fn demo(output: &Path) -> Result<()> {
     let picture = render::decode_picture(DEFAULT_IMAGE, &render::ImageLimits::default())?;
     let project = Project::from_json(DEFAULT_RIG).context("built-in rig")?;
-    let rig = warp_and_save(&picture, &project, None, output, false)?;
+    let deformer = warp_and_save(&picture, &project, None, output, false)?;
+    let pipeline::Output::Skinned(rig) = deformer.output() else {
+        bail!("the built-in rig uses the C² weights");
+    };
     let stats = rig.stats();
     if is_stdout(output) {
         return Ok(());

@@ -1,7 +1,10 @@
 //! A step counter on stderr for work that takes more than a moment (drawn only when
 //! stderr is a terminal).
 
+use std::sync::atomic::{AtomicU32, Ordering};
+
 use indicatif::{ProgressBar, ProgressStyle};
+use weights_core::{Phase, Progress};
 
 /// Numbered steps with a spinner.
 pub struct Steps {
@@ -24,6 +27,26 @@ impl Steps {
     pub fn step(&self, message: &'static str) {
         self.bar.inc(1);
         self.bar.set_message(message);
+    }
+
+    /// A callback for a rig build ([`pipeline::prepare_with_progress`]) that shows
+    /// its phase and percentage in the current step's message.
+    pub fn weighting(&self) -> impl Fn(Progress) + Sync + '_ {
+        let shown = AtomicU32::new(u32::MAX);
+        move |progress: Progress| {
+            let percent = (progress.fraction() * 100.0) as u32;
+            let key = percent * 4 + progress.phase as u32;
+            if shown.swap(key, Ordering::Relaxed) != key {
+                let phase = match progress.phase {
+                    Phase::Partition => "Voronoi cells",
+                    Phase::VirtualHandles => "virtual handles",
+                    Phase::Weights => "weights",
+                    Phase::Transforms => "harmonic coordinates",
+                };
+                self.bar
+                    .set_message(format!("meshing and weighting: {phase}, {percent}%"));
+            }
+        }
     }
 
     /// Clears the counter.

@@ -160,6 +160,9 @@ pub struct EditorApp {
     /// Use the built-in file dialog (the desktop has none, or the user prefers it).
     pub builtin_dialogs: bool,
     pub(crate) file_dialog: Option<BuiltinDialog>,
+    /// Where the built-in file dialog starts when the document has no file of its own
+    /// (else the current folder).
+    pub default_folder: Option<PathBuf>,
     pub(crate) gpu: GpuFrame,
     pub(crate) has_gpu: bool,
     next_version: u64,
@@ -252,6 +255,7 @@ impl EditorApp {
             large_mesh: 100_000,
             builtin_dialogs: false,
             file_dialog: None,
+            default_folder: None,
             gpu: GpuFrame::default(),
             has_gpu,
             next_version: 0,
@@ -867,6 +871,7 @@ impl EditorApp {
                 .map(Path::to_path_buf)
         });
         from_doc
+            .or_else(|| self.default_folder.clone())
             .or_else(|| std::env::current_dir().ok())
             .unwrap_or_else(|| PathBuf::from("."))
     }
@@ -1115,6 +1120,7 @@ fn open_outcome(path: PathBuf) -> Outcome {
 fn without_virtuals(project: &project::Project) -> project::Project {
     project::Project {
         virtual_handles: Vec::new(),
+        virtual_placed_for: Vec::new(),
         ..project.clone()
     }
 }

@@ -11,7 +11,7 @@ use anyhow::{Context, Result, bail};
 use glam::DVec2;
 use image::RgbaImage;
 use project::{HandleSpec, MetricChoice, Middle, Project};
-use weights_core::{Domain, NodeKind, Rig};
+use weights_core::{Domain, NodeKind, Rig, VirtualHandle};
 
 /// The parameters of the weighting a user can change in the side panel.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -122,6 +122,7 @@ impl Document {
         let prepared = pipeline::prepare(&image, &project, None)?;
         // Virtual handles live in the rig while editing; they are written out on save.
         project.virtual_handles.clear();
+        project.virtual_placed_for.clear();
         Ok(Self {
             project,
             image,
@@ -315,12 +316,12 @@ impl Document {
     pub fn snapshot(&self) -> Project {
         let mut project = self.project.clone();
         let positions = self.rig.domain().positions();
-        project.virtual_handles = self
-            .rig
-            .virtual_vertices()
+        let placed = self.rig.placed_virtual_handles();
+        project.virtual_handles = placed
             .iter()
-            .map(|&v| positions[v as usize].to_array())
+            .map(|v| positions[v.vertex as usize].to_array())
             .collect();
+        project.virtual_placed_for = placed.iter().map(|v| v.placed_for).collect();
         project
     }
 
@@ -337,6 +338,7 @@ impl Document {
 
     fn restore_with(&mut self, mut project: Project, exact: bool) -> Result<()> {
         let virtuals = std::mem::take(&mut project.virtual_handles);
+        let placed_for = std::mem::take(&mut project.virtual_placed_for);
         let clock = Instant::now();
         let old = self.settings();
         let new = Settings::of(&project);
@@ -351,18 +353,25 @@ impl Document {
             let mut with_virtuals = project.clone();
             if exact {
                 with_virtuals.virtual_handles = virtuals;
+                with_virtuals.virtual_placed_for = placed_for;
             }
             self.rig = pipeline::prepare(&self.image, &with_virtuals, None)?.rig;
         } else if new == old && exact && !same_rest {
             let domain = self.rig.domain();
-            let vertices: Vec<u32> = virtuals
+            let placed: Vec<VirtualHandle> = virtuals
                 .iter()
-                .filter_map(|&p| domain.nearest_vertex(DVec2::from(p)))
+                .enumerate()
+                .filter_map(|(i, &p)| {
+                    Some(VirtualHandle {
+                        vertex: domain.nearest_vertex(DVec2::from(p))?,
+                        placed_for: placed_for.get(i).copied().flatten(),
+                    })
+                })
                 .collect();
-            self.rig = Rig::with_virtual_handles(
+            self.rig = Rig::with_placed_virtual_handles(
                 domain.clone(),
                 handles,
-                &vertices,
+                &placed,
                 pipeline::rig_options(&project)?,
             )?;
         } else if new != old {
@@ -511,10 +520,7 @@ impl Document {
                 NodeKind::Point { handle: h } | NodeKind::BarSample { handle: h, .. } => {
                     f64::from(u8::from(h == handle))
                 }
-                NodeKind::Virtual => rig
-                    .harmonic_coordinates(k)
-                    .and_then(|c| c.get(handle).copied())
-                    .unwrap_or(0.0),
+                NodeKind::Virtual => rig.harmonic_coordinate(k, handle),
                 NodeKind::Boundary => 0.0,
             })
             .collect();
@@ -744,6 +750,38 @@ mod tests {
         doc.undo_to(before.clone()).expect("undo");
         assert_eq!(doc.rig().virtual_vertices(), virtuals);
         assert_eq!(doc.snapshot(), before);
+    }
+
+    /// Which handle placed each virtual handle survives an undo, a redo and a save, so
+    /// removing that handle afterwards still takes its virtual handles along.
+    #[test]
+    fn removal_after_redo_or_reload_takes_the_virtual_handles_along() {
+        let mut doc = document();
+        let before = doc.rig().virtual_vertices();
+        let undo = doc.snapshot();
+        doc.apply(Edit::Add(point(14.0, 14.0)))
+            .expect("a close handle");
+        let redo = doc.snapshot();
+        assert!(
+            redo.virtual_placed_for.contains(&Some(2)),
+            "the new handle placed virtual handles: {:?}",
+            redo.virtual_placed_for
+        );
+        assert_eq!(redo.virtual_placed_for.len(), redo.virtual_handles.len());
+
+        doc.undo_to(undo).expect("undo");
+        doc.undo_to(redo.clone()).expect("redo");
+        assert_eq!(doc.snapshot(), redo, "redo restores the owners too");
+        let mut reloaded = Document::new((*doc.image).clone(), None, doc.project_for_saving(None))
+            .expect("reload");
+        for doc in [&mut doc, &mut reloaded] {
+            doc.apply(Edit::Remove(2)).expect("remove");
+            assert_eq!(
+                doc.rig().virtual_vertices(),
+                before,
+                "the removed handle's virtual handles go with it"
+            );
+        }
     }
 
     #[test]

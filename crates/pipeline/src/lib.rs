@@ -1,6 +1,8 @@
 //! Image + project → mesh → rig → warped image: the path the `c2warp` command line and
 //! the editor share, so an export from either gives the same pixels.
 
+pub mod method;
+
 use std::io::{BufReader, Read};
 use std::path::Path;
 
@@ -10,7 +12,11 @@ use image::RgbaImage;
 use mesh::{Constraints, DomainOptions, Mesh, MeshError, MeshOptions};
 use project::{HandleSpec, MetricChoice, Middle, Project};
 use render::Picture;
-use weights_core::{Basis, Domain, Handle, Metric, MiddleControls, Rig, RigOptions, Similarity};
+
+pub use method::{ArapRig, ArapTimes, Deformer, Method, Output, deformer};
+use weights_core::{
+    Basis, Domain, Handle, Metric, MiddleControls, Rig, RigOptions, Similarity, VirtualHandle,
+};
 
 /// The picture the editor opens with and the demo warps (public domain, see
 /// `assets/LICENSES.md`).
@@ -124,6 +130,13 @@ pub fn load_obj(path: &Path) -> Result<Mesh> {
 /// Target vertex count of the mesh when neither the project nor the command says.
 pub const DEFAULT_DENSITY: usize = 20_000;
 
+/// The most virtual handles a rig file may list for each vertex the mesh aims at
+/// (its density): each virtual handle takes a vertex of its own, and a mesh lands
+/// within about 30% of its target, so a file with more was not saved from a rig at
+/// this density. Such a file is refused before meshing (2.5 million virtual handles
+/// would take minutes and gigabytes).
+pub const MAX_VIRTUAL_PER_VERTEX: usize = 2;
+
 /// The user handles of a project.
 pub fn handles(project: &Project) -> Vec<Handle> {
     project
@@ -215,16 +228,43 @@ pub struct Prepared {
 ///
 /// # Errors
 /// A density out of range, handles off the image or the shape, coincident handles,
-/// an image with no opaque pixel, and the like, each as one sentence.
+/// more handles than [`project::MAX_HANDLES`], more virtual handles than
+/// [`MAX_VIRTUAL_PER_VERTEX`] times the density, an image with no visible pixel, and the
+/// like, each as one sentence.
 pub fn prepare(image: &RgbaImage, project: &Project, density: Option<usize>) -> Result<Prepared> {
+    prepare_with_progress(image, project, density, &|_| {})
+}
+
+/// As [`prepare`], telling `progress` how far the rig build has come (see
+/// [`weights_core::Progress`]; meshing, before it, is not reported). It is called from
+/// the building threads, often: it should only store the figure.
+///
+/// # Errors
+/// As [`prepare`].
+pub fn prepare_with_progress(
+    image: &RgbaImage,
+    project: &Project,
+    density: Option<usize>,
+    progress: &(dyn Fn(weights_core::Progress) + Sync),
+) -> Result<Prepared> {
     if let Some(density) = density {
         project::validate_density(density)?;
     }
     project.validate(Some(image.dimensions()))?;
+    let target_vertices = density.or(project.density).unwrap_or(DEFAULT_DENSITY);
+    let most = MAX_VIRTUAL_PER_VERTEX.saturating_mul(target_vertices);
+    if project.virtual_handles.len() > most {
+        bail!(
+            "the rig lists {} virtual handles, more than a mesh of about {target_vertices} \
+             vertices can carry (each takes a vertex; C2Warp accepts up to twice the \
+             density, {most}); leave out \"virtual_handles\" to have them placed afresh",
+            project.virtual_handles.len()
+        );
+    }
     let handles = handles(project);
     let (points, bars) = constraints(project, &handles);
     let options = MeshOptions {
-        target_vertices: density.or(project.density).unwrap_or(DEFAULT_DENSITY),
+        target_vertices,
         ..MeshOptions::default()
     };
     let mesh = mesh::mesh_image(
@@ -237,59 +277,89 @@ pub fn prepare(image: &RgbaImage, project: &Project, density: Option<usize>) -> 
         },
     )
     .context("cannot mesh the image")?;
-    let virtual_vertices: Vec<u32> =
-        mesh.point_vertices[points.len() - project.virtual_handles.len()..].to_vec();
+    let first_virtual = points.len() - project.virtual_handles.len();
+    let virtual_handles: Vec<VirtualHandle> = mesh.point_vertices[first_virtual..]
+        .iter()
+        .enumerate()
+        .map(|(i, &vertex)| VirtualHandle {
+            vertex,
+            placed_for: project.virtual_placed_for.get(i).copied().flatten(),
+        })
+        .collect();
     let domain = Domain::new(
         mesh.mesh.vertices.clone(),
         mesh.mesh.triangles.clone(),
         metric(project.metric, mesh.is_convex),
     )?;
-    let rig = Rig::with_virtual_handles(domain, handles, &virtual_vertices, rig_options(project)?)?;
+    let rig = Rig::with_progress(
+        domain,
+        handles,
+        &virtual_handles,
+        rig_options(project)?,
+        progress,
+    )?;
     Ok(Prepared { rig })
 }
 
-/// The rig's samples at rest in f32: the texture coordinates of the mesh.
-fn rest_positions(rig: &Rig) -> Vec<Vec2> {
-    rig.domain()
+/// The mesh's vertices at rest in f32: its texture coordinates.
+fn rest_positions(deformer: &dyn Deformer) -> Vec<Vec2> {
+    deformer
+        .domain()
         .positions()
         .iter()
         .map(|p| p.as_vec2())
         .collect()
 }
 
-/// The image warped by the rig's current pose on the GPU (or a software adapter): the
-/// vertex shader blends the node transforms with the sparse weights.
+/// The image warped by the current pose on the GPU (or a software adapter): for C²
+/// weights the vertex shader blends the node transforms with the sparse weights; for
+/// a method that gives positions, they are drawn as they are.
 ///
 /// # Errors
 /// No adapter, or a GPU failure.
-pub fn warp_gpu(image: &RgbaImage, rig: &Rig) -> Result<RgbaImage> {
+pub fn warp_gpu(image: &RgbaImage, deformer: &dyn Deformer) -> Result<RgbaImage> {
     let gpu = render::GpuContext::new()?;
-    let (rows, nodes, weights) = rig.weight_table();
-    let rest = rest_positions(rig);
-    let mesh = render::SkinnedMesh {
-        rest: &rest,
-        rows: &rows,
-        nodes: &nodes,
-        weights: &weights,
-        triangles: rig.domain().triangles(),
-    };
+    let rest = rest_positions(deformer);
+    let triangles = deformer.domain().triangles();
     let (w, h) = image.dimensions();
-    Ok(gpu.warp_skinned(image, &mesh, &rig.node_affines(), w, h)?)
+    match deformer.output() {
+        Output::Skinned(rig) => {
+            let (rows, nodes, weights) = rig.weight_table();
+            let mesh = render::SkinnedMesh {
+                rest: &rest,
+                rows: &rows,
+                nodes: &nodes,
+                weights: &weights,
+                triangles,
+            };
+            Ok(gpu.warp_skinned(image, &mesh, &rig.node_affines(), w, h)?)
+        }
+        Output::Positions(_) => {
+            let deformed = deformed_f32(deformer)?;
+            let mesh = render::WarpMesh {
+                rest: &rest,
+                deformed: &deformed,
+                triangles,
+            };
+            Ok(gpu.warp(image, &mesh, w, h)?)
+        }
+    }
 }
 
-/// The picture warped by the rig's current pose on the CPU, at its full resolution
-/// and in its own depth: a 16-bit picture gives a 16-bit picture (write it with
+/// The picture warped by the current pose on the CPU, at its full resolution and in
+/// its own depth: a 16-bit picture gives a 16-bit picture (write it with
 /// [`render::save_png_atomic`] for a 16-bit PNG); an 8-bit one exactly what [`warp`]
 /// gives.
 ///
 /// # Errors
 /// Only if the deformation produced non-finite positions.
-pub fn warp_picture(picture: &Picture, rig: &Rig) -> Result<Picture> {
-    let (rest, deformed) = warp_positions(rig)?;
+pub fn warp_picture(picture: &Picture, deformer: &dyn Deformer) -> Result<Picture> {
+    let rest = rest_positions(deformer);
+    let deformed = deformed_f32(deformer)?;
     let mesh = render::WarpMesh {
         rest: &rest,
         deformed: &deformed,
-        triangles: rig.domain().triangles(),
+        triangles: deformer.domain().triangles(),
     };
     let (w, h) = picture.dimensions();
     Ok(render::warp_picture(
@@ -301,26 +371,26 @@ pub fn warp_picture(picture: &Picture, rig: &Rig) -> Result<Picture> {
     )?)
 }
 
-/// Rest and deformed positions in f32 for drawing.
-fn warp_positions(rig: &Rig) -> Result<(Vec<Vec2>, Vec<Vec2>)> {
-    let deformed = rig.deform();
+/// The deformed positions in f32 for drawing.
+fn deformed_f32(deformer: &dyn Deformer) -> Result<Vec<Vec2>> {
+    let deformed = deformer.deformed();
     if deformed.iter().any(|p| !p.is_finite()) {
         bail!("the deformation produced non-finite positions");
     }
-    let deformed = deformed.iter().map(|p| p.as_vec2()).collect();
-    Ok((rest_positions(rig), deformed))
+    Ok(deformed.iter().map(|p| p.as_vec2()).collect())
 }
 
-/// The image warped by the rig's current pose, at the image's full resolution.
+/// The image warped by the current pose, at the image's full resolution.
 ///
 /// # Errors
 /// Only if the deformation produced non-finite positions.
-pub fn warp(image: &RgbaImage, rig: &Rig) -> Result<RgbaImage> {
-    let (rest, deformed) = warp_positions(rig)?;
+pub fn warp(image: &RgbaImage, deformer: &dyn Deformer) -> Result<RgbaImage> {
+    let rest = rest_positions(deformer);
+    let deformed = deformed_f32(deformer)?;
     let mesh = render::WarpMesh {
         rest: &rest,
         deformed: &deformed,
-        triangles: rig.domain().triangles(),
+        triangles: deformer.domain().triangles(),
     };
     let (w, h) = image.dimensions();
     Ok(render::warp_cpu(
@@ -330,4 +400,120 @@ pub fn warp(image: &RgbaImage, rig: &Rig) -> Result<RgbaImage> {
         h,
         &render::RasterOptions::default(),
     )?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lizard() -> RgbaImage {
+        image::load_from_memory(DEFAULT_IMAGE)
+            .expect("the built-in picture decodes")
+            .to_rgba8()
+    }
+
+    #[test]
+    fn the_handle_limits_agree() {
+        assert_eq!(project::MAX_HANDLES, weights_core::MAX_HANDLES);
+    }
+
+    #[test]
+    fn a_rig_with_more_virtual_handles_than_its_mesh_can_carry_is_refused_before_meshing() {
+        let mut project = Project::from_json(DEFAULT_RIG).expect("the built-in rig");
+        project.density = Some(2000);
+        project.virtual_handles = (0..4001)
+            .map(|i| [300.0 + (i % 50) as f64 * 0.1, 250.0])
+            .collect();
+        let clock = std::time::Instant::now();
+        let err = prepare(&lizard(), &project, None)
+            .err()
+            .expect("too many virtual handles")
+            .to_string();
+        assert!(
+            err.contains("4001 virtual handles") && err.contains("up to twice the density, 4000"),
+            "{err}"
+        );
+        // Refused before meshing: the build itself would take minutes.
+        assert!(clock.elapsed().as_secs_f64() < 10.0);
+    }
+
+    #[test]
+    fn virtual_handles_keep_the_handle_they_were_placed_for_through_a_file() {
+        let image = lizard();
+        let mut project = Project::from_json(DEFAULT_RIG).expect("the built-in rig");
+        project.density = Some(5000);
+        let mut rig = prepare(&image, &project, None).expect("builds").rig;
+        // A handle beside another: virtual handles placed for it.
+        let new = rig
+            .insert_handle(Handle::point(DVec2::new(446.0, 238.0)))
+            .expect("room");
+        let placed = rig.placed_virtual_handles();
+        let positions = rig.domain().positions();
+        assert!(
+            placed.iter().any(|v| v.placed_for == Some(new)),
+            "{placed:?}"
+        );
+        let point = |p: DVec2| project::HandleSpec::Point {
+            rest: p.to_array(),
+            translate: [0.0, 0.0],
+            rotate: 0.0,
+            scale: 1.0,
+        };
+        project.handles.push(point(DVec2::new(446.0, 238.0)));
+        project.virtual_handles = placed
+            .iter()
+            .map(|v| positions[v.vertex as usize].to_array())
+            .collect();
+        project.virtual_placed_for = placed.iter().map(|v| v.placed_for).collect();
+        let saved = Project::from_json(&project.to_json()).expect("round trip");
+        let mut reloaded = prepare(&image, &saved, None).expect("builds").rig;
+        let at = |rig: &Rig, v: &VirtualHandle| {
+            let p = rig.domain().positions()[v.vertex as usize];
+            ((p.x * 1e6).round() as i64, (p.y * 1e6).round() as i64)
+        };
+        let theirs: Vec<_> = placed
+            .iter()
+            .filter(|v| v.placed_for == Some(new))
+            .map(|v| at(&rig, v))
+            .collect();
+        let reloaded_theirs: Vec<_> = reloaded
+            .placed_virtual_handles()
+            .iter()
+            .filter(|v| v.placed_for == Some(new))
+            .map(|v| at(&reloaded, v))
+            .collect();
+        assert_eq!(reloaded_theirs, theirs);
+        // Removing the handle from the reloaded rig takes its virtual handles along:
+        // the same as building, on the reloaded mesh, the other handles with the
+        // other virtual handles (the handle is the last one, so nothing renumbers).
+        let others: Vec<VirtualHandle> = reloaded
+            .placed_virtual_handles()
+            .into_iter()
+            .filter(|v| v.placed_for != Some(new))
+            .collect();
+        assert!(others.len() < reloaded.placed_virtual_handles().len());
+        let mut handles = reloaded.handles().to_vec();
+        handles.remove(new);
+        let expected = Rig::with_placed_virtual_handles(
+            reloaded.domain().clone(),
+            handles,
+            &others,
+            reloaded.options().clone(),
+        )
+        .expect("builds");
+        reloaded.remove_handle(new).expect("exists");
+        assert_eq!(reloaded.virtual_vertices(), expected.virtual_vertices());
+        assert!(
+            reloaded
+                .placed_virtual_handles()
+                .iter()
+                .all(|v| v.placed_for.is_none_or(|h| h < new))
+        );
+        // Without the owners in the file, they would have stayed.
+        let mut unowned = saved.clone();
+        unowned.virtual_placed_for.clear();
+        let mut unowned = prepare(&image, &unowned, None).expect("builds").rig;
+        unowned.remove_handle(new).expect("exists");
+        assert_ne!(unowned.virtual_vertices(), expected.virtual_vertices());
+    }
 }

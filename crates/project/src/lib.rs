@@ -28,6 +28,12 @@ pub const MAX_SCALE: f64 = 1e9;
 /// The file format version this crate reads and writes.
 pub const VERSION: u32 = 1;
 
+/// The most handles a rig file may have: the weights are built for up to this many
+/// (`weights_core::MAX_HANDLES`; this crate does not depend on it, and the pipeline's
+/// tests check that the two agree). A larger rig is refused with a message naming the
+/// limit before anything is computed.
+pub const MAX_HANDLES: usize = 10_000;
+
 /// Which distance the weights use.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "lowercase")]
@@ -40,6 +46,70 @@ pub enum MetricChoice {
     /// Shortest paths inside the shape.
     Intrinsic,
 }
+
+/// Which published method warps the picture.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Method {
+    /// The closed-form C² weights of Xian, Jin and Wang, with virtual handles.
+    #[default]
+    C2,
+    /// As-rigid-as-possible shape manipulation (Igarashi, Moscovich and Hughes 2005).
+    Arap,
+}
+
+impl Method {
+    /// Every method, in the order a user is offered them.
+    pub const ALL: [Method; 2] = [Method::C2, Method::Arap];
+
+    /// The name in rig files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::C2 => "c2",
+            Method::Arap => "arap",
+        }
+    }
+
+    /// The name shown to users.
+    pub fn label(self) -> &'static str {
+        match self {
+            Method::C2 => "C² weights",
+            Method::Arap => "ARAP",
+        }
+    }
+}
+
+impl std::str::FromStr for Method {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Method::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| format!("unknown method {s:?} (known: c2, arap)"))
+    }
+}
+
+/// A painted stroke of rigidity (ARAP, the paper's §5.2): every triangle whose
+/// centroid lies within `radius` pixels of the polyline `stroke` takes `weight` (the
+/// largest where strokes overlap; 1 elsewhere).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RigidityStroke {
+    /// The brush's path in image pixels; one point paints a disc.
+    pub stroke: Vec<[f64; 2]>,
+    /// The brush radius in pixels.
+    pub radius: f64,
+    /// The weight of the painted triangles (the paper paints 10000).
+    pub weight: f64,
+}
+
+/// The largest rigidity weight accepted (the paper paints 10⁴; far beyond, the
+/// systems lose precision).
+pub const MAX_RIGIDITY: f64 = 1e8;
+
+/// The most points all rigidity strokes of a rig may have together.
+pub const MAX_STROKE_POINTS: usize = 100_000;
 
 /// Placement of the basis's middle Bézier controls (degrees above 5).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -123,6 +193,23 @@ pub struct Project {
     /// exactly the weights it had. Omit to let them be computed afresh.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub virtual_handles: Vec<[f64; 2]>,
+    /// For each of [`Project::virtual_handles`], in the same order, the index into
+    /// [`Project::handles`] of the handle it was placed for (`null` for none), so that
+    /// removing that handle after a reload takes it along, as it would have before.
+    /// Either empty (omitted: no virtual handle was placed for a handle, as in files
+    /// from before this field) or as long as `virtual_handles`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub virtual_placed_for: Vec<Option<usize>>,
+    /// The warping method (`"c2"` when absent, so older files load unchanged).
+    #[serde(default, skip_serializing_if = "is_c2")]
+    pub method: Method,
+    /// Painted rigidity (used by ARAP; kept with the file whatever the method).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub rigidity: Vec<RigidityStroke>,
+}
+
+fn is_c2(method: &Method) -> bool {
+    *method == Method::C2
 }
 
 impl Default for Project {
@@ -138,6 +225,9 @@ impl Default for Project {
             density: None,
             handles: Vec::new(),
             virtual_handles: Vec::new(),
+            virtual_placed_for: Vec::new(),
+            method: Method::C2,
+            rigidity: Vec::new(),
         }
     }
 }
@@ -219,13 +309,42 @@ impl Project {
         s
     }
 
-    /// Checks ranges and finiteness, and with `image_size = Some((w, h))` that every
-    /// handle lies on the image.
+    /// Checks ranges and finiteness, the number of handles (at most [`MAX_HANDLES`]),
+    /// that [`Project::virtual_placed_for`] matches the virtual handles and names
+    /// handles that exist, and with `image_size = Some((w, h))` that every handle lies
+    /// on the image.
     ///
     /// # Errors
     /// The first problem found, naming the handle.
     pub fn validate(&self, image_size: Option<(u32, u32)>) -> Result<(), ProjectError> {
         let bad = |m: String| Err(ProjectError::Invalid(m));
+        if self.handles.len() > MAX_HANDLES {
+            return bad(format!(
+                "{} handles; C2Warp is built for up to {MAX_HANDLES} handles",
+                self.handles.len()
+            ));
+        }
+        if !self.virtual_placed_for.is_empty() {
+            if self.virtual_placed_for.len() != self.virtual_handles.len() {
+                return bad(format!(
+                    "virtual_placed_for has {} entries for {} virtual handles (one each, or \
+                     leave it out)",
+                    self.virtual_placed_for.len(),
+                    self.virtual_handles.len()
+                ));
+            }
+            if let Some((i, h)) = self
+                .virtual_placed_for
+                .iter()
+                .enumerate()
+                .find_map(|(i, h)| h.filter(|&h| h >= self.handles.len()).map(|h| (i, h)))
+            {
+                return bad(format!(
+                    "virtual handle {i} was placed for handle {h}, but there are {} handles",
+                    self.handles.len()
+                ));
+            }
+        }
         if !(0.0..=1.0).contains(&self.alpha) {
             return bad(format!("alpha must be in [0, 1], got {}", self.alpha));
         }
@@ -302,6 +421,35 @@ impl Project {
         {
             return bad(format!("virtual handle ({}, {}) is not finite", p[0], p[1]));
         }
+        let points: usize = self.rigidity.iter().map(|s| s.stroke.len()).sum();
+        if points > MAX_STROKE_POINTS {
+            return bad(format!(
+                "rigidity strokes have {points} points; at most {MAX_STROKE_POINTS} are read"
+            ));
+        }
+        for (i, s) in self.rigidity.iter().enumerate() {
+            if s.stroke.is_empty() {
+                return bad(format!("rigidity stroke {i} has no points"));
+            }
+            if s.stroke.iter().flatten().any(|x| !x.is_finite()) {
+                return bad(format!(
+                    "rigidity stroke {i}: coordinates must be finite numbers"
+                ));
+            }
+            if !(s.radius.is_finite() && s.radius > 0.0 && s.radius <= MAX_POSE) {
+                return bad(format!(
+                    "rigidity stroke {i}: radius must be a positive number of pixels, got {}",
+                    s.radius
+                ));
+            }
+            if !(s.weight.is_finite() && s.weight > 0.0 && s.weight <= MAX_RIGIDITY) {
+                return bad(format!(
+                    "rigidity stroke {i}: weight must be positive and at most {MAX_RIGIDITY:e}, \
+                     got {}",
+                    s.weight
+                ));
+            }
+        }
         Ok(())
     }
 }
@@ -332,8 +480,38 @@ mod tests {
                 },
             ],
             virtual_handles: vec![[5.0, 6.0], [0.1, 0.2]],
+            virtual_placed_for: vec![Some(1), None],
+            method: Method::Arap,
+            rigidity: vec![
+                RigidityStroke {
+                    stroke: vec![[3.0, 4.0], [10.25, 1.0 / 3.0]],
+                    radius: 6.5,
+                    weight: 10000.0,
+                },
+                RigidityStroke {
+                    stroke: vec![[20.0, 20.0]],
+                    radius: 1.0,
+                    weight: 0.5,
+                },
+            ],
             ..Project::default()
         }
+    }
+
+    #[test]
+    fn the_method_defaults_to_c2_and_is_left_out_for_it() {
+        let p = Project::from_json(r#"{"version":1,"handles":[]}"#).expect("parses");
+        assert_eq!(p.method, Method::C2);
+        assert!(p.rigidity.is_empty());
+        assert!(!p.to_json().contains("method"), "{}", p.to_json());
+        let arap =
+            Project::from_json(r#"{"version":1,"method":"arap","handles":[]}"#).expect("parses");
+        assert_eq!(arap.method, Method::Arap);
+        assert!(arap.to_json().contains(r#""method": "arap""#));
+        for m in Method::ALL {
+            assert_eq!(m.name().parse::<Method>(), Ok(m));
+        }
+        assert!("lbc2".parse::<Method>().is_err());
     }
 
     #[test]
@@ -414,6 +592,42 @@ mod tests {
             ),
             // A byte-order mark anywhere but at the start is not whitespace.
             ("{\u{feff}\"version\":1,\"handles\":[]}", "malformed"),
+            (
+                r#"{"version":1,"handles":[],"virtual_handles":[[1,1]],"virtual_placed_for":[null,0]}"#,
+                "2 entries for 1 virtual handles",
+            ),
+            (
+                r#"{"version":1,"handles":[{"type":"point","rest":[1,1]}],"virtual_handles":[[1,2]],"virtual_placed_for":[1]}"#,
+                "placed for handle 1, but there are 1 handles",
+            ),
+            (
+                r#"{"version":1,"method":"c3","handles":[]}"#,
+                "unknown variant `c3`",
+            ),
+            (
+                r#"{"version":1,"handles":[],"rigidity":[{"stroke":[[1,NaN]],"radius":2,"weight":3}]}"#,
+                "malformed",
+            ),
+            (
+                r#"{"version":1,"handles":[],"rigidity":[{"stroke":[[1,1e999]],"radius":2,"weight":3}]}"#,
+                "out of range",
+            ),
+            (
+                r#"{"version":1,"handles":[],"rigidity":[{"stroke":[[1,1]],"radius":-2,"weight":3}]}"#,
+                "radius must be a positive",
+            ),
+            (
+                r#"{"version":1,"handles":[],"rigidity":[{"stroke":[[1,1]],"radius":2,"weight":0}]}"#,
+                "weight must be positive",
+            ),
+            (
+                r#"{"version":1,"handles":[],"rigidity":[{"stroke":[],"radius":2,"weight":1}]}"#,
+                "no points",
+            ),
+            (
+                r#"{"version":1,"handles":[],"rigidity":[{"stroke":[[1,1]],"radius":2}]}"#,
+                "missing field `weight`",
+            ),
         ];
         for (text, expected) in cases {
             let err = Project::from_json(text).expect_err(text).to_string();
@@ -436,5 +650,41 @@ mod tests {
             .validate(Some((20, 20)))
             .expect_err("bar end off the image");
         assert!(err.to_string().contains("outside the image"), "{err}");
+    }
+
+    #[test]
+    fn files_without_virtual_placed_for_still_load_and_files_with_it_round_trip() {
+        let old = r#"{"version":1,"handles":[{"type":"point","rest":[1,2]}],"virtual_handles":[[3,4],[5,6]]}"#;
+        let p = Project::from_json(old).expect("an older file");
+        assert!(p.virtual_placed_for.is_empty());
+        assert!(!p.to_json().contains("virtual_placed_for"));
+        let with = Project {
+            virtual_placed_for: vec![None, Some(0)],
+            ..p
+        };
+        let text = with.to_json();
+        assert!(text.contains("\"virtual_placed_for\""), "{text}");
+        assert_eq!(Project::from_json(&text).expect("parses"), with);
+    }
+
+    #[test]
+    fn too_many_handles_are_refused_naming_the_limit() {
+        let point = HandleSpec::Point {
+            rest: [1.0, 1.0],
+            translate: [0.0, 0.0],
+            rotate: 0.0,
+            scale: 1.0,
+        };
+        let mut p = Project {
+            handles: vec![point; MAX_HANDLES],
+            ..Project::default()
+        };
+        assert!(p.validate(None).is_ok());
+        p.handles.push(p.handles[0].clone());
+        let err = p.validate(None).expect_err("one too many").to_string();
+        assert!(
+            err.contains("10001 handles; C2Warp is built for up to 10000 handles"),
+            "{err}"
+        );
     }
 }

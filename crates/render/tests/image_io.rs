@@ -270,7 +270,7 @@ fn a_tiny_jpeg_claiming_a_huge_size_is_refused_before_decoding() {
     let start = Instant::now();
     let err = decode_image(&forged, &ImageLimits::default()).expect_err("too short");
     assert!(
-        start.elapsed() < Duration::from_millis(100),
+        start.elapsed() < Duration::from_secs(5), // refused up front, not decoded
         "{:?}",
         start.elapsed()
     );
@@ -314,7 +314,7 @@ fn huge_header_fails_fast() {
     let bytes = png_with_header(100_000, 100_000);
     let start = Instant::now();
     let err = decode_image(&bytes, &ImageLimits::default()).expect_err("too large");
-    assert!(start.elapsed() < Duration::from_secs(1));
+    assert!(start.elapsed() < Duration::from_secs(5), "refused up front");
     assert!(
         matches!(
             err,
@@ -340,7 +340,7 @@ fn huge_header_fails_fast() {
     };
     let start = Instant::now();
     let err = decode_image(&bytes, &limits).expect_err("too much memory");
-    assert!(start.elapsed() < Duration::from_secs(1));
+    assert!(start.elapsed() < Duration::from_secs(5), "refused up front");
     assert!(matches!(err, RenderError::MemoryLimit { .. }), "{err}");
 
     // Within both limits, the tiny IDAT is simply not enough data.
@@ -509,7 +509,10 @@ fn fifos_and_devices_are_refused_without_reading() {
     std::os::unix::fs::symlink("/dev/zero", &link).expect("symlink");
     let err = read_regular_file(&link, "rig file", 8 << 20).expect_err("a device");
     assert!(matches!(err, RenderError::NotRegularFile { .. }), "{err}");
-    assert!(start.elapsed() < Duration::from_secs(2));
+    assert!(
+        start.elapsed() < Duration::from_secs(5),
+        "refused, not read"
+    );
 }
 
 #[test]

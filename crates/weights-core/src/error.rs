@@ -101,4 +101,30 @@ pub enum RigError {
     /// A virtual handle given to rebuild a rig names no sample.
     #[error("virtual handle sample {0} does not exist")]
     BadVirtual(u32),
+    /// A virtual handle given to rebuild a rig was placed for a handle that does not
+    /// exist.
+    #[error("virtual handle {index} was placed for handle {handle}, which does not exist")]
+    BadPlacedFor {
+        /// Index of the virtual handle in the list given.
+        index: usize,
+        /// The handle it names.
+        handle: usize,
+    },
+    /// More handles than [`crate::MAX_HANDLES`].
+    #[error("{count} handles; the weights are built for up to {max} handles")]
+    TooManyHandles {
+        /// Handles given.
+        count: usize,
+        /// The most a rig takes.
+        max: usize,
+    },
+    /// More virtual handles than the domain has samples (each takes a sample of its
+    /// own).
+    #[error("{count} virtual handles on {samples} samples: there can be at most one a sample")]
+    TooManyVirtual {
+        /// Virtual handles given.
+        count: usize,
+        /// Samples of the domain.
+        samples: usize,
+    },
 }

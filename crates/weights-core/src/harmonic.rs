@@ -1,11 +1,13 @@
 //! Harmonic coordinates of the virtual handles with respect to the real handles, on
 //! the dual (Delaunay) graph of the Voronoi cells: one harmonic field per real handle,
-//! 1 on that handle's nodes and 0 on every other real node.
+//! 1 on that handle's nodes and 0 on every other real node, solved directly per
+//! component of the virtual handles and stored sparse.
 
 use glam::DVec2;
 use rayon::prelude::*;
 
 use crate::domain::{Domain, Metric};
+use crate::ldl::{BLOCK, Ldl, dissection_order};
 use crate::voronoi::{NONE, Partition};
 
 /// The dual graph: pairs of nodes whose closed cells share a mesh edge, each pair once
@@ -144,28 +146,55 @@ fn triangle_pairs(domain: &Domain, partition: &Partition) -> PairsAndTies {
         )
 }
 
+/// Coefficients below this are left out (and the others scaled to sum to one).
+///
+/// A group's field falls off exponentially with the real nodes between it and a
+/// virtual one; where thousands of virtual handles surround thousands of handles,
+/// keeping every coefficient would cost a number per handle per virtual handle (25
+/// million for 2,000 random handles on the lizard at 20k samples; 2.3 million, 180 a
+/// virtual handle, at this threshold). Even with 10,000 handles the mass left out is
+/// under 1e-6 of a node's, and it moves a virtual handle by less than a millionth of
+/// the largest difference between two handles' motions.
+pub(crate) const NEGLIGIBLE: f64 = 1e-10;
+
+/// The harmonic coefficients of one virtual node: `(group, coefficient)` pairs, groups
+/// ascending, coefficients at least [`NEGLIGIBLE`] and summing to 1; empty when no real
+/// handle is connected to the node.
+pub(crate) type Coefficients = Box<[(u32, f64)]>;
+
 /// Harmonic coefficients: for every node, `None` for a real node (it has a group of its
-/// own) or the coefficients over the `groups` real handles (summing to 1, or all zero
-/// when no real handle is connected to it).
+/// own) or its coefficients over the `groups` real handles.
+///
+/// The field of group g is 1 on g's nodes, 0 on the other real nodes and harmonic
+/// (with edge weights 1/length) at the free nodes. Free nodes fall into components
+/// joined by free–free edges: a component's values depend only on the groups it
+/// touches (every other group's field is exactly zero on it), so each component is
+/// solved on its own, for the groups it touches, by one sparse LDLᵀ factorisation and
+/// one solve per group. (A global iterative solve per group cost groups × iterations ×
+/// nodes: minutes for thousands of virtual handles around hundreds of handles.)
 pub(crate) fn harmonic_coordinates(
     positions: &[DVec2],
     node_vertex: &[u32],
     node_group: &[Option<usize>],
-    groups: usize,
     edges: &[(u32, u32)],
-) -> Vec<Option<Vec<f64>>> {
+    progress: &(dyn Fn(usize, usize) + Sync),
+    earlier: &Solved,
+) -> (Vec<Option<Coefficients>>, Solved) {
     let n = node_vertex.len();
     // Free nodes in a canonical order (by sample), so results do not depend on how the
     // nodes happen to be numbered.
     let mut free: Vec<usize> = (0..n).filter(|&k| node_group[k].is_none()).collect();
     free.sort_unstable_by_key(|&k| node_vertex[k]);
-    let mut index = vec![usize::MAX; n];
+    let mut index = vec![u32::MAX; n];
     for (i, &k) in free.iter().enumerate() {
-        index[k] = i;
+        index[k] = i as u32;
     }
     let mut adjacency: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
     for &(a, b) in edges {
         let (a, b) = (a as usize, b as usize);
+        if node_group[a].is_some() && node_group[b].is_some() {
+            continue;
+        }
         let len = (positions[node_vertex[a] as usize] - positions[node_vertex[b] as usize])
             .length()
             .max(1e-12);
@@ -175,122 +204,238 @@ pub(crate) fn harmonic_coordinates(
     for list in adjacency.iter_mut() {
         list.sort_unstable_by_key(|&(j, _)| node_vertex[j]);
     }
-    // Free nodes connected (through free nodes) to some real node.
-    let mut anchored = vec![false; free.len()];
-    let mut stack: Vec<usize> = free
-        .iter()
-        .enumerate()
-        .filter(|(_, k)| adjacency[**k].iter().any(|&(j, _)| node_group[j].is_some()))
-        .map(|(i, _)| i)
-        .collect();
-    for &i in &stack {
-        anchored[i] = true;
-    }
-    while let Some(i) = stack.pop() {
-        for &(j, _) in &adjacency[free[i]] {
-            let fj = index[j];
-            if fj != usize::MAX && !anchored[fj] {
-                anchored[fj] = true;
-                stack.push(fj);
-            }
+    // Components of the free nodes, each listed in free order, in the order of their
+    // first member.
+    let mut component = vec![u32::MAX; free.len()];
+    let mut components: Vec<Vec<u32>> = Vec::new();
+    for start in 0..free.len() {
+        if component[start] != u32::MAX {
+            continue;
         }
-    }
-    let diag: Vec<f64> = free
-        .iter()
-        .map(|&k| adjacency[k].iter().map(|&(_, w)| w).sum())
-        .collect();
-    let apply = |x: &[f64], out: &mut [f64]| {
-        for (i, &k) in free.iter().enumerate() {
-            if !anchored[i] {
-                out[i] = 0.0;
-                continue;
-            }
-            let mut s = diag[i] * x[i];
-            for &(j, w) in &adjacency[k] {
+        let c = components.len() as u32;
+        component[start] = c;
+        let mut members = vec![start as u32];
+        let mut next = 0;
+        while next < members.len() {
+            let i = members[next] as usize;
+            next += 1;
+            for &(j, _) in &adjacency[free[i]] {
                 let fj = index[j];
-                if fj != usize::MAX {
-                    s -= w * x[fj];
+                if fj != u32::MAX && component[fj as usize] == u32::MAX {
+                    component[fj as usize] = c;
+                    members.push(fj);
                 }
             }
-            out[i] = s;
         }
-    };
-    let columns: Vec<Vec<f64>> = (0..groups)
-        .into_par_iter()
-        .map(|g| {
-            let b: Vec<f64> = free
+        members.sort_unstable();
+        components.push(members);
+    }
+    // The groups each component touches, and a solve per group and component.
+    let touched: Vec<Vec<u32>> = components
+        .par_iter()
+        .map(|members| {
+            let mut groups: Vec<u32> = members
                 .iter()
-                .enumerate()
-                .map(|(i, &k)| {
-                    if !anchored[i] {
-                        return 0.0;
-                    }
-                    adjacency[k]
-                        .iter()
-                        .filter(|&&(j, _)| node_group[j] == Some(g))
-                        .map(|&(_, w)| w)
-                        .sum()
-                })
+                .flat_map(|&i| adjacency[free[i as usize]].iter())
+                .filter_map(|&(j, _)| node_group[j].map(|g| g as u32))
                 .collect();
-            conjugate_gradient(&apply, &diag, &b)
+            groups.sort_unstable();
+            groups.dedup();
+            groups
         })
         .collect();
-    let mut out: Vec<Option<Vec<f64>>> = vec![None; n];
-    for (i, &k) in free.iter().enumerate() {
-        let mut coefficients: Vec<f64> = columns.iter().map(|c| c[i].max(0.0)).collect();
-        let sum: f64 = coefficients.iter().sum();
-        if sum > 0.0 {
-            coefficients.iter_mut().for_each(|c| *c /= sum);
+    let total: usize = touched.iter().map(Vec::len).sum();
+    progress(0, total);
+    // Solves done so far, told in order.
+    let done = std::sync::Mutex::new(0usize);
+    let solved_some = |count: usize| {
+        let mut done = done
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        for _ in 0..count {
+            *done += 1;
+            progress(*done, total);
         }
-        out[k] = Some(coefficients);
+    };
+    // A component solved before, with the same inputs, is taken as it was.
+    let solved: Vec<(Vec<u64>, SolvedRows)> = components
+        .par_iter()
+        .zip(&touched)
+        .map(|(members, groups)| {
+            let key = component_key(
+                node_vertex,
+                node_group,
+                (&free, &index, &adjacency),
+                members,
+                groups,
+            );
+            if let Some(rows) = earlier.0.get(&key) {
+                solved_some(groups.len());
+                return (key, rows.clone());
+            }
+            let rows = solve_component(
+                positions,
+                node_vertex,
+                node_group,
+                (&free, &index, &adjacency),
+                members,
+                groups,
+                &solved_some,
+            );
+            (key, rows.into())
+        })
+        .collect();
+    let mut out: Vec<Option<Coefficients>> = vec![None; n];
+    for ((members, groups), (_, rows)) in components.iter().zip(&touched).zip(&solved) {
+        for (&i, row) in members.iter().zip(rows.iter()) {
+            let named: Coefficients = row
+                .iter()
+                .map(|&(rank, v)| (groups[rank as usize], v))
+                .collect();
+            out[free[i as usize]] = Some(named);
+        }
     }
-    out
+    (out, Solved(solved.into_iter().collect()))
 }
 
-/// Jacobi-preconditioned conjugate gradients for the symmetric positive definite
-/// system `A x = b`, to a relative residual of 1e-13.
-fn conjugate_gradient(apply: &dyn Fn(&[f64], &mut [f64]), diag: &[f64], b: &[f64]) -> Vec<f64> {
-    let n = b.len();
-    let mut x = vec![0.0; n];
-    let mut r = b.to_vec();
-    let precondition = |r: &[f64]| -> Vec<f64> {
-        r.iter()
-            .zip(diag)
-            .map(|(r, d)| if *d > 0.0 { r / d } else { 0.0 })
-            .collect()
+/// A component's rows, each coefficient with the rank of its group among those the
+/// component touches.
+type SolvedRows = std::sync::Arc<[Coefficients]>;
+
+/// The components solved by a call of [`harmonic_coordinates`], by their inputs: the
+/// next call takes those it meets again as they are. An insertion changes the dual
+/// graph only near the new handle, so with thousands of handles it re-solves a few
+/// components instead of all.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Solved(std::collections::HashMap<Vec<u64>, SolvedRows>);
+
+/// Everything a component's solution depends on: its members' samples, and for each
+/// member its neighbours in order, free ones by sample, real ones by sample and the
+/// rank of their group among those the component touches (ranks, not group numbers,
+/// so that handles renumbered after a removal do not count as a change). The edge
+/// weights and the ordering follow from the samples' positions.
+fn component_key(
+    node_vertex: &[u32],
+    node_group: &[Option<usize>],
+    (free, _, adjacency): FreeGraph,
+    members: &[u32],
+    groups: &[u32],
+) -> Vec<u64> {
+    let mut key = Vec::with_capacity(members.len() * 8);
+    for &i in members {
+        let k = free[i as usize];
+        key.push(u64::from(node_vertex[k]) | (adjacency[k].len() as u64) << 32);
+        for &(j, _) in &adjacency[k] {
+            let sample = u64::from(node_vertex[j]);
+            key.push(match node_group[j] {
+                None => sample,
+                Some(g) => {
+                    let rank = groups.binary_search(&(g as u32)).unwrap_or(0) as u64;
+                    1 << 63 | rank << 32 | sample
+                }
+            });
+        }
+    }
+    key
+}
+
+/// The free nodes in canonical order, each node's index among them, and the dual graph
+/// with edge weights.
+type FreeGraph<'a> = (&'a [usize], &'a [u32], &'a [Vec<(usize, f64)>]);
+
+/// The coefficients of one component of free nodes (`members`: free indices,
+/// ascending), in the members' order, over the groups it touches (`groups`,
+/// ascending), each named by its rank among them; `solved` is called after each
+/// group's solve.
+fn solve_component(
+    positions: &[DVec2],
+    node_vertex: &[u32],
+    node_group: &[Option<usize>],
+    (free, index, adjacency): FreeGraph,
+    members: &[u32],
+    groups: &[u32],
+    solved: &(dyn Fn(usize) + Sync),
+) -> Vec<Coefficients> {
+    let m = members.len();
+    // Local numbering: position in `members`.
+    let local = |fj: u32| members.binary_search(&fj).map(|l| l as u32).ok();
+    if groups.is_empty() {
+        return vec![Box::default(); m];
+    }
+    // The system: diagonal = all edge weights of the node, off-diagonal −w to free
+    // neighbours; right-hand side of group g: the weights of the edges to g's nodes.
+    let mut diagonal = Vec::with_capacity(m);
+    let mut inner: Vec<Vec<(u32, f64)>> = Vec::with_capacity(m);
+    let mut rhs: Vec<Vec<(u32, f64)>> = vec![Vec::new(); groups.len()];
+    for (l, &i) in members.iter().enumerate() {
+        let k = free[i as usize];
+        let mut row = Vec::with_capacity(adjacency[k].len());
+        let mut d = 0.0;
+        for &(j, w) in &adjacency[k] {
+            d += w;
+            match node_group[j] {
+                Some(g) => {
+                    let c = groups.binary_search(&(g as u32)).unwrap_or(0);
+                    rhs[c].push((l as u32, w));
+                }
+                None => {
+                    if let Some(lj) = local(index[j]) {
+                        row.push((lj, w));
+                    }
+                }
+            }
+        }
+        diagonal.push(d);
+        inner.push(row);
+    }
+    let points: Vec<DVec2> = members
+        .iter()
+        .map(|&i| positions[node_vertex[free[i as usize]] as usize])
+        .collect();
+    let order = dissection_order(&points, &inner);
+    let Some(ldl) = Ldl::factor(&diagonal, &inner, order) else {
+        // Not reached: a component with an edge to a real node is positive definite.
+        solved(groups.len());
+        return vec![Box::default(); m];
     };
-    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(a, b)| a * b).sum::<f64>();
-    let norm_b = dot(b, b).sqrt();
-    if norm_b == 0.0 {
-        return x;
-    }
-    let mut z = precondition(&r);
-    let mut p = z.clone();
-    let mut rz = dot(&r, &z);
-    let mut ap = vec![0.0; n];
-    for _ in 0..(10 * n + 100) {
-        apply(&p, &mut ap);
-        let pap = dot(&p, &ap);
-        if pap <= 0.0 {
-            break;
-        }
-        let alpha = rz / pap;
-        for i in 0..n {
-            x[i] += alpha * p[i];
-            r[i] -= alpha * ap[i];
-        }
-        if dot(&r, &r).sqrt() <= 1e-13 * norm_b {
-            break;
-        }
-        z = precondition(&r);
-        let rz_next = dot(&r, &z);
-        let beta = rz_next / rz;
-        rz = rz_next;
-        for i in 0..n {
-            p[i] = z[i] + beta * p[i];
+    // One solve per group, in parallel; each group's values kept where positive.
+    let columns: Vec<Vec<(u32, f64)>> = rhs
+        .par_chunks(BLOCK)
+        .map_init(
+            || (vec![[0.0; BLOCK]; m], vec![[0.0; BLOCK]; m]),
+            |(x, work), block| {
+                let bs: Vec<&[(u32, f64)]> = block.iter().map(Vec::as_slice).collect();
+                ldl.solve_block(&bs, x, work);
+                let columns: Vec<Vec<(u32, f64)>> = (0..block.len())
+                    .map(|r| {
+                        x.iter()
+                            .enumerate()
+                            .filter(|(_, v)| v[r] >= NEGLIGIBLE)
+                            .map(|(l, v)| (l as u32, v[r]))
+                            .collect()
+                    })
+                    .collect();
+                solved(block.len());
+                columns
+            },
+        )
+        .flatten()
+        .collect();
+    let mut rows: Vec<Vec<(u32, f64)>> = vec![Vec::new(); m];
+    for (c, column) in columns.iter().enumerate() {
+        for &(l, v) in column {
+            rows[l as usize].push((c as u32, v));
         }
     }
-    x
+    rows.into_iter()
+        .map(|mut row| {
+            let sum: f64 = row.iter().map(|e| e.1).sum();
+            if sum > 0.0 {
+                row.iter_mut().for_each(|e| e.1 /= sum);
+            }
+            row.into_boxed_slice()
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -304,11 +449,20 @@ mod tests {
         let node_vertex: Vec<u32> = (0..5).collect();
         let groups = [Some(0), None, None, None, Some(1)];
         let edges = [(0, 1), (1, 2), (2, 3), (3, 4)];
-        let h = harmonic_coordinates(&positions, &node_vertex, &groups, 2, &edges);
+        let h = harmonic_coordinates(
+            &positions,
+            &node_vertex,
+            &groups,
+            &edges,
+            &|_, _| {},
+            &Solved::default(),
+        )
+        .0;
         for (i, c) in h.iter().enumerate().take(4).skip(1) {
             let c = c.as_ref().expect("free");
-            assert!((c[0] - (1.0 - i as f64 / 4.0)).abs() < 1e-12, "{c:?}");
-            assert!((c[0] + c[1] - 1.0).abs() < 1e-12);
+            assert_eq!((c[0].0, c[1].0), (0, 1));
+            assert!((c[0].1 - (1.0 - i as f64 / 4.0)).abs() < 1e-15, "{c:?}");
+            assert!((c[0].1 + c[1].1 - 1.0).abs() < 1e-15);
         }
         assert!(h[0].is_none() && h[4].is_none());
     }
@@ -319,9 +473,103 @@ mod tests {
         let node_vertex: Vec<u32> = (0..4).collect();
         let groups = [Some(0), None, None, None];
         let edges = [(0, 1), (2, 3)];
-        let h = harmonic_coordinates(&positions, &node_vertex, &groups, 1, &edges);
-        assert_eq!(h[1].as_deref(), Some(&[1.0][..]));
-        assert_eq!(h[2].as_deref(), Some(&[0.0][..]));
+        let h = harmonic_coordinates(
+            &positions,
+            &node_vertex,
+            &groups,
+            &edges,
+            &|_, _| {},
+            &Solved::default(),
+        )
+        .0;
+        assert_eq!(h[1].as_deref(), Some(&[(0, 1.0)][..]));
+        assert_eq!(h[2].as_deref(), Some(&[][..]));
+    }
+
+    #[test]
+    fn a_component_sees_only_the_groups_it_touches() {
+        // Free chain 1–2 between groups 0 and 1; free node 4 hangs off group 2 alone.
+        let positions: Vec<DVec2> = (0..6).map(|i| DVec2::new(i as f64, 0.0)).collect();
+        let node_vertex: Vec<u32> = (0..6).collect();
+        let node_group = [Some(0), None, None, Some(1), None, Some(2)];
+        let edges = [(0, 1), (1, 2), (2, 3), (4, 5)];
+        let h = harmonic_coordinates(
+            &positions,
+            &node_vertex,
+            &node_group,
+            &edges,
+            &|_, _| {},
+            &Solved::default(),
+        )
+        .0;
+        let groups_of =
+            |k: usize| -> Vec<u32> { h[k].as_deref().expect("free").iter().map(|e| e.0).collect() };
+        assert_eq!(groups_of(1), vec![0, 1]);
+        assert_eq!(groups_of(2), vec![0, 1]);
+        assert_eq!(h[4].as_deref(), Some(&[(2, 1.0)][..]));
+    }
+
+    #[test]
+    fn harmonic_fields_satisfy_the_mean_value_property() {
+        use crate::domain::tests::grid_mesh;
+        // Free nodes on a grid with a few real nodes of three groups: at every free node
+        // each group's coefficient is the weighted mean of its neighbours'.
+        let (p, _) = grid_mesh(30, 20, 1.0);
+        let id = |i: u32, j: u32| j * 31 + i;
+        let node_vertex: Vec<u32> = (0..p.len() as u32).collect();
+        let mut node_group = vec![None; p.len()];
+        for (g, v) in [
+            (0, id(3, 3)),
+            (1, id(25, 15)),
+            (2, id(10, 18)),
+            (2, id(11, 18)),
+        ] {
+            node_group[v as usize] = Some(g);
+        }
+        let mut edges = Vec::new();
+        for j in 0..=20 {
+            for i in 0..=30 {
+                if i < 30 {
+                    edges.push((id(i, j), id(i + 1, j)));
+                }
+                if j < 20 {
+                    edges.push((id(i, j), id(i, j + 1)));
+                }
+            }
+        }
+        let h = harmonic_coordinates(
+            &p,
+            &node_vertex,
+            &node_group,
+            &edges,
+            &|_, _| {},
+            &Solved::default(),
+        )
+        .0;
+        let value = |k: usize, g: u32| -> f64 {
+            match node_group[k] {
+                Some(own) => f64::from(u8::from(own as u32 == g)),
+                None => h[k]
+                    .as_deref()
+                    .and_then(|c| c.iter().find(|e| e.0 == g))
+                    .map_or(0.0, |e| e.1),
+            }
+        };
+        let mut neighbours = vec![Vec::new(); p.len()];
+        for &(a, b) in &edges {
+            neighbours[a as usize].push(b as usize);
+            neighbours[b as usize].push(a as usize);
+        }
+        for k in (0..p.len()).filter(|&k| node_group[k].is_none()) {
+            let c = h[k].as_deref().expect("free");
+            assert_eq!(c.len(), 3);
+            assert!((c.iter().map(|e| e.1).sum::<f64>() - 1.0).abs() < 1e-14);
+            for g in 0..3 {
+                let mean = neighbours[k].iter().map(|&j| value(j, g)).sum::<f64>()
+                    / neighbours[k].len() as f64;
+                assert!((value(k, g) - mean).abs() < 1e-12, "node {k}, group {g}");
+            }
+        }
     }
 
     /// The dual graph by brute force: every triangle edge, with the closed-cell ties

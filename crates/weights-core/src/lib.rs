@@ -15,11 +15,18 @@
 //! its support (Algorithm 1); their transforms blend the real handles' by harmonic
 //! coordinates on the dual graph. Inserting or removing a handle updates only what it
 //! changes and gives the same weights as a rebuild with the same nodes.
+//!
+//! A rig takes up to [`MAX_HANDLES`] handles; [`Rig::with_progress`] tells a caller how
+//! far a long build has come, and [`Rig::placed_virtual_handles`] with
+//! [`Rig::with_placed_virtual_handles`] save and restore the virtual handles together
+//! with the handle each was placed for.
 
 mod basis;
 mod domain;
 mod error;
 mod harmonic;
+mod ldl;
+mod nearest;
 mod queue;
 mod rig;
 mod transform;
@@ -31,7 +38,8 @@ pub use basis::{Basis, MAX_DEGREE, MIN_DEGREE, MiddleControls};
 pub use domain::{Domain, Metric};
 pub use error::{DomainError, RigError};
 pub use rig::{
-    BuildTimings, Handle, MAX_BAR_PIECES, MAX_POSE, MAX_SCALE, MIN_SCALE, Node, NodeKind,
-    NodeRadii, Rig, RigOptions, RigStats, UpdateTimings, bar_samples, bar_spacing,
+    BuildTimings, Handle, MAX_BAR_PIECES, MAX_HANDLES, MAX_POSE, MAX_SCALE, MIN_SCALE, Node,
+    NodeKind, NodeRadii, Phase, Progress, Rig, RigOptions, RigStats, UpdateTimings, VirtualHandle,
+    bar_samples, bar_spacing,
 };
 pub use transform::Similarity;

@@ -10,7 +10,8 @@ use glam::{DAffine2, DVec2};
 use crate::basis::Basis;
 use crate::domain::{Domain, Metric};
 use crate::error::RigError;
-use crate::harmonic::{dual_edges, harmonic_coordinates};
+use crate::harmonic::{Coefficients, Solved, dual_edges, harmonic_coordinates};
+use crate::nearest::segment_distance;
 use crate::transform::Similarity;
 use crate::virtual_handles::insert_virtual_handles;
 use crate::voronoi::{CellStats, NONE, Partition};
@@ -199,24 +200,120 @@ fn group_of(n: &Node, handle_count: usize) -> Option<usize> {
     }
 }
 
-/// Harmonic coordinates of the virtual nodes over `groups` groups, on the dual graph of
+/// Harmonic coordinates of the virtual nodes over the groups, on the dual graph of
 /// `partition`.
+/// `progress(done, total)` is told of the solves (one per group and part of the dual
+/// graph), in order; parts solved `earlier` with the same inputs are taken as they
+/// were. Returns the coordinates and the parts solved, for the next call.
 fn harmonic_of(
     domain: &Domain,
     partition: &Partition,
     nodes: &[Node],
     handle_count: usize,
-    groups: usize,
-) -> Vec<Option<Vec<f64>>> {
+    progress: &(dyn Fn(usize, usize) + Sync),
+    earlier: &Solved,
+) -> (Vec<Option<Coefficients>>, Solved) {
     let edges = dual_edges(domain, partition);
     let node_group: Vec<Option<usize>> = nodes.iter().map(|n| group_of(n, handle_count)).collect();
     harmonic_coordinates(
         domain.positions(),
         &partition.node_vertex,
         &node_group,
-        groups,
         &edges,
+        progress,
+        earlier,
     )
+}
+
+/// The most handles a rig takes; more are refused up front. On a mesh of the default
+/// 20,000 samples that is a handle on every other sample, and the build stays under a
+/// second however they lie (measured with the `many_handles` example of the pipeline
+/// crate on the lizard: 0.6 s at worst, with every handle one pixel from another;
+/// 1.3 s at 100,000 samples).
+pub const MAX_HANDLES: usize = 10_000;
+
+/// A virtual handle to build a rig with: its sample, and the handle it was placed for
+/// (whose removal takes it along), if any.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct VirtualHandle {
+    /// The sample it sits on.
+    pub vertex: u32,
+    /// Index of the handle it was placed for.
+    pub placed_for: Option<usize>,
+}
+
+/// A phase of a rig build, in the order they run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Phase {
+    /// Every sample's nearest node, the Voronoi cells and their radii.
+    Partition,
+    /// Virtual handles placed by Algorithm 1; how many it needs is known only at the
+    /// end (up to one a sample, where two handles are a mesh edge apart).
+    VirtualHandles,
+    /// Supports and sparse weights.
+    Weights,
+    /// Harmonic coordinates of the virtual handles: one solve per real handle and part
+    /// of the dual graph it touches.
+    Transforms,
+}
+
+/// How far a build has come, as told to the callback of [`Rig::with_progress`].
+///
+/// Reports come in order: by phase, and within a phase by `done`; the last one is
+/// [`Phase::Transforms`] with `done == total`, at [`Progress::fraction`] 1.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Progress {
+    /// The phase under way.
+    pub phase: Phase,
+    /// Steps of the phase done.
+    pub done: usize,
+    /// Steps of the phase, when known (`None` while Algorithm 1 runs).
+    pub total: Option<usize>,
+}
+
+impl Progress {
+    /// The build's progress in [0, 1], never lower than at an earlier report: each
+    /// phase has a share of the scale (a rough guess at its share of the time; the
+    /// virtual handles' is filled ever more slowly, as their number is not known).
+    pub fn fraction(&self) -> f64 {
+        let (start, end) = match self.phase {
+            Phase::Partition => (0.0, 0.1),
+            Phase::VirtualHandles => (0.1, 0.4),
+            Phase::Weights => (0.4, 0.6),
+            Phase::Transforms => (0.6, 1.0),
+        };
+        let within = match self.total {
+            Some(0) => 1.0,
+            Some(total) => (self.done as f64 / total as f64).min(1.0),
+            None => self.done as f64 / (self.done as f64 + 1000.0),
+        };
+        if within >= 1.0 {
+            end
+        } else {
+            (start + (end - start) * within).min(end)
+        }
+    }
+}
+
+/// Algorithm 1 reports its progress once every this many virtual handles.
+const PROGRESS_STEP: usize = 64;
+
+/// For each of the `old` handles, its index among `new` if it is there (the same rest
+/// geometry; equal handles are matched in order), `None` if it left.
+fn match_handles(old: &[Handle], new: &[Handle]) -> Vec<Option<usize>> {
+    // Rest geometry as bits (+ 0.0 makes −0 and 0 alike, as == has them).
+    let bits = |x: f64| (x + 0.0).to_bits();
+    let key = |h: &Handle| match *h {
+        Handle::Point { rest, .. } => (false, [bits(rest.x), bits(rest.y), 0, 0]),
+        Handle::Bar { rest: [a, b], .. } => (true, [bits(a.x), bits(a.y), bits(b.x), bits(b.y)]),
+    };
+    let mut waiting: HashMap<(bool, [u64; 4]), std::collections::VecDeque<usize>> = HashMap::new();
+    for (j, h) in new.iter().enumerate() {
+        waiting.entry(key(h)).or_default().push_back(j);
+    }
+    old.iter()
+        .map(|h| waiting.get_mut(&key(h)).and_then(|q| q.pop_front()))
+        .collect()
 }
 
 /// Sizes of a rig.
@@ -278,16 +375,20 @@ pub struct Rig {
     partition: Partition,
     radii: Vec<f64>,
     weights: Weights,
-    harmonic: Vec<Option<Vec<f64>>>,
+    harmonic: Vec<Option<Coefficients>>,
+    /// The parts of the dual graph the harmonic coordinates were solved on, kept for
+    /// the next update.
+    solved: Solved,
     affines: Vec<DAffine2>,
     resolution: f64,
     timings: BuildTimings,
     update_timings: UpdateTimings,
-    /// The virtual handles placed while real nodes arrived, by sample, with the sample
-    /// of one of those real nodes: they go when it goes, so inserting and removing
-    /// handles does not leave ever more virtual handles behind. (Virtual handles from a
-    /// build, or placed while nodes only left, stay until crowded out.)
-    placed_for: HashMap<u32, u32>,
+    /// The virtual handles placed while a handle arrived, by sample, with that handle's
+    /// index (renumbered when handles before it go): they go when it goes, so inserting
+    /// and removing handles does not leave ever more virtual handles behind. (Virtual
+    /// handles from a build, or placed while handles only left, stay until crowded
+    /// out.)
+    placed_for: HashMap<u32, usize>,
 }
 
 impl Rig {
@@ -309,29 +410,114 @@ impl Rig {
     /// the weights it had.
     ///
     /// # Errors
-    /// As [`Rig::new`], and a virtual handle on a sample that does not exist.
+    /// As [`Rig::new`], a virtual handle on a sample that does not exist, and more
+    /// virtual handles than samples.
     pub fn with_virtual_handles(
         domain: Domain,
         handles: Vec<Handle>,
         virtual_vertices: &[u32],
         options: RigOptions,
     ) -> Result<Self, RigError> {
+        let placed: Vec<VirtualHandle> = virtual_vertices
+            .iter()
+            .map(|&vertex| VirtualHandle {
+                vertex,
+                placed_for: None,
+            })
+            .collect();
+        Self::with_progress(domain, handles, &placed, options, &|_| {})
+    }
+
+    /// As [`Rig::with_virtual_handles`], with the handle each virtual handle was placed
+    /// for (as [`Rig::placed_virtual_handles`] lists them): removing that handle later
+    /// takes them along, as it would have in the rig they were saved from.
+    ///
+    /// # Errors
+    /// As [`Rig::with_virtual_handles`], and a `placed_for` that names no handle.
+    pub fn with_placed_virtual_handles(
+        domain: Domain,
+        handles: Vec<Handle>,
+        virtual_handles: &[VirtualHandle],
+        options: RigOptions,
+    ) -> Result<Self, RigError> {
+        Self::with_progress(domain, handles, virtual_handles, options, &|_| {})
+    }
+
+    /// As [`Rig::with_placed_virtual_handles`], telling `progress` how far the build
+    /// has come (see [`Progress`]); it is called from the building threads, often, so
+    /// it should be quick (store the figure; draw elsewhere).
+    ///
+    /// ```
+    /// use std::sync::Mutex;
+    /// use glam::DVec2;
+    /// use weights_core::{Domain, Handle, Metric, Progress, Rig, RigOptions};
+    ///
+    /// let positions: Vec<DVec2> =
+    ///     (0..400).map(|i| DVec2::new((i % 20) as f64, (i / 20) as f64)).collect();
+    /// let mut triangles = Vec::new();
+    /// for y in 0..19u32 {
+    ///     for x in 0..19u32 {
+    ///         let a = y * 20 + x;
+    ///         triangles.push([a, a + 1, a + 21]);
+    ///         triangles.push([a, a + 21, a + 20]);
+    ///     }
+    /// }
+    /// let domain = Domain::new(positions, triangles, Metric::Intrinsic).unwrap();
+    /// let handles = vec![Handle::point(DVec2::new(2.0, 2.0)), Handle::point(DVec2::new(4.0, 2.0))];
+    /// let last = Mutex::new(0.0);
+    /// let rig = Rig::with_progress(domain, handles, &[], RigOptions::default(), &|p: Progress| {
+    ///     *last.lock().unwrap() = p.fraction();
+    /// })
+    /// .unwrap();
+    /// assert_eq!(*last.lock().unwrap(), 1.0);
+    /// assert!(rig.stats().virtual_nodes > 0);
+    /// ```
+    ///
+    /// # Errors
+    /// As [`Rig::with_placed_virtual_handles`].
+    pub fn with_progress(
+        domain: Domain,
+        handles: Vec<Handle>,
+        virtual_handles: &[VirtualHandle],
+        options: RigOptions,
+        progress: &(dyn Fn(Progress) + Sync),
+    ) -> Result<Self, RigError> {
         check_options(&options)?;
+        if virtual_handles.len() > domain.len() {
+            return Err(RigError::TooManyVirtual {
+                count: virtual_handles.len(),
+                samples: domain.len(),
+            });
+        }
         domain.prepare();
         let resolution = domain.mean_edge_length();
         let mut nodes = real_nodes(&domain, &handles, &options, resolution)?;
         let mut taken: std::collections::HashSet<u32> = nodes.iter().map(|n| n.vertex).collect();
-        for &v in virtual_vertices {
-            if v as usize >= domain.len() {
-                return Err(RigError::BadVirtual(v));
+        let mut placed_for = HashMap::new();
+        for (i, v) in virtual_handles.iter().enumerate() {
+            if v.vertex as usize >= domain.len() {
+                return Err(RigError::BadVirtual(v.vertex));
             }
-            if taken.insert(v) {
-                nodes.push(Node {
-                    vertex: v,
-                    kind: NodeKind::Virtual,
+            if let Some(h) = v.placed_for.filter(|&h| h >= handles.len()) {
+                return Err(RigError::BadPlacedFor {
+                    index: i,
+                    handle: h,
                 });
             }
+            if taken.insert(v.vertex) {
+                nodes.push(Node {
+                    vertex: v.vertex,
+                    kind: NodeKind::Virtual,
+                });
+                if let Some(h) = v.placed_for {
+                    placed_for.insert(v.vertex, h);
+                }
+            }
         }
+        let report = |phase, done, total| {
+            progress(Progress { phase, done, total });
+        };
+        report(Phase::Partition, 0, Some(1));
         let mut timings = BuildTimings::default();
         let clock = Instant::now();
         let mut partition = Partition::distances(&domain, nodes.iter().map(|n| n.vertex).collect());
@@ -339,17 +525,27 @@ impl Rig {
         let clock = Instant::now();
         partition.decompose(&domain);
         timings.voronoi_ms = ms(clock);
+        report(Phase::Partition, 1, Some(1));
+        report(Phase::VirtualHandles, 0, None);
         let clock = Instant::now();
-        for v in insert_virtual_handles(&domain, &mut partition, |_, _| {}) {
-            nodes.push(Node {
-                vertex: v,
-                kind: NodeKind::Virtual,
-            });
-        }
+        let mut placed = 0;
+        let added = insert_virtual_handles(&domain, &mut partition, |_, _| {
+            placed += 1;
+            if placed % PROGRESS_STEP == 0 {
+                report(Phase::VirtualHandles, placed, None);
+            }
+        });
+        report(Phase::VirtualHandles, added.len(), Some(added.len()));
+        nodes.extend(added.into_iter().map(|v| Node {
+            vertex: v,
+            kind: NodeKind::Virtual,
+        }));
         timings.virtual_ms = ms(clock);
+        report(Phase::Weights, 0, Some(1));
         let clock = Instant::now();
         let radii = support_radii(&partition, options.alpha);
         let weights = Weights::build(&domain, &partition, &radii, &options.basis);
+        report(Phase::Weights, 1, Some(1));
         let mut rig = Self {
             domain,
             options,
@@ -359,13 +555,22 @@ impl Rig {
             radii,
             weights,
             harmonic: Vec::new(),
+            solved: Solved::default(),
             affines: Vec::new(),
             resolution,
             timings,
             update_timings: UpdateTimings::default(),
-            placed_for: HashMap::new(),
+            placed_for,
         };
-        rig.update_transforms();
+        (rig.harmonic, rig.solved) = harmonic_of(
+            &rig.domain,
+            &rig.partition,
+            &rig.nodes,
+            rig.handles.len(),
+            &|done, total| report(Phase::Transforms, done, Some(total)),
+            &Solved::default(),
+        );
+        rig.update_affines();
         rig.timings.weights_ms = ms(clock);
         Ok(rig)
     }
@@ -434,10 +639,11 @@ impl Rig {
         }
         let clock = Instant::now();
         let target = real_nodes(&self.domain, &handles, &self.options, self.resolution)?;
+        let kept = match_handles(&self.handles, &handles);
         self.update_timings = UpdateTimings::default();
         self.update_timings.plan_ms = ms(clock);
         self.handles = handles;
-        self.apply(target);
+        self.apply(target, &kept);
         let clock = Instant::now();
         self.update_affines();
         self.update_timings.transforms_ms += ms(clock);
@@ -502,7 +708,9 @@ impl Rig {
 
     /// Moves the node set to `target` real nodes (virtual nodes kept unless a real node
     /// takes their sample), updating partition, virtual handles and weights locally.
-    fn apply(&mut self, target: Vec<Node>) {
+    /// `kept[i]` is the new index of the old handle `i`, `None` if it left; new
+    /// handles that no old one became have arrived.
+    fn apply(&mut self, target: Vec<Node>, kept: &[Option<usize>]) {
         let clock = Instant::now();
         let target_vertices: std::collections::HashSet<u32> =
             target.iter().map(|n| n.vertex).collect();
@@ -534,30 +742,33 @@ impl Rig {
             })
             .map(|(_, n)| n.vertex)
             .collect();
-        // Real nodes that leave take the virtual handles placed for them along.
-        let leaving_real: std::collections::HashSet<u32> = self
-            .nodes
-            .iter()
-            .filter(|n| n.kind != NodeKind::Virtual && !target_vertices.contains(&n.vertex))
-            .map(|n| n.vertex)
-            .collect();
+        // Handles that leave take the virtual handles placed for them along.
         let doomed: Vec<usize> = (0..self.nodes.len())
             .filter(|&k| {
                 let n = self.nodes[k];
                 if n.kind != NodeKind::Virtual {
-                    return leaving_real.contains(&n.vertex);
+                    return !target_vertices.contains(&n.vertex);
                 }
                 target_vertices.contains(&n.vertex)
                     || replaced.contains(&n.vertex)
                     || self
                         .placed_for
                         .get(&n.vertex)
-                        .is_some_and(|r| leaving_real.contains(r))
+                        .is_some_and(|&h| kept.get(h).copied().flatten().is_none())
             })
             .collect();
         for &k in &doomed {
             self.placed_for.remove(&self.nodes[k].vertex);
         }
+        for h in self.placed_for.values_mut() {
+            *h = kept.get(*h).copied().flatten().unwrap_or(*h);
+        }
+        // The first handle that arrives gets the virtual handles placed now.
+        let mut stays = vec![false; self.handles.len()];
+        for &i in kept.iter().flatten() {
+            stays[i] = true;
+        }
+        let first_arrival = stays.iter().position(|s| !s);
         // Radii of the surviving nodes, by sample (node numbers change below).
         let old_radius: HashMap<u32, f64> = (0..self.nodes.len())
             .filter(|k| doomed.binary_search(k).is_err())
@@ -613,7 +824,6 @@ impl Rig {
             .collect();
         let mut map: Vec<u32> = (0..self.nodes.len() as u32).collect();
         let handle_count = self.handles.len();
-        let groups = handle_count + usize::from(self.options.fixed_boundary);
         let Self {
             domain,
             options,
@@ -622,6 +832,7 @@ impl Rig {
             weights,
             update_timings,
             placed_for,
+            solved,
             ..
         } = &mut *self;
         let (domain, weights, alpha) = (&*domain, &*weights, options.alpha);
@@ -711,7 +922,7 @@ impl Rig {
                     Some(Ball::compute_from(domain, v, radius, inner))
                 });
             });
-            if let Some(&first) = arriving.first() {
+            if let Some(first) = first_arrival {
                 placed_for.extend(added.iter().map(|&v| (v, first)));
             }
             nodes.extend(added.into_iter().map(|v| Node {
@@ -724,10 +935,11 @@ impl Rig {
             // only: worked out by whichever core is free while the last fields are
             // searched.
             let (partition, nodes): (&Partition, &Vec<Node>) = (&*partition, &*nodes);
-            let transforms = &transforms;
+            let (transforms, solved) = (&transforms, &*solved);
             scope.spawn(move |_| {
                 let clock = Instant::now();
-                let harmonic = harmonic_of(domain, partition, nodes, handle_count, groups);
+                let harmonic =
+                    harmonic_of(domain, partition, nodes, handle_count, &|_, _| {}, solved);
                 *transforms.lock().expect("not poisoned") = Some((harmonic, ms(clock)));
             });
         });
@@ -758,35 +970,14 @@ impl Rig {
             &map,
             &dirty,
         );
-        let (harmonic, transforms_ms) = transforms
+        let ((harmonic, solved), transforms_ms) = transforms
             .into_inner()
             .expect("not poisoned")
             .expect("computed in the scope");
         self.harmonic = harmonic;
+        self.solved = solved;
         self.update_timings.weights_ms = ms(clock);
         self.update_timings.transforms_ms = transforms_ms;
-    }
-
-    /// Recomputes the dual graph, the virtual handles' harmonic coordinates and all
-    /// node transforms.
-    fn update_transforms(&mut self) {
-        self.harmonic = self.harmonic_coordinates_now();
-        self.update_affines();
-    }
-
-    /// The virtual handles' harmonic coordinates on the current dual graph.
-    fn harmonic_coordinates_now(&self) -> Vec<Option<Vec<f64>>> {
-        harmonic_of(
-            &self.domain,
-            &self.partition,
-            &self.nodes,
-            self.handles.len(),
-            self.group_count(),
-        )
-    }
-
-    fn group_count(&self) -> usize {
-        self.handles.len() + usize::from(self.options.fixed_boundary)
     }
 
     fn group_of(&self, n: &Node) -> Option<usize> {
@@ -795,11 +986,13 @@ impl Rig {
 
     /// Node transforms from the handles' poses (virtual ones blended harmonically).
     fn update_affines(&mut self) {
-        // Per group: the similarity, its centre, and its rotation as a unit complex.
-        let mut groups: Vec<(Similarity, DVec2)> =
-            self.handles.iter().map(Handle::similarity).collect();
+        let mut groups: Vec<GroupPose> = self
+            .handles
+            .iter()
+            .map(|h| GroupPose::new(h.similarity()))
+            .collect();
         if self.options.fixed_boundary {
-            groups.push((Similarity::IDENTITY, DVec2::ZERO));
+            groups.push(GroupPose::new((Similarity::IDENTITY, DVec2::ZERO)));
         }
         let positions = self.domain.positions();
         self.affines = self
@@ -807,7 +1000,7 @@ impl Rig {
             .iter()
             .enumerate()
             .map(|(k, n)| match self.group_of(n) {
-                Some(g) => groups[g].0.to_affine(groups[g].1),
+                Some(g) => groups[g].affine,
                 None => {
                     let c = positions[n.vertex as usize];
                     let Some(coefficients) = self.harmonic.get(k).and_then(Option::as_ref) else {
@@ -942,10 +1135,23 @@ impl Rig {
         dual_edges(&self.domain, &self.partition)
     }
 
-    /// Harmonic coordinates of node `k` over the real handles (and, last, the fixed
-    /// border): `None` for the nodes of real handles.
-    pub fn harmonic_coordinates(&self, k: usize) -> Option<&[f64]> {
+    /// Harmonic coordinates of virtual node `k` over the real handles (and, numbered
+    /// after them, the fixed border) as `(handle, coefficient)` pairs: handles
+    /// ascending, coefficients positive and summing to one. The handles left out have
+    /// coefficient zero: those out of reach of the node's part of the dual graph, and
+    /// those below 1e-10 (dropped, so that thousands of handles do not cost a number
+    /// each per virtual handle). The list is empty when no real handle is reachable.
+    /// `None` for the nodes of real handles.
+    pub fn harmonic_coordinates(&self, k: usize) -> Option<&[(u32, f64)]> {
         self.harmonic.get(k).and_then(|c| c.as_deref())
+    }
+
+    /// The harmonic coordinate of virtual node `k` for handle `handle` (zero when the
+    /// node is not virtual or the handle has no share in it).
+    pub fn harmonic_coordinate(&self, k: usize, handle: usize) -> f64 {
+        self.harmonic_coordinates(k)
+            .and_then(|c| c.iter().find(|e| e.0 as usize == handle))
+            .map_or(0.0, |e| e.1)
     }
 
     /// The transform of node `k` as an affine map of image coordinates.
@@ -961,11 +1167,9 @@ impl Rig {
             NodeKind::Boundary => None,
             NodeKind::Virtual => self.harmonic_coordinates(k).and_then(|c| {
                 c.iter()
-                    .take(self.handles.len())
-                    .enumerate()
-                    .filter(|(_, w)| **w > 0.0)
-                    .max_by(|a, b| a.1.total_cmp(b.1))
-                    .map(|(i, _)| i)
+                    .filter(|e| (e.0 as usize) < self.handles.len())
+                    .max_by(|a, b| a.1.total_cmp(&b.1))
+                    .map(|e| e.0 as usize)
             }),
         }
     }
@@ -1002,6 +1206,22 @@ impl Rig {
             .iter()
             .filter(|n| n.kind == NodeKind::Virtual)
             .map(|n| n.vertex)
+            .collect()
+    }
+
+    /// The virtual handles in node order (as [`Rig::virtual_vertices`]), each with the
+    /// handle it was placed for, if any: the handle whose insertion placed it, which
+    /// takes it along when removed. Save this and rebuild with
+    /// [`Rig::with_placed_virtual_handles`] to get back a rig that also removes the
+    /// same virtual handles with each handle.
+    pub fn placed_virtual_handles(&self) -> Vec<VirtualHandle> {
+        self.nodes
+            .iter()
+            .filter(|n| n.kind == NodeKind::Virtual)
+            .map(|n| VirtualHandle {
+                vertex: n.vertex,
+                placed_for: self.placed_for.get(&n.vertex).copied(),
+            })
             .collect()
     }
 
@@ -1066,17 +1286,44 @@ fn round_up_f32(x: f64) -> f64 {
     }
 }
 
+/// A group's pose, worked out once for all the nodes that blend it.
+struct GroupPose {
+    /// The similarity and the centre it is taken about.
+    similarity: Similarity,
+    centre: DVec2,
+    /// Its rotation as a unit complex number.
+    rotation: DVec2,
+    /// Its linear part.
+    linear: glam::DMat2,
+    /// The whole map in image coordinates.
+    affine: DAffine2,
+}
+
+impl GroupPose {
+    fn new((similarity, centre): (Similarity, DVec2)) -> Self {
+        Self {
+            similarity,
+            centre,
+            rotation: DVec2::from_angle(similarity.rotation),
+            linear: similarity.linear(),
+            affine: similarity.to_affine(centre),
+        }
+    }
+}
+
 /// The virtual handle at `c`: the groups' rotations (unit complex numbers), scales and
 /// the images of `c` blended with the harmonic coefficients.
-fn blend(groups: &[(Similarity, DVec2)], coefficients: &[f64], c: DVec2) -> DAffine2 {
+fn blend(groups: &[GroupPose], coefficients: &[(u32, f64)], c: DVec2) -> DAffine2 {
     let (mut rot, mut scale, mut pos, mut total) = (DVec2::ZERO, 0.0, DVec2::ZERO, 0.0);
-    for ((s, centre), &w) in groups.iter().zip(coefficients) {
-        if w == 0.0 {
+    for &(g, w) in coefficients {
+        let Some(group) = groups.get(g as usize) else {
             continue;
-        }
-        rot += w * DVec2::from_angle(s.rotation);
-        scale += w * s.scale;
-        pos += w * s.apply(*centre, c);
+        };
+        rot += w * group.rotation;
+        scale += w * group.similarity.scale;
+        // As Similarity::apply, with the linear part worked out once.
+        pos +=
+            w * (group.centre + group.similarity.translation + group.linear * (c - group.centre));
         total += w;
     }
     if total <= 0.0 {
@@ -1152,43 +1399,11 @@ fn check_handles(handles: &[Handle]) -> Result<(), RigError> {
         .try_for_each(|(i, h)| check_handle(i, h))
 }
 
-fn segment_distance(a: [DVec2; 2], b: [DVec2; 2]) -> f64 {
-    let point_seg = |p: DVec2, s: [DVec2; 2]| {
-        let d = s[1] - s[0];
-        let t = if d.length_squared() > 0.0 {
-            ((p - s[0]).dot(d) / d.length_squared()).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        (p - (s[0] + d * t)).length()
-    };
-    let (da, db) = (a[1] - a[0], b[1] - b[0]);
-    let cross = |u: DVec2, v: DVec2| u.perp_dot(v);
-    let o1 = cross(da, b[0] - a[0]);
-    let o2 = cross(da, b[1] - a[0]);
-    let o3 = cross(db, a[0] - b[0]);
-    let o4 = cross(db, a[1] - b[0]);
-    if o1 * o2 < 0.0 && o3 * o4 < 0.0 {
-        return 0.0;
-    }
-    point_seg(a[0], b)
-        .min(point_seg(a[1], b))
-        .min(point_seg(b[0], a))
-        .min(point_seg(b[1], a))
-}
-
-/// The closest two handles `(a, b, distance)` with `a < b`, by segment distance.
+/// The closest two handles `(a, b, distance)` with `a < b`, by segment distance (of
+/// equally close pairs, the lowest `b`, then the lowest `a`).
 fn closest_pair(handles: &[Handle]) -> Option<(usize, usize, f64)> {
-    let mut best: Option<(usize, usize, f64)> = None;
-    for i in 0..handles.len() {
-        for j in 0..i {
-            let d = segment_distance(segment_of(&handles[i]), segment_of(&handles[j]));
-            if best.is_none_or(|b| d < b.2) {
-                best = Some((j, i, d));
-            }
-        }
-    }
-    best
+    let segments: Vec<[DVec2; 2]> = handles.iter().map(segment_of).collect();
+    crate::nearest::closest_pair(&segments)
 }
 
 /// The finest a bar is cut: into this many pieces.
@@ -1207,11 +1422,16 @@ pub const MAX_BAR_PIECES: f64 = 16.0;
 /// length. (For a point handle: the distance to the nearest other handle.)
 pub fn bar_spacing(handles: &[Handle], bar: usize) -> f64 {
     let own = segment_of(&handles[bar]);
-    let length = (own[1] - own[0]).length();
     let nearest = (0..handles.len())
         .filter(|&j| j != bar)
         .map(|j| segment_distance(own, segment_of(&handles[j])))
         .fold(f64::INFINITY, f64::min);
+    spacing_of(own, nearest)
+}
+
+/// [`bar_spacing`] of the bar `own` with its nearest other handle `nearest` away.
+fn spacing_of(own: [DVec2; 2], nearest: f64) -> f64 {
+    let length = (own[1] - own[0]).length();
     if nearest.is_finite() {
         nearest.max(length / MAX_BAR_PIECES)
     } else {
@@ -1268,6 +1488,12 @@ fn real_nodes(
     options: &RigOptions,
     resolution: f64,
 ) -> Result<Vec<Node>, RigError> {
+    if handles.len() > MAX_HANDLES {
+        return Err(RigError::TooManyHandles {
+            count: handles.len(),
+            max: MAX_HANDLES,
+        });
+    }
     check_handles(handles)?;
     let (lo, hi) = domain.bounds();
     let tiny = 1e-9 * (hi - lo).length().max(1.0);
@@ -1289,6 +1515,9 @@ fn real_nodes(
             .unwrap_or(0);
         Ok(tri[best])
     };
+    // The nearest other handle of each bar, through a grid of the handles.
+    let segments: Vec<[DVec2; 2]> = handles.iter().map(segment_of).collect();
+    let bars = crate::nearest::SegmentGrid::new(&segments);
     let mut nodes: Vec<Node> = Vec::new();
     let mut used: HashMap<u32, usize> = HashMap::new();
     for (i, h) in handles.iter().enumerate() {
@@ -1312,7 +1541,7 @@ fn real_nodes(
                         y: p.y,
                     });
                 }
-                let spacing = bar_spacing(handles, i).max(resolution);
+                let spacing = spacing_of(rest, bars.nearest(i)).max(resolution);
                 for (t, p) in bar_samples(rest, spacing) {
                     let v = snap(i, p)?;
                     if own.iter().all(|n| n.vertex != v) {

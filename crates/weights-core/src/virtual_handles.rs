@@ -7,6 +7,8 @@
 //! none (the farthest sample of a cell with r_d > 0), so the loop ends after at most as
 //! many insertions as there are samples.
 
+use std::collections::{BinaryHeap, HashMap, HashSet};
+
 use crate::domain::{Domain, Metric};
 use crate::voronoi::Partition;
 
@@ -16,6 +18,75 @@ use crate::voronoi::Partition;
 const TIE: f64 = 1e-9;
 /// At most this many tied farthest samples of one cell get a virtual handle at once.
 const MAX_TIED_PER_CELL: usize = 4;
+
+/// A cheap hash for grid squares (a multiply and a fold), in place of the default
+/// keyed one: the keys are small integers of our own, never adversarial.
+#[derive(Clone, Copy, Default)]
+struct SquareHash;
+
+impl std::hash::BuildHasher for SquareHash {
+    type Hasher = SquareHasher;
+    fn build_hasher(&self) -> SquareHasher {
+        SquareHasher(0)
+    }
+}
+
+/// The hasher of [`SquareHash`].
+struct SquareHasher(u64);
+
+impl std::hash::Hasher for SquareHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(u64::from(b));
+        }
+    }
+    fn write_i64(&mut self, x: i64) {
+        self.write_u64(x as u64);
+    }
+    fn write_u32(&mut self, x: u32) {
+        self.write_u64(u64::from(x));
+    }
+    fn write_usize(&mut self, x: usize) {
+        self.write_u64(x as u64);
+    }
+    fn write_u64(&mut self, x: u64) {
+        self.0 = (self.0.rotate_left(5) ^ x).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+}
+
+/// A node violating r_d < r_h, ordered worst first: by ratio (r_d − r_h)/r_d, then by
+/// lower sample.
+#[derive(Clone, Copy, Debug)]
+struct Violator {
+    ratio: f64,
+    key: u32,
+    node: usize,
+}
+
+impl PartialEq for Violator {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == std::cmp::Ordering::Equal
+    }
+}
+
+impl Eq for Violator {}
+
+impl PartialOrd for Violator {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Violator {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.ratio
+            .total_cmp(&other.ratio)
+            .then(other.key.cmp(&self.key))
+    }
+}
 
 /// Inserts virtual nodes into `partition` until the r_d < r_h condition holds for every
 /// node, and every sample is reached by some node. Returns the new nodes' samples in
@@ -42,21 +113,54 @@ pub(crate) fn insert_virtual_handles(
             }
         }
     }
+    // The violators by ratio, worst first: a heap with an entry pushed whenever a
+    // cell's radii change (add_node says which), entries no longer current skipped
+    // when they come up. (Scanning every node each round cost nodes × rounds: 14 s
+    // where two handles a quarter pixel apart turn a 100k-sample mesh into nodes.)
+    let ratio = |partition: &Partition, k: usize| -> Option<f64> {
+        let s = &partition.stats[k];
+        (s.r_d > 0.0 && s.r_d >= s.r_h).then(|| (s.r_d - s.r_h) / s.r_d)
+    };
+    let mut heap: BinaryHeap<Violator> = (0..partition.len())
+        .filter_map(|k| {
+            ratio(partition, k).map(|r| Violator {
+                ratio: r,
+                key: partition.node_vertex[k],
+                node: k,
+            })
+        })
+        .collect();
+    let mut taken = vec![false; partition.len()];
+    // Each cell's farthest samples (up to MAX_TIED_PER_CELL), kept until add_node says
+    // the cell changed: where thousands of cells tie, most of a round's violators are
+    // merged and come up again unchanged next round.
+    let mut farthest: Vec<Option<Vec<u32>>> = vec![None; partition.len()];
     loop {
         let round_start = added.len();
-        let mut violators: Vec<(f64, usize)> = partition
-            .stats
-            .iter()
-            .enumerate()
-            .filter(|(_, s)| s.r_d > 0.0 && s.r_d >= s.r_h)
-            .map(|(k, s)| ((s.r_d - s.r_h) / s.r_d, k))
-            .collect();
+        // The current violators within TIE of the worst, worst first, then by sample.
+        let mut violators: Vec<(f64, usize)> = Vec::new();
+        let mut threshold = f64::NEG_INFINITY;
+        while let Some(top) = heap.peek().copied() {
+            if top.ratio < threshold {
+                break;
+            }
+            heap.pop();
+            if taken[top.node] || ratio(partition, top.node) != Some(top.ratio) {
+                continue;
+            }
+            if violators.is_empty() {
+                threshold = top.ratio - TIE * top.ratio.abs().max(TIE);
+            }
+            taken[top.node] = true;
+            violators.push((top.ratio, top.node));
+        }
         if violators.is_empty() {
             break;
         }
-        let key = |k: usize| partition.node_vertex[k];
-        violators.sort_by(|a, b| b.0.total_cmp(&a.0).then(key(a.1).cmp(&key(b.1))));
-        let top = violators[0].0;
+        let mut touched: Vec<usize> = Vec::new();
+        for &(_, k) in &violators {
+            taken[k] = false;
+        }
         // Tied violators are fixed together, so that mirror images of a symmetric rig
         // get mirror-image virtual handles; a cell whose farthest samples tie (a
         // symmetric cell) offers all of them, up to a few (perfectly regular grids can
@@ -67,29 +171,55 @@ pub(crate) fn insert_virtual_handles(
         // onto the mirror line, which keeps the symmetry.
         let positions = domain.positions();
         let mut groups: Vec<(Vec<u32>, f64)> = Vec::new();
-        for &(ratio, k) in &violators {
-            if ratio < top - TIE * top.abs().max(TIE) {
-                break;
+        // Members by grid square, a square as wide as the largest reach of the round,
+        // so a candidate's groups lie in the 3 × 3 squares around it (a linear search
+        // through every group cost candidates² where thousands of cells tie).
+        let width = violators
+            .iter()
+            .map(|&(_, k)| partition.stats[k].r_h)
+            .fold(0.0, f64::max);
+        let square = |p: glam::DVec2| {
+            if width > 0.0 && width.is_finite() {
+                ((p.x / width).floor() as i64, (p.y / width).floor() as i64)
+            } else {
+                (0, 0)
             }
+        };
+        let mut grid: HashMap<(i64, i64), Vec<(u32, usize)>, SquareHash> = HashMap::default();
+        // (group, sample) pairs already in, so that a group that draws hundreds of
+        // candidates does not search its member list for each.
+        let mut joined: HashSet<(usize, u32), SquareHash> = HashSet::default();
+        for &(_, k) in &violators {
             let r_h = partition.stats[k].r_h;
-            for far in partition
-                .farthest_samples(domain, k)
-                .into_iter()
-                .take(MAX_TIED_PER_CELL)
-            {
+            let samples = farthest[k].get_or_insert_with(|| {
+                let mut all = partition.farthest_samples(domain, k);
+                all.truncate(MAX_TIED_PER_CELL);
+                all
+            });
+            for &far in samples.iter() {
                 let p = positions[far as usize];
-                let near = groups.iter_mut().find(|(members, reach)| {
-                    members
-                        .iter()
-                        .any(|&b| (positions[b as usize] - p).length() < r_h.max(*reach))
-                });
+                let (sx, sy) = square(p);
+                // The first group (in order of creation) with a member closer than the
+                // larger of this violator's r_h and the group's reach.
+                let near = (sx - 1..=sx + 1)
+                    .flat_map(|x| (sy - 1..=sy + 1).map(move |y| (x, y)))
+                    .filter_map(|key| grid.get(&key))
+                    .flatten()
+                    .filter(|&&(b, g)| (positions[b as usize] - p).length() < r_h.max(groups[g].1))
+                    .map(|&(_, g)| g)
+                    .min();
                 match near {
-                    Some((members, _)) => {
-                        if !members.contains(&far) {
-                            members.push(far);
+                    Some(g) => {
+                        if joined.insert((g, far)) {
+                            groups[g].0.push(far);
+                            grid.entry((sx, sy)).or_default().push((far, g));
                         }
                     }
-                    None => groups.push((vec![far], r_h)),
+                    None => {
+                        joined.insert((groups.len(), far));
+                        grid.entry((sx, sy)).or_default().push((far, groups.len()));
+                        groups.push((vec![far], r_h));
+                    }
                 }
             }
         }
@@ -105,7 +235,7 @@ pub(crate) fn insert_virtual_handles(
             .into_iter()
             .partition(|(members, _)| members.len() == 1);
         for (members, _) in singles {
-            partition.add_node(domain, members[0]);
+            touched.extend(partition.add_node(domain, members[0]));
             inserted(partition, partition.len() - 1);
             added.push(members[0]);
         }
@@ -121,7 +251,7 @@ pub(crate) fn insert_virtual_handles(
                 .chain(members.first().copied())
                 .find(|&v| partition.dist[v as usize] >= r_h);
             if let Some(v) = candidate {
-                partition.add_node(domain, v);
+                touched.extend(partition.add_node(domain, v));
                 inserted(partition, partition.len() - 1);
                 added.push(v);
             }
@@ -132,6 +262,25 @@ pub(crate) fn insert_virtual_handles(
             debug_assert!(false, "Algorithm 1 made no progress");
             break;
         }
+        // The violators of this round that are left, and every cell whose radii may
+        // have changed, come up again with their current ratio.
+        taken.resize(partition.len(), false);
+        farthest.resize(partition.len(), None);
+        touched.sort_unstable();
+        touched.dedup();
+        for &k in &touched {
+            farthest[k] = None;
+        }
+        touched.extend(violators.iter().map(|v| v.1));
+        touched.sort_unstable();
+        touched.dedup();
+        heap.extend(touched.into_iter().filter_map(|k| {
+            ratio(partition, k).map(|r| Violator {
+                ratio: r,
+                key: partition.node_vertex[k],
+                node: k,
+            })
+        }));
     }
     added
 }

@@ -180,6 +180,8 @@ pub(crate) struct Partition {
     bin_max: Vec<f64>,
     /// Radii of each cell.
     pub stats: Vec<CellStats>,
+    /// Scratch: a flag per cell, all clear between calls.
+    noted: Vec<bool>,
 }
 
 #[inline]
@@ -210,6 +212,7 @@ impl Partition {
             far: Vec::new(),
             bin_max: Vec::new(),
             stats: Vec::new(),
+            noted: Vec::new(),
         };
         match domain.metric() {
             Metric::Intrinsic => {
@@ -741,7 +744,11 @@ impl Partition {
     /// on (new cells, whose samples all changed and are checked in full).
     fn settle(&mut self, domain: &Domain, changed: &[(u32, u32)], fresh: usize) -> Vec<usize> {
         let graph = domain.graph();
-        let mut seen = vec![false; self.node_vertex.len()];
+        // A flag per cell, kept between calls and cleared after: a fresh one each time
+        // would cost a pass over every cell for each new node (quadratic where Algorithm
+        // 1 turns nearly every sample into a node).
+        let mut seen = std::mem::take(&mut self.noted);
+        seen.resize(self.node_vertex.len(), false);
         let mut cells = Vec::new();
         let mut note = |o: u32, cells: &mut Vec<usize>| {
             if o != NONE && !seen[o as usize] {
@@ -774,6 +781,10 @@ impl Partition {
             }
             self.set_frontier(v, if front { o } else { NONE });
         }
+        for &c in &cells {
+            seen[c] = false;
+        }
+        self.noted = seen;
         cells
     }
 

@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 
 use egui::{Modifiers, Pos2, Vec2};
 use egui_kittest::Harness;
@@ -56,6 +57,8 @@ pub fn build(
     let builder = if gpu { builder.wgpu() } else { builder };
     let mut harness = builder.build_eframe(move |cc| {
         let mut app = EditorApp::new(cc, None);
+        // What the built-in dialog saves lands in a scratch folder, not in the crate.
+        app.default_folder = Some(scratch_folder());
         if let Some(dialogs) = dialogs.take() {
             app.set_dialogs(dialogs);
         }
@@ -63,6 +66,15 @@ pub fn build(
     });
     harness.run();
     harness
+}
+
+/// A folder of this test process's own for files the built-in dialog writes.
+pub fn scratch_folder() -> PathBuf {
+    static FOLDER: OnceLock<tempfile::TempDir> = OnceLock::new();
+    FOLDER
+        .get_or_init(|| tempfile::tempdir().expect("temp dir"))
+        .path()
+        .to_path_buf()
 }
 
 /// Dialogs of a desktop that has none (a bare X session).

@@ -1,0 +1,57 @@
+//! `c2warp deform`: the deformed mesh as Wavefront OBJ, by any method.
+
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::Path;
+
+use anyhow::{Context, Result, bail};
+use pipeline::{Method, load_project};
+
+use crate::export::{self, Built};
+use crate::{Source, is_stdout};
+
+/// Runs `c2warp deform`: meshes (or reads) the samples, sets up `method` (else the
+/// rig's) for the rig's handles and pose, and writes one `v x y 0` line per vertex in
+/// full precision — the file's vertices in its order, then those the command inserted
+/// — and the triangles as `f a b c` (1-based).
+pub fn run(source: &Source, rig_path: &Path, method: Option<Method>, output: &Path) -> Result<()> {
+    let project = load_project(rig_path)?;
+    let method = method.unwrap_or(project.method);
+    let progress = crate::progress::Steps::new(3);
+    progress.step("meshing and weighting");
+    let Built { rig, .. } = export::build(source, &project, &progress.weighting())?;
+    progress.step("deforming");
+    let deformer = pipeline::deformer(method, rig, &project.rigidity)?;
+    let deformed = deformer.deformed();
+    if let Some(v) = deformed.iter().position(|p| !p.is_finite()) {
+        bail!("the deformation sent vertex {v} to a non-finite position");
+    }
+    progress.step("writing");
+    let triangles = deformer.domain().triangles();
+    let mut text = String::with_capacity(deformed.len() * 40 + triangles.len() * 24);
+    let _ = writeln!(
+        text,
+        "# c2warp deform, method {}: {} vertices, {} triangles",
+        method.name(),
+        deformed.len(),
+        triangles.len()
+    );
+    for p in &deformed {
+        // `{}` prints the shortest decimal that reads back as the same f64.
+        let _ = writeln!(text, "v {} {} 0", p.x, p.y);
+    }
+    for t in triangles {
+        let _ = writeln!(text, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1);
+    }
+    if is_stdout(output) {
+        let mut stdout = std::io::stdout().lock();
+        stdout
+            .write_all(text.as_bytes())
+            .and_then(|()| stdout.flush())
+            .context("cannot write to standard output")?;
+    } else {
+        render::write_atomic(output, text.as_bytes())?;
+    }
+    progress.finish();
+    Ok(())
+}

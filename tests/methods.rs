@@ -1,0 +1,258 @@
+//! End-to-end tests of the method switch: `c2warp deform` for every method, `render
+//! --method`, and the bad-input bank of the method's fields.
+
+mod support;
+
+use std::ffi::OsStr;
+use std::fs;
+use std::path::Path;
+
+use support::{c2warp, data, difference, fails, load, ok, render_args};
+
+fn os(s: &str) -> &OsStr {
+    OsStr::new(s)
+}
+
+/// The vertices and faces of an OBJ file written by `c2warp deform`.
+fn read_obj(path: &Path) -> (Vec<[f64; 2]>, Vec<[usize; 3]>) {
+    let text = fs::read_to_string(path).expect("read OBJ");
+    let (mut vertices, mut faces) = (Vec::new(), Vec::new());
+    for line in text.lines() {
+        let fields: Vec<&str> = line.split_whitespace().collect();
+        match fields.first() {
+            Some(&"v") => {
+                assert_eq!(fields.len(), 4, "v x y 0: {line}");
+                assert_eq!(fields[3], "0");
+                vertices.push([fields[1].parse().expect("x"), fields[2].parse().expect("y")]);
+            }
+            Some(&"f") => faces.push([1, 2, 3].map(|i| fields[i].parse().expect("index"))),
+            Some(&"#") | None => {}
+            Some(other) => panic!("unexpected line {other}: {line}"),
+        }
+    }
+    (vertices, faces)
+}
+
+fn deform(source: &[&OsStr], rig: &Path, method: Option<&str>, out: &Path) {
+    let mut args = vec![os("deform")];
+    args.extend_from_slice(source);
+    args.extend([os("--rig"), rig.as_os_str(), os("-o"), out.as_os_str()]);
+    if let Some(method) = method {
+        args.extend([os("--method"), os(method)]);
+    }
+    ok(&args);
+}
+
+/// The strip's rest vertices, in file order.
+fn strip_rest() -> Vec<[f64; 2]> {
+    let (rest, _) = read_obj(&data("strip.obj"));
+    assert_eq!(rest.len(), 52);
+    rest
+}
+
+#[test]
+fn deform_moves_the_mesh_rigidly_under_a_rigid_motion_for_every_method() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let rig = dir.path().join("rig.json");
+    // Every handle translated by (7, -3) and the bar with them: a rigid motion.
+    fs::write(
+        &rig,
+        r#"{"version":1,"handles":[
+            {"type":"point","rest":[0,0],"translate":[7,-3]},
+            {"type":"point","rest":[120,30],"translate":[7,-3]},
+            {"type":"bar","rest":[[60,0],[60,30]],"pose":[[67,-3],[67,27]]}]}"#,
+    )
+    .expect("write rig");
+    let mesh = data("strip.obj");
+    let rest = strip_rest();
+    for method in ["c2", "arap"] {
+        let out = dir.path().join(format!("{method}.obj"));
+        deform(&[os("--mesh"), mesh.as_os_str()], &rig, Some(method), &out);
+        let (moved, faces) = read_obj(&out);
+        assert_eq!(moved.len(), rest.len(), "{method}: no vertex inserted");
+        assert_eq!(faces.len(), 72);
+        for (v, (p, r)) in moved.iter().zip(&rest).enumerate() {
+            let (dx, dy) = (p[0] - r[0] - 7.0, p[1] - r[1] + 3.0);
+            assert!(
+                dx.abs() < 1e-9 && dy.abs() < 1e-9,
+                "{method}: vertex {v} at {p:?}, rest {r:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn deform_keeps_the_file_order_and_puts_inserted_vertices_after() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let rig = dir.path().join("rig.json");
+    // One handle on a vertex and one inside a square (inserted), both at rest.
+    fs::write(
+        &rig,
+        r#"{"version":1,"method":"arap","handles":[
+            {"type":"point","rest":[0,0]},{"type":"point","rest":[33,17]}]}"#,
+    )
+    .expect("write rig");
+    let rest = strip_rest();
+    for method in [None, Some("c2")] {
+        let out = dir.path().join("rest.obj");
+        deform(
+            &[os("--mesh"), data("strip.obj").as_os_str()],
+            &rig,
+            method,
+            &out,
+        );
+        let (at, faces) = read_obj(&out);
+        assert_eq!(at.len(), rest.len() + 1, "{method:?}");
+        // At rest, every vertex comes back where the file had it, in its order (up to
+        // the solver's rounding).
+        let close = |p: [f64; 2], q: [f64; 2]| (p[0] - q[0]).hypot(p[1] - q[1]) < 1e-9;
+        for (v, (p, r)) in at.iter().zip(&rest).enumerate() {
+            assert!(close(*p, *r), "{method:?}: vertex {v} at {p:?}, file {r:?}");
+        }
+        assert!(close(at[rest.len()], [33.0, 17.0]), "{:?}", at[rest.len()]);
+        assert!(faces.iter().flatten().all(|&i| i >= 1 && i <= at.len()));
+        // The inserted vertex split a triangle into three.
+        assert_eq!(faces.len(), 74);
+    }
+}
+
+#[test]
+fn deform_from_an_image_gives_the_methods_own_answers() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let image = data("dino.png");
+    let source = [os("--image"), image.as_os_str()];
+    let rig = data("dino-rig.json");
+    let (c2, arap) = (dir.path().join("c2.obj"), dir.path().join("arap.obj"));
+    deform(&source, &rig, Some("c2"), &c2);
+    deform(&source, &rig, Some("arap"), &arap);
+    let (a, fa) = read_obj(&c2);
+    let (b, fb) = read_obj(&arap);
+    assert_eq!(fa, fb, "the same mesh");
+    assert_eq!(a.len(), b.len());
+    let apart = a
+        .iter()
+        .zip(&b)
+        .filter(|(p, q)| (p[0] - q[0]).hypot(p[1] - q[1]) > 0.5)
+        .count();
+    assert!(apart > a.len() / 10, "the methods differ: {apart} vertices");
+    // The point handle at (250, 120) went by (10, -30) under both: it is one vertex,
+    // the same in both files.
+    let near = |p: &[f64; 2]| (p[0] - 260.0).abs() < 1e-9 && (p[1] - 90.0).abs() < 1e-9;
+    let i = a.iter().position(near).expect("C² pins the handle");
+    assert!(near(&b[i]), "ARAP pins it too: {:?}", b[i]);
+}
+
+#[test]
+/// The expected image comes from this renderer; regenerate it (and look at it) when
+/// the mesher or the method change on purpose: `c2warp render tests/data/dino.png
+/// --rig tests/data/dino-rig.json --method arap -o tests/data/dino-arap.png`.
+fn render_arap_matches_the_golden_image_and_the_flag_overrides_the_rig() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("arap.png");
+    ok(&render_args(
+        &data("dino.png"),
+        &data("dino-rig.json"),
+        &out,
+        &["--method", "arap"],
+    ));
+    let got = load(&out);
+    let (worst, share) = difference(&got, &load(&data("dino-arap.png")), 8);
+    assert!(
+        share < 0.002,
+        "{:.3}% of channels differ by more than 8 (largest {worst})",
+        share * 100.0
+    );
+    let (_, apart) = difference(&got, &load(&data("dino-warped.png")), 8);
+    assert!(apart > 0.005, "ARAP differs from C² ({apart})");
+    // A rig that asks for ARAP gives the same picture; --method c2 overrides it.
+    let text = fs::read_to_string(data("dino-rig.json")).expect("read");
+    let arap_rig = dir.path().join("arap.json");
+    fs::write(
+        &arap_rig,
+        text.replacen(
+            "\"version\": 1,",
+            "\"version\": 1, \"method\": \"arap\",",
+            1,
+        ),
+    )
+    .expect("write");
+    let by_rig = dir.path().join("by-rig.png");
+    ok(&render_args(&data("dino.png"), &arap_rig, &by_rig, &[]));
+    assert_eq!(load(&by_rig), got);
+    let overridden = dir.path().join("c2.png");
+    ok(&render_args(
+        &data("dino.png"),
+        &arap_rig,
+        &overridden,
+        &["--method", "c2"],
+    ));
+    let (worst, share) = difference(&load(&overridden), &load(&data("dino-warped.png")), 8);
+    assert!(share < 0.002, "--method c2 draws C² ({worst})");
+}
+
+#[test]
+fn painted_rigidity_changes_the_arap_render() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let text = fs::read_to_string(data("dino-rig.json")).expect("read");
+    let painted = dir.path().join("painted.json");
+    fs::write(
+        &painted,
+        text.replacen(
+            "\"version\": 1,",
+            r#""version": 1, "method": "arap", "rigidity": [{"stroke": [[150, 180], [200, 200]], "radius": 40, "weight": 10000}],"#,
+            1,
+        ),
+    )
+    .expect("write");
+    let out = dir.path().join("painted.png");
+    ok(&render_args(&data("dino.png"), &painted, &out, &[]));
+    let (_, apart) = difference(&load(&out), &load(&data("dino-arap.png")), 8);
+    assert!(apart > 0.0005, "the paint changed the picture ({apart})");
+}
+
+#[test]
+fn bad_method_fields_give_one_clear_line_and_keep_the_old_output() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("out.png");
+    fs::write(&out, b"precious").expect("write");
+    let handles = r#""handles":[{"type":"point","rest":[60,60]}]"#;
+    let cases = [
+        (r#""method":"lbc3""#, "unknown variant `lbc3`"),
+        (
+            r#""rigidity":[{"stroke":[[1,NaN]],"radius":2,"weight":3}]"#,
+            "malformed",
+        ),
+        (
+            r#""rigidity":[{"stroke":[[1,1]],"radius":-2,"weight":3}]"#,
+            "radius must be a positive number of pixels, got -2",
+        ),
+        (
+            r#""rigidity":[{"stroke":[[1,1]],"radius":2,"weight":0}]"#,
+            "weight must be positive",
+        ),
+    ];
+    for (i, (field, expected)) in cases.into_iter().enumerate() {
+        let rig = dir.path().join(format!("bad{i}.json"));
+        fs::write(&rig, format!(r#"{{"version":1,{field},{handles}}}"#)).expect("write");
+        for extra in [&[][..], &["--method", "arap"][..]] {
+            let line = fails(&render_args(&data("dino.png"), &rig, &out, extra));
+            assert!(line.contains(expected), "{field}: {line}");
+        }
+    }
+    assert_eq!(fs::read(&out).expect("read"), b"precious");
+    // An unknown --method is refused by the argument parser, naming the known ones.
+    let rig = data("dino-rig.json");
+    let refused = c2warp(&render_args(
+        &data("dino.png"),
+        &rig,
+        &out,
+        &["--method", "c3"],
+    ));
+    assert!(!refused.status.success());
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        stderr.contains("unknown method \"c3\" (known: c2, arap)"),
+        "{stderr}"
+    );
+    assert_eq!(fs::read(&out).expect("read"), b"precious");
+}
