@@ -29,6 +29,8 @@ pub enum Tool {
     AddPoint,
     /// Drag to add a bar handle.
     AddBar,
+    /// Paint rigidity (ARAP); Alt-drag erases.
+    Rigidity,
 }
 
 /// Which overlays are on.
@@ -48,6 +50,8 @@ pub struct Show {
     pub folds: bool,
     /// The weights under the cursor.
     pub hover_weights: bool,
+    /// Painted rigidity, translucent.
+    pub rigidity: bool,
 }
 
 impl Default for Show {
@@ -60,6 +64,7 @@ impl Default for Show {
             heat: false,
             folds: true,
             hover_weights: true,
+            rigidity: true,
         }
     }
 }
@@ -160,6 +165,10 @@ pub struct EditorApp {
     /// Use the built-in file dialog (the desktop has none, or the user prefers it).
     pub builtin_dialogs: bool,
     pub(crate) file_dialog: Option<BuiltinDialog>,
+    /// The rigidity brush's radius and weight.
+    pub brush: crate::brush::Brush,
+    pub(crate) brush_stroke: Option<crate::brush::BrushStroke>,
+    pub(crate) painted: crate::brush::PaintedCache,
     /// Where the built-in file dialog starts when the document has no file of its own
     /// (else the current folder).
     pub default_folder: Option<PathBuf>,
@@ -255,6 +264,9 @@ impl EditorApp {
             large_mesh: 100_000,
             builtin_dialogs: false,
             file_dialog: None,
+            brush: crate::brush::Brush::default(),
+            brush_stroke: None,
+            painted: crate::brush::PaintedCache::default(),
             default_folder: None,
             gpu: GpuFrame::default(),
             has_gpu,
@@ -1028,6 +1040,14 @@ impl EditorApp {
             gpu.pose = Versioned {
                 version: bump(),
                 value: Arc::new(doc.rig().node_affines()),
+            };
+            let positions = match doc.deformer().output() {
+                pipeline::Output::Skinned(_) => Vec::new(),
+                pipeline::Output::Positions(p) => p.iter().map(|p| p.as_vec2()).collect(),
+            };
+            gpu.positions = Versioned {
+                version: bump(),
+                value: Arc::new(positions),
             };
         }
         let heat_key = self

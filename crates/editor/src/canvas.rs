@@ -113,6 +113,9 @@ impl EditorApp {
                 Color32::LIGHT_RED,
             );
         }
+        if self.show.rigidity {
+            self.paint_rigidity(&painter);
+        }
         self.paint_overlays(&painter);
         if let (Some(a), Some(b)) = (self.bar_start, ui.input(|i| i.pointer.latest_pos())) {
             let a = self.viewport.to_screen(a);
@@ -223,12 +226,15 @@ impl EditorApp {
         if self.tool == Tool::AddBar {
             self.bar_input(ui, response);
         }
+        if self.tool == Tool::Rigidity {
+            self.brush_input(ui, response);
+        }
         if response.drag_started_by(PointerButton::Middle)
             || (response.drag_started_by(PointerButton::Primary) && space)
         {
             self.panning = true;
         } else if response.drag_started_by(PointerButton::Primary)
-            && self.tool != Tool::AddBar
+            && !matches!(self.tool, Tool::AddBar | Tool::Rigidity)
             && let Some(pos) = press
         {
             match self.hit(pos) {
@@ -253,7 +259,7 @@ impl EditorApp {
         {
             let hit = self.hit(pos).map(|(i, _)| i);
             match (self.tool, hit) {
-                (Tool::AddBar, _) => {}
+                (Tool::AddBar | Tool::Rigidity, _) => {}
                 (_, Some(i)) if modifiers.alt => {
                     // The Puppet Warp convention: Alt-click deletes a handle.
                     self.selected = Some(i);
@@ -287,7 +293,9 @@ impl EditorApp {
             Some(CursorIcon::Grabbing)
         } else if response.hover_pos().and_then(|p| self.hit(p)).is_some() {
             Some(CursorIcon::Grab)
-        } else if matches!(self.tool, Tool::AddPoint | Tool::AddBar) && response.hovered() {
+        } else if matches!(self.tool, Tool::AddPoint | Tool::AddBar | Tool::Rigidity)
+            && response.hovered()
+        {
             Some(CursorIcon::Crosshair)
         } else {
             None

@@ -10,7 +10,8 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use glam::DVec2;
 use image::RgbaImage;
-use project::{HandleSpec, MetricChoice, Middle, Project};
+use pipeline::{ArapRig, ArapTimes, Deformer, Method};
+use project::{HandleSpec, MetricChoice, Middle, Project, RigidityStroke};
 use weights_core::{Domain, NodeKind, Rig, VirtualHandle};
 
 /// The parameters of the weighting a user can change in the side panel.
@@ -69,6 +70,10 @@ pub enum Edit {
     ResetPose,
     /// New weighting parameters (a new density re-meshes the picture).
     Settings(Settings),
+    /// Another warping method, on the same picture, handles and pose.
+    Method(Method),
+    /// New painted rigidity (ARAP).
+    Rigidity(Vec<RigidityStroke>),
 }
 
 /// An open picture with its rig. Cloning copies the rig (tens of megabytes at a
@@ -96,6 +101,11 @@ pub struct Document {
     pub last_update_ms: f64,
     /// Deformed samples, and the (pose, weights) versions they were computed for.
     deformed: Option<((u64, u64), Vec<DVec2>)>,
+    /// Bumped when the picture is meshed anew.
+    mesh_version: u64,
+    /// With ARAP chosen: its deformer, and the mesh version it was set up on. The C²
+    /// rig stays beside it: it holds the mesh and the handles, and its heat maps.
+    arap: Option<(u64, ArapRig)>,
 }
 
 impl Document {
@@ -123,7 +133,7 @@ impl Document {
         // Virtual handles live in the rig while editing; they are written out on save.
         project.virtual_handles.clear();
         project.virtual_placed_for.clear();
-        Ok(Self {
+        Self {
             project,
             image,
             deep: None,
@@ -134,7 +144,69 @@ impl Document {
             pose_version: 1,
             last_update_ms: ms(clock),
             deformed: None,
-        })
+            mesh_version: 1,
+            arap: None,
+        }
+        .with_method()
+    }
+
+    /// This document with its method's deformer set up.
+    fn with_method(mut self) -> Result<Self> {
+        self.sync_method()?;
+        Ok(self)
+    }
+
+    /// Brings the method's deformer in line with the rig file: for ARAP, set up (on a
+    /// new mesh, or when first chosen), repainted and posed with the rig's handles; for
+    /// C², none.
+    fn sync_method(&mut self) -> Result<()> {
+        if self.project.method != Method::Arap {
+            self.arap = None;
+            return Ok(());
+        }
+        match &mut self.arap {
+            Some((mesh, arap)) if *mesh == self.mesh_version => {
+                arap.set_rigidity(&self.project.rigidity)?;
+                arap.set_handles(self.rig.handles())?;
+            }
+            _ => {
+                let arap = ArapRig::new(
+                    self.rig.domain().clone(),
+                    self.rig.handles(),
+                    &self.project.rigidity,
+                )?;
+                self.arap = Some((self.mesh_version, arap));
+            }
+        }
+        Ok(())
+    }
+
+    /// Bumped whenever the picture is meshed anew.
+    pub fn mesh_version(&self) -> u64 {
+        self.mesh_version
+    }
+
+    /// The method in use.
+    pub fn method(&self) -> Method {
+        self.project.method
+    }
+
+    /// The method's deformer: the ARAP rig, or the C² rig.
+    pub fn deformer(&self) -> &dyn Deformer {
+        match &self.arap {
+            Some((_, arap)) => arap,
+            None => &self.rig,
+        }
+    }
+
+    /// ARAP's step times, when ARAP is in use.
+    pub fn arap_times(&self) -> Option<ArapTimes> {
+        self.arap.as_ref().map(|(_, arap)| arap.times())
+    }
+
+    /// ARAP's per-triangle rigidity, when ARAP is in use.
+    pub fn rigidity(&self) -> Option<&[f64]> {
+        self.arap.as_ref().map(|(_, arap)| arap.rigidity())
     }
 
     /// The built-in picture with its sample rig.
@@ -274,6 +346,8 @@ impl Document {
                 }
             }
             Edit::Settings(settings) => settings.write_to(&mut project),
+            Edit::Method(method) => project.method = method,
+            Edit::Rigidity(strokes) => project.rigidity = strokes,
         }
         self.restore(project)
     }
@@ -356,6 +430,7 @@ impl Document {
                 with_virtuals.virtual_placed_for = placed_for;
             }
             self.rig = pipeline::prepare(&self.image, &with_virtuals, None)?.rig;
+            self.mesh_version += 1;
         } else if new == old && exact && !same_rest {
             let domain = self.rig.domain();
             let placed: Vec<VirtualHandle> = virtuals
@@ -392,12 +467,13 @@ impl Document {
             if same_rest {
                 self.project = project;
                 self.pose_version += 1;
-                return Ok(());
+                return self.sync_method();
             }
         }
         self.project = project;
         self.weights_version += 1;
         self.pose_version += 1;
+        self.sync_method()?;
         self.last_update_ms = ms(clock);
         Ok(())
     }
@@ -449,6 +525,36 @@ impl Document {
         if let Some(v) = self.rig.deform().iter().position(|p| !p.is_finite()) {
             bail!("sample {v} deforms to a non-finite point");
         }
+        match (&self.arap, self.project.method) {
+            (None, Method::C2) => {}
+            (Some((mesh, arap)), Method::Arap) => {
+                if *mesh != self.mesh_version {
+                    bail!("the ARAP deformer was set up on another mesh");
+                }
+                if arap.handles() != self.rig.handles() {
+                    bail!("the ARAP deformer has other handles than the rig");
+                }
+                if arap.strokes() != self.project.rigidity.as_slice() {
+                    bail!("the ARAP deformer has other rigidity than the rig file");
+                }
+                let positions = arap.positions();
+                if positions.len() != self.rig.domain().len() {
+                    bail!(
+                        "ARAP gives {} positions for {} samples",
+                        positions.len(),
+                        self.rig.domain().len()
+                    );
+                }
+                if let Some(v) = positions.iter().position(|p| !p.is_finite()) {
+                    bail!("ARAP sends sample {v} to a non-finite point");
+                }
+            }
+            (arap, method) => bail!(
+                "method {} with{} an ARAP deformer",
+                method.name(),
+                if arap.is_some() { "" } else { "out" }
+            ),
+        }
         if self.weights_version == 0 || self.pose_version == 0 {
             bail!("versions start at 1");
         }
@@ -459,7 +565,7 @@ impl Document {
     pub fn deformed(&mut self) -> &[DVec2] {
         let version = (self.pose_version, self.weights_version);
         if self.deformed.as_ref().is_none_or(|(v, _)| *v != version) {
-            self.deformed = Some((version, self.rig.deform()));
+            self.deformed = Some((version, self.deformer().deformed()));
         }
         self.deformed.as_ref().map_or(&[], |(_, d)| d)
     }

@@ -8,6 +8,7 @@
 //! turn input into [`Edit`]s that one place applies.
 
 mod app;
+mod brush;
 mod canvas;
 mod dialogs;
 mod document;
@@ -20,6 +21,7 @@ mod viewport;
 use std::path::PathBuf;
 
 pub use app::{EditorApp, Message, Pending, Show, Tool};
+pub use brush::{Brush, erase};
 pub use dialogs::{Answer, Dialogs, FileAction, IMAGES, NativeDialogs, desktop_has_dialogs};
 pub use document::{Document, Edit, Settings, posed};
 pub use panels::SHORTCUTS;

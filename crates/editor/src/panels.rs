@@ -4,7 +4,7 @@
 use std::time::Instant;
 
 use egui::{Key, KeyboardShortcut, Modifiers, Ui};
-use project::{MetricChoice, Middle};
+use project::{Method, MetricChoice, Middle};
 
 use crate::app::{EditorApp, Pending, Tool};
 use crate::dialogs::FileAction;
@@ -19,6 +19,10 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("V", "Select tool: like Puppet, but a click only selects"),
     ("P", "Add point handle tool"),
     ("B", "Add bar handle tool (drag from end to end)"),
+    (
+        "R",
+        "Rigidity brush (ARAP): drag to paint stiffness, Alt + drag to erase",
+    ),
     (
         "Drag a handle",
         "Move it (a bar's end: turn and stretch the bar)",
@@ -185,6 +189,9 @@ impl EditorApp {
         if pressed(none, Key::B) {
             self.set_tool(Tool::AddBar);
         }
+        if pressed(none, Key::R) {
+            self.set_tool(Tool::Rigidity);
+        }
         if pressed(none, Key::F) {
             self.needs_fit = true;
         }
@@ -214,6 +221,7 @@ impl EditorApp {
         if pressed(none, Key::Escape) {
             self.selected = None;
             self.bar_start = None;
+            self.brush_stroke = None;
             self.pending = None;
         }
     }
@@ -315,6 +323,7 @@ impl EditorApp {
             .on_hover_text("The selected handle's weight, with isolines every 0.1");
         ui.checkbox(&mut self.show.folds, "Fold-overs");
         ui.checkbox(&mut self.show.hover_weights, "Weights under cursor");
+        ui.checkbox(&mut self.show.rigidity, "Painted rigidity");
     }
 
     fn side_panel(&mut self, ui: &mut Ui) {
@@ -331,6 +340,11 @@ impl EditorApp {
             ui.selectable_value(&mut tool, Tool::AddPoint, "Add point");
             ui.selectable_value(&mut tool, Tool::AddBar, "Add bar")
                 .on_hover_text("Drag from one end of the bar to the other");
+            ui.selectable_value(&mut tool, Tool::Rigidity, "Rigidity")
+                .on_hover_text(
+                    "Paint stiffness (ARAP): painted parts keep their shape; Alt-drag \
+                     erases. One undo step per stroke",
+                );
             if tool != self.tool {
                 self.set_tool(tool);
             }
@@ -342,8 +356,30 @@ impl EditorApp {
                 self.needs_fit = true;
             }
         });
+        if self.tool == Tool::Rigidity {
+            ui.add(
+                egui::Slider::new(&mut self.brush.radius, 1.0..=200.0)
+                    .logarithmic(true)
+                    .text("Brush radius (px)"),
+            );
+            ui.add(
+                egui::Slider::new(&mut self.brush.weight, 2.0..=100_000.0)
+                    .logarithmic(true)
+                    .text("Stiffness"),
+            )
+            .on_hover_text("The paper paints 10000; unpainted triangles have 1");
+            if let Some(doc) = &self.doc
+                && !doc.project().rigidity.is_empty()
+                && ui.button("Clear rigidity").clicked()
+            {
+                let _ = self.edit(Edit::Rigidity(Vec::new()));
+            }
+        }
         ui.checkbox(&mut self.auto_rotate, "Auto-rotate points")
             .on_hover_text("Point handles turn with their neighbours' motion");
+        ui.separator();
+        ui.heading("Method");
+        self.method_choice(ui);
         ui.separator();
         ui.heading("Weights");
         self.parameters(ui);
@@ -381,6 +417,32 @@ impl EditorApp {
                     ));
                 }
             }
+        }
+    }
+
+    /// The warping method: one undo step; the picture, handles and pose stay.
+    fn method_choice(&mut self, ui: &mut Ui) {
+        let Some(doc) = &self.doc else { return };
+        let current = doc.method();
+        let mut chosen = current;
+        ui.horizontal_wrapped(|ui| {
+            for m in Method::ALL {
+                ui.selectable_value(&mut chosen, m, m.label())
+                    .on_hover_text(match m {
+                        Method::C2 => {
+                            "Closed-form C² weights (Xian, Jin and Wang): smooth, local, \
+                             with virtual handles"
+                        }
+                        Method::Arap => {
+                            "As-rigid-as-possible (Igarashi, Moscovich and Hughes 2005): \
+                             shapes keep their proportions; the C² weights' settings do \
+                             not apply"
+                        }
+                    });
+            }
+        });
+        if chosen != current {
+            let _ = self.edit(Edit::Method(chosen));
         }
     }
 
@@ -443,6 +505,19 @@ impl EditorApp {
                 ));
                 ui.separator();
                 ui.label(format!("weights updated in {:.1} ms", doc.last_update_ms));
+                if let Some(times) = doc.arap_times() {
+                    ui.separator();
+                    ui.label(format!(
+                        "ARAP: compiled in {:.1} ms, updated in {:.2} ms",
+                        times.compile_ms, times.update_ms
+                    ))
+                    .on_hover_text(format!(
+                        "registration {:.1} ms (once per mesh); compilation when handles \
+                         are added or removed or rigidity is painted; an update every \
+                         drag frame",
+                        times.registration_ms
+                    ));
+                }
                 ui.separator();
                 ui.label(format!("frame {:.1} ms", self.frame_ms));
                 ui.separator();

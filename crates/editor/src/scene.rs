@@ -2,8 +2,8 @@
 //! changed and draws it with [`render::MeshView`].
 //!
 //! Every part carries a version; the callback resources remember the versions they
-//! uploaded, so a drag re-uploads only the node transforms (24 bytes a node) and a new
-//! handle only the weights.
+//! uploaded, so a drag re-uploads only the node transforms (24 bytes a node), or with
+//! ARAP the deformed positions (8 bytes a vertex), and a new handle only the weights.
 
 use std::sync::Arc;
 
@@ -60,12 +60,15 @@ pub struct GpuFrame {
     pub heat: Versioned<Vec<f32>>,
     /// Cell colours per vertex.
     pub cells: Versioned<Vec<[u8; 4]>>,
+    /// Deformed positions per vertex, from a method that solves for them (ARAP);
+    /// empty when the node transforms skin the mesh.
+    pub positions: Versioned<Vec<Vec2>>,
 }
 
 /// The GPU side, kept in the renderer's callback resources.
 pub struct SceneResources {
     view: MeshView,
-    uploaded: [u64; 5],
+    uploaded: [u64; 6],
     /// The last upload failure, if any (shown in the status bar).
     pub error: Option<String>,
 }
@@ -76,7 +79,7 @@ impl SceneResources {
     pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, format: wgpu::TextureFormat) -> Self {
         Self {
             view: MeshView::new(device, queue, format, 1),
-            uploaded: [0; 5],
+            uploaded: [0; 6],
             error: None,
         }
     }
@@ -88,6 +91,7 @@ impl SceneResources {
             frame.pose.version,
             frame.heat.version,
             frame.cells.version,
+            frame.positions.version,
         ];
         if versions[0] != self.uploaded[0] {
             self.view.set_texture(device, queue, &frame.image.value);
@@ -108,6 +112,13 @@ impl SceneResources {
                 .set_mesh(device, &mesh, &frame.pose.value, m.source_size);
         } else if versions[2] != self.uploaded[2] {
             result = self.view.set_pose(queue, &frame.pose.value);
+        }
+        let pose_changed = mesh_changed || versions[2] != self.uploaded[2];
+        if result.is_ok()
+            && (pose_changed || versions[5] != self.uploaded[5])
+            && !frame.positions.value.is_empty()
+        {
+            result = self.view.set_positions(queue, &frame.positions.value);
         }
         if result.is_ok()
             && (mesh_changed || versions[3] != self.uploaded[3])

@@ -16,6 +16,7 @@
 //! To add a method: a variant of [`Method`] (in the `project` crate, with its rig-file
 //! name), a type implementing [`Deformer`], and a case in [`deformer`].
 
+use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
@@ -128,15 +129,20 @@ pub struct ArapTimes {
 /// Changing which vertices are pinned recompiles (factorises); a pose of the same pins
 /// only updates. Turning a point handle away from rotate = 0, scale = 1 adds its ring
 /// and so recompiles once, at the start of the turn.
+///
+/// Cloning shares the factorised systems.
+#[derive(Clone)]
 pub struct ArapRig {
     domain: Domain,
     registration: arap::Registration,
     handles: Vec<Handle>,
-    /// Per-triangle rigidity (1 where nothing is painted).
+    /// The painted strokes, and the per-triangle rigidity they give (1 where nothing
+    /// is painted).
+    strokes: Vec<RigidityStroke>,
     rigidity: Vec<f64>,
     /// The pinned vertices, each with the handle that pins it.
     pins: Vec<(u32, usize)>,
-    compiled: arap::Compiled,
+    compiled: Arc<arap::Compiled>,
     pose: arap::Deformation,
     times: ArapTimes,
 }
@@ -146,21 +152,26 @@ impl ArapRig {
     ///
     /// # Errors
     /// A degenerate mesh, or handles that cannot be pinned (non-finite).
-    pub fn new(domain: Domain, handles: &[Handle], rigidity: &[RigidityStroke]) -> Result<Self> {
+    pub fn new(
+        domain: Domain,
+        handles: &[Handle],
+        rigidity_strokes: &[RigidityStroke],
+    ) -> Result<Self> {
         let clock = Instant::now();
         let registration = arap::Registration::new(domain.positions(), domain.triangles())
             .context("cannot set up ARAP on this mesh")?;
         let registration_ms = ms(clock);
-        let rigidity = rigidity_weights(&domain, rigidity);
+        let rigidity = rigidity_weights(&domain, rigidity_strokes);
         let pins = pins(&domain, &registration, handles)?;
         let clock = Instant::now();
         let vertices: Vec<u32> = pins.iter().map(|&(v, _)| v).collect();
-        let compiled = registration.compile(&vertices, Some(&rigidity))?;
+        let compiled = Arc::new(registration.compile(&vertices, Some(&rigidity))?);
         let compile_ms = ms(clock);
         let mut rig = Self {
             domain,
             registration,
             handles: handles.to_vec(),
+            strokes: rigidity_strokes.to_vec(),
             rigidity,
             pins,
             compiled,
@@ -206,16 +217,25 @@ impl ArapRig {
     /// # Errors
     /// As [`ArapRig::new`].
     pub fn set_rigidity(&mut self, strokes: &[RigidityStroke]) -> Result<()> {
+        if strokes == self.strokes {
+            return Ok(());
+        }
         let rigidity = rigidity_weights(&self.domain, strokes);
         if rigidity != self.rigidity {
             let clock = Instant::now();
             let vertices: Vec<u32> = self.pins.iter().map(|&(v, _)| v).collect();
-            self.compiled = self.registration.compile(&vertices, Some(&rigidity))?;
+            self.compiled = Arc::new(self.registration.compile(&vertices, Some(&rigidity))?);
             self.times.compile_ms = ms(clock);
             self.rigidity = rigidity;
             self.update()?;
         }
+        self.strokes = strokes.to_vec();
         Ok(())
+    }
+
+    /// The strokes the rigidity comes from.
+    pub fn strokes(&self) -> &[RigidityStroke] {
+        &self.strokes
     }
 
     /// Poses the compiled system for the current handles.
@@ -257,7 +277,7 @@ impl Deformer for ArapRig {
             match self.registration.compile(&vertices, Some(&self.rigidity)) {
                 Ok(compiled) => {
                     self.times.compile_ms = ms(clock);
-                    let old_compiled = std::mem::replace(&mut self.compiled, compiled);
+                    let old_compiled = std::mem::replace(&mut self.compiled, Arc::new(compiled));
                     let old_pins = std::mem::replace(&mut self.pins, pins);
                     let result = self.update();
                     if result.is_err() {
@@ -414,4 +434,165 @@ fn polyline_distance_squared(points: &[DVec2], p: DVec2) -> f64 {
 
 fn ms(clock: Instant) -> f64 {
     clock.elapsed().as_secs_f64() * 1000.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use weights_core::Metric;
+
+    /// A `w × h` grid of unit squares, each cut into two triangles.
+    fn grid(w: u32, h: u32) -> Domain {
+        let positions = (0..=h)
+            .flat_map(|y| (0..=w).map(move |x| DVec2::new(f64::from(x), f64::from(y))))
+            .collect();
+        let mut triangles = Vec::new();
+        for y in 0..h {
+            for x in 0..w {
+                let v = y * (w + 1) + x;
+                triangles.push([v, v + 1, v + w + 2]);
+                triangles.push([v, v + w + 2, v + w + 1]);
+            }
+        }
+        Domain::new(positions, triangles, Metric::Euclidean).expect("a grid")
+    }
+
+    fn point(rest: DVec2, translation: DVec2, rotation: f64, scale: f64) -> Handle {
+        Handle::Point {
+            rest,
+            transform: Similarity {
+                translation,
+                rotation,
+                scale,
+            },
+        }
+    }
+
+    #[test]
+    fn a_rigid_motion_of_every_handle_moves_every_vertex_by_it() {
+        let domain = grid(12, 6);
+        let (angle, centre, shift) = (0.7, DVec2::new(6.0, 3.0), DVec2::new(3.0, -2.0));
+        let motion = |p: DVec2| centre + shift + glam::DMat2::from_angle(angle) * (p - centre);
+        let rests = [
+            DVec2::new(1.0, 1.0),
+            DVec2::new(11.0, 5.0),
+            DVec2::new(6.0, 0.0),
+        ];
+        let mut handles: Vec<Handle> = rests
+            .iter()
+            .map(|&r| point(r, motion(r) - r, angle, 1.0))
+            .collect();
+        let bar = [DVec2::new(2.0, 5.0), DVec2::new(5.0, 5.0)];
+        handles.push(Handle::Bar {
+            rest: bar,
+            pose: bar.map(motion),
+        });
+        let arap = ArapRig::new(domain.clone(), &handles, &[]).expect("ARAP");
+        for (p, r) in arap.positions().iter().zip(domain.positions()) {
+            assert!((*p - motion(*r)).length() < 1e-9, "{r} went to {p}");
+        }
+    }
+
+    #[test]
+    fn a_plain_point_handle_pins_one_vertex_and_a_turned_one_its_ring() {
+        let domain = grid(8, 8);
+        let centre = DVec2::new(4.0, 4.0);
+        let plain = ArapRig::new(
+            domain.clone(),
+            &[point(centre, DVec2::new(1.0, 0.0), 0.0, 1.0)],
+            &[],
+        )
+        .expect("ARAP");
+        assert_eq!(plain.pinned(), 1);
+        // One handle: the whole shape translates with it.
+        for (p, r) in plain.positions().iter().zip(domain.positions()) {
+            assert!((*p - *r - DVec2::new(1.0, 0.0)).length() < 1e-9);
+        }
+        let mut turned = plain.clone();
+        turned
+            .set_handles(&[point(centre, DVec2::new(1.0, 0.0), 0.5, 1.2)])
+            .expect("turned");
+        assert_eq!(turned.pinned(), 7, "the vertex and its six neighbours");
+        let v = domain
+            .nearest_vertex(DVec2::new(5.0, 4.0))
+            .expect("a vertex") as usize;
+        let expected = Similarity {
+            translation: DVec2::new(1.0, 0.0),
+            rotation: 0.5,
+            scale: 1.2,
+        }
+        .apply(centre, DVec2::new(5.0, 4.0));
+        assert!((turned.positions()[v] - expected).length() < 1e-9);
+    }
+
+    #[test]
+    fn no_handles_give_the_rest_shape_and_crowded_handles_stay_finite() {
+        let domain = grid(6, 3);
+        let arap = ArapRig::new(domain.clone(), &[], &[]).expect("ARAP");
+        assert_eq!(arap.positions(), domain.positions());
+        // Turned handles whose rings overlap, a collinear row, a bar along the border.
+        let handles = [
+            point(DVec2::new(2.0, 1.0), DVec2::new(0.0, 1.0), 1.0, 2.0),
+            point(DVec2::new(3.0, 1.0), DVec2::new(0.0, -1.0), -1.0, 0.5),
+            point(DVec2::new(4.0, 1.0), DVec2::ZERO, 0.0, 1.0),
+            Handle::Bar {
+                rest: [DVec2::new(0.0, 3.0), DVec2::new(6.0, 3.0)],
+                pose: [DVec2::new(0.0, 4.0), DVec2::new(6.0, 2.0)],
+            },
+        ];
+        let arap = ArapRig::new(domain, &handles, &[]).expect("ARAP");
+        assert!(arap.positions().iter().all(|p| p.is_finite()));
+        // A non-finite pose is refused and the last one stays.
+        let mut same = arap.clone();
+        let mut bad = handles.to_vec();
+        bad[0] = point(DVec2::new(2.0, 1.0), DVec2::new(f64::NAN, 0.0), 0.0, 1.0);
+        assert!(same.set_handles(&bad).is_err());
+        assert_eq!(same.positions(), arap.positions());
+        assert_eq!(Deformer::handles(&same), &handles);
+    }
+
+    #[test]
+    fn rigidity_takes_the_largest_stroke_within_reach_of_each_centroid() {
+        let domain = grid(10, 1);
+        let stroke = |points: Vec<[f64; 2]>, radius, weight| RigidityStroke {
+            stroke: points,
+            radius,
+            weight,
+        };
+        let weights = rigidity_weights(
+            &domain,
+            &[
+                // A disc around x = 1.5: the centroids of the first squares' triangles.
+                stroke(vec![[1.5, 0.5]], 0.6, 100.0),
+                // A line over x ∈ [5, 7], overlapping a stronger disc at x = 7.
+                stroke(vec![[5.0, 0.5], [7.0, 0.5]], 0.4, 10.0),
+                stroke(vec![[7.5, 0.5]], 0.5, 1000.0),
+            ],
+        );
+        let centroid = |t: usize| {
+            let tri = domain.triangles()[t];
+            tri.iter()
+                .map(|&v| domain.positions()[v as usize])
+                .sum::<DVec2>()
+                / 3.0
+        };
+        for (t, &w) in weights.iter().enumerate() {
+            let c = centroid(t);
+            let expected = if (c - DVec2::new(7.5, 0.5)).length() <= 0.5 {
+                1000.0
+            } else if (5.0 - 0.4..=7.0 + 0.4).contains(&c.x) && (c.y - 0.5).abs() <= 0.4 {
+                10.0
+            } else if (c - DVec2::new(1.5, 0.5)).length() <= 0.6 {
+                100.0
+            } else {
+                1.0
+            };
+            // The segment's distance is exact only away from its ends.
+            if (c.x - 4.6).abs() > 0.05 && (c.x - 7.4).abs() > 0.05 {
+                assert_eq!(w, expected, "triangle {t} at {c}");
+            }
+        }
+        assert!(weights.contains(&1000.0) && weights.contains(&10.0));
+        assert!(weights.contains(&100.0) && weights.contains(&1.0));
+    }
 }

@@ -6,6 +6,7 @@
 //! It takes a device, a queue and a render pass, not a window or a UI toolkit: the
 //! editor wraps it in its paint callback, and tests draw it offscreen.
 
+use glam::Vec2;
 use image::RgbaImage;
 use wgpu::util::DeviceExt;
 
@@ -53,12 +54,14 @@ struct Uniform {
     offset: [f32; 2],
     mode: u32,
     folds: u32,
-    _pad: [u32; 2],
+    /// 1: vertices sit at the uploaded deformed positions instead of being skinned.
+    positioned: u32,
+    _pad: u32,
     line: [f32; 4],
 }
 
 const VIEW_WGSL: &str = r"
-struct View { scale: vec2<f32>, offset: vec2<f32>, mode: u32, folds: u32, pad: vec2<u32>, line: vec4<f32> };
+struct View { scale: vec2<f32>, offset: vec2<f32>, mode: u32, folds: u32, positioned: u32, pad: u32, line: vec4<f32> };
 @group(0) @binding(0) var<uniform> view: View;
 @group(0) @binding(1) var source: texture_2d<f32>;
 @group(0) @binding(2) var linear: sampler;
@@ -74,6 +77,15 @@ fn place(p: vec2<f32>) -> vec4<f32> {
     return vec4<f32>(p * view.scale + view.offset, 0.0, 1.0);
 }
 
+// Where a vertex goes: blended by its nodes' transforms (C² weights), or where a
+// method that solves for positions (ARAP) put it.
+fn moved(index: u32, rest: vec2<f32>, deformed: vec2<f32>) -> vec2<f32> {
+    if view.positioned == 1u {
+        return deformed;
+    }
+    return skin(index, rest);
+}
+
 @vertex
 fn vs(
     @builtin(vertex_index) index: u32,
@@ -81,9 +93,10 @@ fn vs(
     @location(1) uv: vec2<f32>,
     @location(2) heat: f32,
     @location(3) cell: vec4<f32>,
+    @location(4) deformed: vec2<f32>,
 ) -> Out {
     var out: Out;
-    out.clip = place(skin(index, rest));
+    out.clip = place(moved(index, rest, deformed));
     out.uv = uv;
     out.heat = heat;
     out.cell = cell;
@@ -128,8 +141,12 @@ fn fs(in: Out, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
 }
 
 @vertex
-fn vs_line(@builtin(vertex_index) index: u32, @location(0) rest: vec2<f32>) -> @builtin(position) vec4<f32> {
-    return place(skin(index, rest));
+fn vs_line(
+    @builtin(vertex_index) index: u32,
+    @location(0) rest: vec2<f32>,
+    @location(4) deformed: vec2<f32>,
+) -> @builtin(position) vec4<f32> {
+    return place(moved(index, rest, deformed));
 }
 
 @fragment
@@ -152,6 +169,8 @@ struct GpuMesh {
     vertices: wgpu::Buffer,
     heat: wgpu::Buffer,
     cells: wgpu::Buffer,
+    /// Deformed positions, read instead of skinning in positioned mode.
+    deformed: wgpu::Buffer,
     triangles: wgpu::Buffer,
     triangle_indices: u32,
     edges: wgpu::Buffer,
@@ -172,6 +191,9 @@ pub struct MeshView {
     uniform: wgpu::Buffer,
     texture: wgpu::BindGroup,
     mesh: Option<GpuMesh>,
+    /// Whether the last pose came as positions ([`MeshView::set_positions`]) rather
+    /// than node transforms.
+    positioned: std::sync::atomic::AtomicBool,
 }
 
 impl MeshView {
@@ -246,6 +268,7 @@ impl MeshView {
             let geometry = wgpu::vertex_attr_array![0 => Float32x2, 1 => Float32x2];
             let heat = wgpu::vertex_attr_array![2 => Float32];
             let cells = wgpu::vertex_attr_array![3 => Unorm8x4];
+            let deformed = wgpu::vertex_attr_array![4 => Float32x2];
             let buffer = |stride, attributes| {
                 Some(wgpu::VertexBufferLayout {
                     array_stride: stride,
@@ -258,6 +281,7 @@ impl MeshView {
                 buffers.push(buffer(4, &heat[..]));
                 buffers.push(buffer(4, &cells[..]));
             }
+            buffers.push(buffer(8, &deformed[..]));
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some("mesh view"),
                 layout: Some(&pipeline_layout),
@@ -319,6 +343,7 @@ impl MeshView {
             uniform,
             texture,
             mesh: None,
+            positioned: std::sync::atomic::AtomicBool::new(false),
         }
     }
 
@@ -444,6 +469,11 @@ impl MeshView {
                 bytemuck::cast_slice(&vec![0u32; n.max(1)]),
                 per_vertex,
             ),
+            deformed: init(
+                "deformed",
+                bytemuck::cast_slice(&nonempty_vec2(mesh.rest.to_vec())),
+                per_vertex,
+            ),
             triangles: init(
                 "triangles",
                 bytemuck::cast_slice(&nonempty_u32(triangles.clone())),
@@ -461,6 +491,33 @@ impl MeshView {
             skin,
             vertex_count: n,
         });
+        self.set_positioned(false);
+        Ok(())
+    }
+
+    fn set_positioned(&self, positioned: bool) {
+        self.positioned
+            .store(positioned, std::sync::atomic::Ordering::Relaxed);
+    }
+
+    /// Uploads deformed positions (pixels, one per vertex: 8 bytes a vertex) for a
+    /// method that solves for positions rather than weights; they are drawn until the
+    /// next [`MeshView::set_pose`] or [`MeshView::set_mesh`].
+    ///
+    /// # Errors
+    /// No mesh, not one position per vertex, or non-finite values.
+    pub fn set_positions(
+        &self,
+        queue: &wgpu::Queue,
+        positions: &[Vec2],
+    ) -> Result<(), RenderError> {
+        let mesh = self.per_vertex(positions.len(), "positions")?;
+        if !positions.iter().all(|p| p.is_finite()) {
+            return Err(RenderError::Gpu("non-finite deformed positions".into()));
+        }
+        let packed: Vec<[f32; 2]> = positions.iter().map(|p| p.to_array()).collect();
+        queue.write_buffer(&mesh.deformed, 0, bytemuck::cast_slice(&packed));
+        self.set_positioned(true);
         Ok(())
     }
 
@@ -487,6 +544,7 @@ impl MeshView {
             0,
             bytemuck::cast_slice(&pack_transforms(transforms)),
         );
+        self.set_positioned(false);
         Ok(())
     }
 
@@ -533,7 +591,8 @@ impl MeshView {
                 Overlay::Cells => 2,
             },
             folds: u32::from(params.show_folds),
-            _pad: [0; 2],
+            positioned: u32::from(self.positioned.load(std::sync::atomic::Ordering::Relaxed)),
+            _pad: 0,
             line: [0.0, 0.0, 0.0, 0.25],
         };
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
@@ -549,11 +608,13 @@ impl MeshView {
             pass.set_pipeline(&self.fill);
             pass.set_vertex_buffer(1, mesh.heat.slice(..));
             pass.set_vertex_buffer(2, mesh.cells.slice(..));
+            pass.set_vertex_buffer(3, mesh.deformed.slice(..));
             pass.set_index_buffer(mesh.triangles.slice(..), wgpu::IndexFormat::Uint32);
             pass.draw_indexed(0..mesh.triangle_indices, 0, 0..1);
         }
         if wireframe && mesh.edge_indices > 0 {
             pass.set_pipeline(&self.lines);
+            pass.set_vertex_buffer(1, mesh.deformed.slice(..));
             pass.set_index_buffer(mesh.edges.slice(..), wgpu::IndexFormat::Uint32);
             pass.draw_indexed(0..mesh.edge_indices, 0, 0..1);
         }
@@ -562,6 +623,15 @@ impl MeshView {
 
 fn no_mesh(what: &str) -> RenderError {
     RenderError::Gpu(format!("no mesh to set the {what} of"))
+}
+
+/// The points of `v` as arrays, or one zero point if it is empty (buffers may not be
+/// empty).
+fn nonempty_vec2(v: Vec<Vec2>) -> Vec<[f32; 2]> {
+    if v.is_empty() {
+        return vec![[0.0; 2]];
+    }
+    v.iter().map(|p| p.to_array()).collect()
 }
 
 fn nonempty_u32(mut v: Vec<u32>) -> Vec<u32> {

@@ -110,6 +110,36 @@ fn a_new_pose_moves_the_mesh() {
 }
 
 #[test]
+fn uploaded_positions_replace_the_skinning_until_the_next_pose() {
+    let scene = Scene::new(IDENTITY);
+    let queue = scene.gpu.queue();
+    // The quad squeezed into the right half by positions (8 bytes a vertex).
+    let right = [
+        Vec2::new(4.0, 0.0),
+        Vec2::new(8.0, 0.0),
+        Vec2::new(8.0, 8.0),
+        Vec2::new(4.0, 8.0),
+    ];
+    scene.view.set_positions(queue, &right).expect("positions");
+    let image = scene.draw(Overlay::None, true);
+    for (x, _, p) in image.enumerate_pixels() {
+        if x < 8 {
+            assert_eq!(p[3], 0, "left half is empty");
+        } else {
+            assert!(green(p), "right half is the picture: {p:?}");
+        }
+    }
+    // A pose by transforms takes over again.
+    scene.view.set_pose(queue, &[IDENTITY]).expect("pose");
+    assert_eq!(count(&scene.draw(Overlay::None, true), green), 256);
+    // Wrong counts and NaN are refused.
+    assert!(scene.view.set_positions(queue, &right[..3]).is_err());
+    let mut bad = right;
+    bad[2].x = f32::NAN;
+    assert!(scene.view.set_positions(queue, &bad).is_err());
+}
+
+#[test]
 fn vertices_no_node_reaches_stay_at_rest() {
     // A rig without handles: every row is empty, and the picture must stay put.
     let gpu = GpuContext::new().expect("a wgpu adapter (run scripts/setup.sh)");

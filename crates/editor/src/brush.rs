@@ -1,0 +1,276 @@
+//! The rigidity brush (ARAP, the paper's §5.2): strokes painted on the picture make
+//! the triangles under them stiffer. A stroke is stored in rest pixels, so the paint
+//! stays on the same part of the picture whatever the pose; one stroke is one undo
+//! step. Alt erases.
+
+use std::sync::Arc;
+
+use egui::{Color32, Mesh, PointerButton, Pos2, Shape, Ui};
+use glam::DVec2;
+use project::{Method, RigidityStroke};
+
+use crate::app::EditorApp;
+use crate::document::Edit;
+
+/// The brush's settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Brush {
+    /// Radius in picture pixels.
+    pub radius: f64,
+    /// The weight painted (the paper paints 10000; 1 is unpainted).
+    pub weight: f64,
+}
+
+impl Default for Brush {
+    fn default() -> Self {
+        Self {
+            radius: 20.0,
+            weight: 10_000.0,
+        }
+    }
+}
+
+/// A stroke being painted (or erased), in rest pixels.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct BrushStroke {
+    erase: bool,
+    /// The stroke in rest pixels, as it is stored.
+    points: Vec<[f64; 2]>,
+    /// The same points where the pose shows them, for drawing the stroke under way.
+    posed: Vec<DVec2>,
+}
+
+/// The painted triangles, by the (mesh, strokes) they were found for.
+#[derive(Clone, Default)]
+pub(crate) struct PaintedCache {
+    key: Option<(u64, Vec<RigidityStroke>)>,
+    /// Each painted triangle with its weight.
+    triangles: Arc<Vec<(u32, f64)>>,
+}
+
+/// `strokes` with every point within `radius` plus the stroke's own radius of the
+/// polyline `eraser` removed, a stroke split where points go: what remains paints
+/// nothing within `radius` of the eraser's path.
+pub fn erase(strokes: &[RigidityStroke], eraser: &[[f64; 2]], radius: f64) -> Vec<RigidityStroke> {
+    let eraser: Vec<DVec2> = eraser.iter().map(|&p| DVec2::from(p)).collect();
+    let mut out = Vec::new();
+    for stroke in strokes {
+        let reach = radius + stroke.radius;
+        let mut piece = Vec::new();
+        for &p in &stroke.stroke {
+            if polyline_distance(&eraser, DVec2::from(p)) < reach {
+                if !piece.is_empty() {
+                    out.push(RigidityStroke {
+                        stroke: std::mem::take(&mut piece),
+                        ..stroke.clone()
+                    });
+                }
+            } else {
+                piece.push(p);
+            }
+        }
+        if !piece.is_empty() {
+            out.push(RigidityStroke {
+                stroke: piece,
+                ..stroke.clone()
+            });
+        }
+    }
+    out
+}
+
+/// The distance from `p` to the polyline through `points` (infinite for none).
+fn polyline_distance(points: &[DVec2], p: DVec2) -> f64 {
+    match points {
+        [] => f64::INFINITY,
+        [a] => a.distance(p),
+        _ => points
+            .windows(2)
+            .map(|w| {
+                let d = w[1] - w[0];
+                let t = if d.length_squared() > 0.0 {
+                    ((p - w[0]).dot(d) / d.length_squared()).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                (w[0] + d * t).distance(p)
+            })
+            .fold(f64::INFINITY, f64::min),
+    }
+}
+
+impl EditorApp {
+    /// Paints or erases (with Alt) while the primary button is down on the canvas, and
+    /// commits the stroke when it is released. Space or the middle button still pan.
+    pub(crate) fn brush_input(&mut self, ui: &Ui, response: &egui::Response) {
+        let (pressed, down, released, latest, alt, space) = ui.input(|i| {
+            (
+                i.pointer.primary_pressed(),
+                i.pointer.primary_down(),
+                i.pointer.primary_released(),
+                i.pointer.latest_pos(),
+                i.modifiers.alt,
+                i.key_down(egui::Key::Space),
+            )
+        });
+        if pressed
+            && !space
+            && response.contains_pointer()
+            && !response.drag_started_by(PointerButton::Middle)
+        {
+            self.brush_stroke = Some(BrushStroke {
+                erase: alt,
+                ..BrushStroke::default()
+            });
+        }
+        if (down || released)
+            && let (Some(pos), Some(_)) = (latest, &self.brush_stroke)
+        {
+            self.brush_point(pos);
+        }
+        if released && let Some(stroke) = self.brush_stroke.take() {
+            self.commit_stroke(stroke);
+        }
+    }
+
+    /// Adds the rest point under screen point `pos` to the stroke, at most every
+    /// quarter radius.
+    fn brush_point(&mut self, pos: Pos2) {
+        let at = self.viewport.to_image(pos);
+        let Some(doc) = self.doc.as_mut() else { return };
+        let Some((rest, _, _)) = doc.unwarp(at) else {
+            return;
+        };
+        let spacing = self.brush.radius * 0.25;
+        let Some(stroke) = &mut self.brush_stroke else {
+            return;
+        };
+        if stroke
+            .points
+            .last()
+            .is_none_or(|&last| DVec2::from(last).distance(rest) >= spacing)
+        {
+            stroke.points.push(rest.to_array());
+            stroke.posed.push(at);
+        }
+    }
+
+    fn commit_stroke(&mut self, stroke: BrushStroke) {
+        let Some(doc) = &self.doc else { return };
+        if stroke.points.is_empty() {
+            return;
+        }
+        let current = doc.project().rigidity.clone();
+        let strokes = if stroke.erase {
+            erase(&current, &stroke.points, self.brush.radius)
+        } else {
+            let mut strokes = current.clone();
+            strokes.push(RigidityStroke {
+                stroke: stroke.points,
+                radius: self.brush.radius,
+                weight: self.brush.weight,
+            });
+            strokes
+        };
+        if strokes == current {
+            return;
+        }
+        let method = doc.method();
+        if self.edit(Edit::Rigidity(strokes)) && method != Method::Arap {
+            self.info("rigidity is painted for ARAP: choose ARAP under Method to see its effect");
+        }
+    }
+
+    /// Draws the painted triangles, translucent, where the pose puts them (and the
+    /// stroke being painted).
+    pub(crate) fn paint_rigidity(&mut self, painter: &egui::Painter) {
+        let Some(doc) = self.doc.as_mut() else { return };
+        let strokes = &doc.project().rigidity;
+        if strokes.is_empty() && self.brush_stroke.is_none() {
+            return;
+        }
+        let key = (doc.mesh_version(), strokes.clone());
+        if self.painted.key.as_ref() != Some(&key) {
+            let weights = pipeline::method::rigidity_weights(doc.rig().domain(), strokes);
+            let painted = weights
+                .iter()
+                .enumerate()
+                .filter(|(_, w)| **w != 1.0)
+                .map(|(t, &w)| (t as u32, w))
+                .collect();
+            self.painted = PaintedCache {
+                key: Some(key),
+                triangles: Arc::new(painted),
+            };
+        }
+        let painted = self.painted.triangles.clone();
+        let triangles = doc.rig().domain().triangles().to_vec();
+        let deformed = doc.deformed();
+        let mut mesh = Mesh::default();
+        for &(t, w) in painted.iter() {
+            // Stiffer is more opaque: 10 → faint, 10⁴ → strong; below 1 blue.
+            let strength = (w.log10().abs() / 4.0).clamp(0.15, 1.0);
+            let alpha = (40.0 + 70.0 * strength) as u8;
+            let color = if w >= 1.0 {
+                Color32::from_rgba_unmultiplied(255, 140, 0, alpha)
+            } else {
+                Color32::from_rgba_unmultiplied(40, 140, 255, alpha)
+            };
+            let base = mesh.vertices.len() as u32;
+            for &v in &triangles[t as usize] {
+                let p = self.viewport.to_screen(deformed[v as usize]);
+                mesh.colored_vertex(p, color);
+            }
+            mesh.add_triangle(base, base + 1, base + 2);
+        }
+        if !mesh.is_empty() {
+            painter.add(Shape::mesh(mesh));
+        }
+        if let Some(stroke) = &self.brush_stroke {
+            let color = if stroke.erase {
+                Color32::from_white_alpha(90)
+            } else {
+                Color32::from_rgba_unmultiplied(255, 140, 0, 90)
+            };
+            let radius = self.brush.radius as f32 * self.viewport.zoom;
+            for &p in &stroke.posed {
+                painter.circle_filled(self.viewport.to_screen(p), radius, color);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn stroke(points: &[[f64; 2]], radius: f64) -> RigidityStroke {
+        RigidityStroke {
+            stroke: points.to_vec(),
+            radius,
+            weight: 100.0,
+        }
+    }
+
+    #[test]
+    fn erasing_splits_strokes_and_clears_the_eraser_path() {
+        let line: Vec<[f64; 2]> = (0..=10).map(|i| [f64::from(i) * 10.0, 0.0]).collect();
+        let strokes = [stroke(&line, 5.0), stroke(&[[0.0, 100.0]], 5.0)];
+        // An eraser across the middle of the line.
+        let out = erase(&strokes, &[[50.0, -20.0], [50.0, 20.0]], 5.0);
+        assert_eq!(out.len(), 3, "{out:?}");
+        let left = &out[0].stroke;
+        let right = &out[1].stroke;
+        assert_eq!(left.last(), Some(&[40.0, 0.0]));
+        assert_eq!(right.first(), Some(&[60.0, 0.0]));
+        // Nothing left within the eraser's reach of its path.
+        for s in &out {
+            for p in &s.stroke {
+                assert!((p[0] - 50.0).abs() >= 10.0 || p[1] == 100.0, "{p:?}");
+            }
+        }
+        assert_eq!(out[2], strokes[1], "a stroke out of reach stays whole");
+        // Erasing everything leaves nothing.
+        assert!(erase(&strokes, &[[0.0, 0.0], [100.0, 0.0], [0.0, 100.0]], 50.0).is_empty());
+    }
+}

@@ -1,0 +1,238 @@
+//! The method switch and the rigidity brush, driven as a user drives them, on the
+//! built-in picture with its posed sample rig; the canvas drawn by the real wgpu paint
+//! callback on the software adapter.
+
+mod support;
+
+use egui::{Key, Modifiers};
+use egui_kittest::Harness;
+use glam::DVec2;
+use pipeline::{ArapRig, Deformer};
+use project::Method;
+
+use editor::{EditorApp, Tool};
+use support::{at, click_label, drag, editor};
+
+/// The share of pixels that differ by more than 8 in some channel.
+fn changed(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
+    assert_eq!(a.dimensions(), b.dimensions());
+    let differ = a
+        .pixels()
+        .zip(b.pixels())
+        .filter(|(p, q)| p.0.iter().zip(q.0).any(|(x, y)| x.abs_diff(y) > 8))
+        .count();
+    differ as f64 / (a.width() * a.height()) as f64
+}
+
+/// The canvas as drawn (the panels around it show times and messages that differ).
+fn shot(h: &mut Harness<'_, EditorApp>) -> image::RgbaImage {
+    h.run();
+    let frame = h.render().expect("a frame drawn on the software adapter");
+    let scale = h.ctx.pixels_per_point();
+    let canvas = h.state().viewport.canvas;
+    let [x, y] = [canvas.min.x * scale, canvas.min.y * scale].map(|v| v.max(0.0) as u32);
+    let w = ((canvas.width() * scale) as u32).min(frame.width() - x);
+    let h = ((canvas.height() * scale) as u32).min(frame.height() - y);
+    image::imageops::crop_imm(&frame, x, y, w, h).to_image()
+}
+
+fn method(h: &Harness<'_, EditorApp>) -> Method {
+    h.state().document().expect("a document").method()
+}
+
+fn positions(h: &Harness<'_, EditorApp>) -> Vec<DVec2> {
+    h.state()
+        .document()
+        .expect("a document")
+        .deformer()
+        .deformed()
+}
+
+#[test]
+fn switching_methods_keeps_the_pose_and_comes_back_and_undoes() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    let handles = h.state().document().expect("doc").project().handles.clone();
+    let c2 = shot(&mut h);
+    let c2_positions = positions(&h);
+
+    click_label(&mut h, "ARAP");
+    assert_eq!(method(&h), Method::Arap);
+    let doc = h.state().document().expect("doc");
+    assert_eq!(doc.project().handles, handles, "same handles and pose");
+    let times = doc.arap_times().expect("ARAP is set up");
+    assert!(times.compile_ms > 0.0);
+    // The editor's ARAP is the method's own answer for the rig's mesh and handles.
+    let own = ArapRig::new(doc.rig().domain().clone(), doc.rig().handles(), &[])
+        .expect("ARAP")
+        .deformed();
+    assert_eq!(positions(&h), own);
+    let arap = shot(&mut h);
+    assert!(
+        changed(&c2, &arap) > 0.002,
+        "ARAP draws another picture ({})",
+        changed(&c2, &arap)
+    );
+    let moved = positions(&h)
+        .iter()
+        .zip(&c2_positions)
+        .filter(|(a, b)| a.distance(**b) > 1.0)
+        .count();
+    assert!(moved > c2_positions.len() / 10, "{moved} vertices moved");
+
+    click_label(&mut h, "C² weights");
+    assert_eq!(method(&h), Method::C2);
+    assert_eq!(positions(&h), c2_positions);
+    assert_eq!(
+        changed(&c2, &shot(&mut h)),
+        0.0,
+        "the C² picture comes back"
+    );
+
+    // Each switch is one undo step.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert_eq!(method(&h), Method::Arap);
+    assert_eq!(changed(&arap, &shot(&mut h)), 0.0);
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert_eq!(method(&h), Method::C2);
+    // The method is saved with the project.
+    h.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
+    h.run();
+    let saved = h
+        .state()
+        .document()
+        .expect("doc")
+        .project_for_saving(None)
+        .to_json();
+    assert!(saved.contains(r#""method": "arap""#), "{saved}");
+    h.state().sanity_check().expect("consistent");
+}
+
+#[test]
+fn a_drag_under_arap_moves_the_handle_and_keeps_the_compiled_system() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    click_label(&mut h, "ARAP");
+    click_label(&mut h, "Select");
+    let compile = h
+        .state()
+        .document()
+        .and_then(|d| d.arap_times())
+        .expect("ARAP");
+    // Drag the first handle (a point) by 20 pixels.
+    let first = h.state().document().expect("doc").node_position(0);
+    let (from, to) = (
+        at(&h, first.x, first.y),
+        at(&h, first.x + 20.0, first.y + 10.0),
+    );
+    drag(&mut h, from, to, Modifiers::NONE);
+    let doc = h.state().document().expect("doc");
+    let moved = doc.node_position(0);
+    assert!(
+        (moved - first - DVec2::new(20.0, 10.0)).length() < 2.0,
+        "{first} -> {moved}"
+    );
+    let after = doc.arap_times().expect("ARAP");
+    assert_eq!(
+        after.compile_ms, compile.compile_ms,
+        "a translation drag recompiles nothing"
+    );
+    h.state().sanity_check().expect("consistent");
+}
+
+#[test]
+fn painted_rigidity_is_one_undo_step_and_erases() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    click_label(&mut h, "ARAP");
+    let before = positions(&h);
+    let unpainted = shot(&mut h);
+    h.key_press(Key::R);
+    h.run();
+    assert_eq!(h.state().tool, Tool::Rigidity);
+    // A stroke along the tail, which the pose bends.
+    let (a, b) = (at(&h, 300.0, 420.0), at(&h, 420.0, 520.0));
+    drag(&mut h, a, b, Modifiers::NONE);
+    let strokes = h
+        .state()
+        .document()
+        .expect("doc")
+        .project()
+        .rigidity
+        .clone();
+    assert_eq!(strokes.len(), 1, "{:?}", h.state().message);
+    assert!(strokes[0].stroke.len() > 2);
+    assert_eq!(strokes[0].weight, 10_000.0);
+    let painted = positions(&h);
+    assert_ne!(painted, before, "the paint changed the warp");
+    assert!(changed(&unpainted, &shot(&mut h)) > 0.0);
+    let stiff = h
+        .state()
+        .document()
+        .and_then(|d| d.rigidity())
+        .expect("ARAP")
+        .iter()
+        .filter(|w| **w > 1.0)
+        .count();
+    assert!(stiff > 10, "{stiff} painted triangles");
+
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert!(
+        h.state()
+            .document()
+            .expect("doc")
+            .project()
+            .rigidity
+            .is_empty()
+    );
+    assert_eq!(positions(&h), before, "undo takes the paint back");
+    h.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
+    h.run();
+    assert_eq!(positions(&h), painted, "and redo puts it back");
+
+    // Alt-drag along the same path erases it.
+    drag(&mut h, a, b, Modifiers::ALT);
+    let doc = h.state().document().expect("doc");
+    assert!(
+        doc.project().rigidity.is_empty(),
+        "{:?}",
+        doc.project().rigidity
+    );
+    assert_eq!(positions(&h), before);
+    h.state().sanity_check().expect("consistent");
+}
+
+#[test]
+fn arap_with_no_handles_one_handle_and_paint_under_c2() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    click_label(&mut h, "ARAP");
+    click_label(&mut h, "Clear all handles");
+    let doc = h.state().document().expect("doc");
+    let rest = doc.rig().domain().positions().to_vec();
+    let at_rest = positions(&h);
+    let worst = at_rest
+        .iter()
+        .zip(&rest)
+        .map(|(a, b)| a.distance(*b))
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-9, "no handles: the rest shape ({worst})");
+    h.state().sanity_check().expect("consistent");
+    // Paint under C²: kept, with a word that it is for ARAP.
+    click_label(&mut h, "C² weights");
+    h.key_press(Key::R);
+    h.run();
+    let (a, b) = (at(&h, 300.0, 300.0), at(&h, 340.0, 320.0));
+    drag(&mut h, a, b, Modifiers::NONE);
+    let state = h.state();
+    assert_eq!(state.document().expect("doc").project().rigidity.len(), 1);
+    let message = state.message.as_ref().map(|m| m.text.clone());
+    assert!(
+        message.as_deref().is_some_and(|m| m.contains("ARAP")),
+        "{message:?}"
+    );
+    state.sanity_check().expect("consistent");
+}
