@@ -369,6 +369,7 @@ fn the_editor_exports_what_the_command_renders() {
         translate: [12.0, -25.0],
         rotate: 0.3,
         scale: 1.1,
+        depth: 0,
     };
     assert!(app.edit(editor::Edit::Pose(0, posed)), "{:?}", app.message);
     let handles = app.document().map_or(0, |d| d.project().handles.len());

@@ -256,3 +256,56 @@ fn bad_method_fields_give_one_clear_line_and_keep_the_old_output() {
     );
     assert_eq!(fs::read(&out).expect("read"), b"precious");
 }
+
+/// The lizard with its hind leg dragged over its body; `depth` is the leg's handle's.
+fn folded_rig(dir: &Path, depth: i32) -> std::path::PathBuf {
+    let rig = dir.join(format!("fold{depth}.json"));
+    fs::write(
+        &rig,
+        format!(
+            r#"{{"version": 1, "density": 4000, "handles": [
+                {{"type": "bar", "rest": [[110, 130], [250, 250]]}},
+                {{"type": "point", "rest": [440, 238]}},
+                {{"type": "point", "rest": [685, 590]}},
+                {{"type": "point", "rest": [190, 470], "translate": [140, -150], "depth": {depth}}}]}}"#
+        ),
+    )
+    .expect("write rig");
+    rig
+}
+
+#[test]
+fn handle_depth_decides_what_is_in_front_on_the_cpu_and_the_gpu_alike() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let lizard = dir.path().join("lizard.png");
+    fs::write(&lizard, pipeline::DEFAULT_IMAGE).expect("write");
+    let (front, back) = (folded_rig(dir.path(), 1), folded_rig(dir.path(), -1));
+    for method in ["c2", "arap"] {
+        let out = |rig: &Path, extra: &[&'static str]| {
+            let out = dir.path().join(format!(
+                "{method}-{}{}.png",
+                rig.file_stem().and_then(|s| s.to_str()).unwrap_or(""),
+                extra.len()
+            ));
+            let mut flags = vec!["--method", method];
+            flags.extend_from_slice(extra);
+            ok(&render_args(&lizard, rig, &out, &flags));
+            load(&out)
+        };
+        let (in_front, behind) = (out(&front, &[]), out(&back, &[]));
+        let (_, share) = difference(&in_front, &behind, 8);
+        assert!(
+            share > 0.001,
+            "{method}: the leg in front or behind differs ({share})"
+        );
+        // The GPU draws the triangles in the same order.
+        let gpu = out(&front, &["--gpu"]);
+        let (worst, share) = difference(&in_front, &gpu, 8);
+        assert!(
+            share < 0.01,
+            "{method}: GPU and CPU differ in {share} (largest {worst})"
+        );
+        let (_, wrong) = difference(&behind, &gpu, 8);
+        assert!(wrong > share, "{method}: the GPU puts the leg in front too");
+    }
+}

@@ -219,20 +219,18 @@ fn warp_and_save(
     let progress = progress::Steps::new(3);
     progress.step("meshing and weighting");
     let rgba8 = picture.to_rgba8();
-    let prepared =
-        pipeline::prepare_with_progress(&rgba8, project, density, &progress.weighting())?;
-    let deformer = pipeline::deformer(project.method, prepared.rig, &project.rigidity)?;
+    let warper = pipeline::prepare_warper(&rgba8, project, density, &progress.weighting())?;
     progress.step("rendering");
     let warped = if gpu {
-        Picture::Rgba8(pipeline::warp_gpu(&rgba8, deformer.as_ref())?)
+        Picture::Rgba8(pipeline::warp_gpu(&rgba8, &warper)?)
     } else {
         drop(rgba8);
-        pipeline::warp_picture(picture, deformer.as_ref())?
+        pipeline::warp_picture(picture, &warper)?
     };
     progress.step("writing");
     write_png(output, &warped)?;
     progress.finish();
-    Ok(deformer)
+    Ok(warper.deformer)
 }
 
 /// Whether `output` names standard output (`-`).

@@ -115,6 +115,7 @@ fn export(c: &mut Criterion) {
         translate,
         rotate: 0.2,
         scale: 1.0,
+        depth: 0,
     };
     let project = Project {
         handles: vec![

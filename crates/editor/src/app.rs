@@ -281,6 +281,24 @@ impl EditorApp {
         }
     }
 
+    /// Moves handle `index` `by` steps forward in the overlap order (negative:
+    /// backward): where the warped picture overlaps itself, the part nearest the
+    /// handle of greater depth is drawn in front. One undo step.
+    pub fn change_depth(&mut self, index: usize, by: i32) {
+        let Some(handle) = self
+            .doc
+            .as_ref()
+            .and_then(|d| d.project().handles.get(index))
+        else {
+            return;
+        };
+        let depth = handle.depth().saturating_add(by);
+        let moved = handle.with_depth(depth);
+        if self.edit(Edit::Pose(index, moved)) {
+            self.info(format!("handle {} now has depth {depth}", index + 1));
+        }
+    }
+
     /// Replaces the file dialogs (tests answer them with fixed paths).
     pub fn set_dialogs(&mut self, dialogs: Box<dyn Dialogs>) {
         self.dialogs = dialogs;
@@ -462,6 +480,7 @@ impl EditorApp {
             } else {
                 scale
             },
+            depth: 0,
         };
         if self.edit(Edit::Add(handle))
             && let Some(doc) = &self.doc
@@ -484,6 +503,7 @@ impl EditorApp {
         let handle = HandleSpec::Bar {
             rest: [ra.to_array(), rb.to_array()],
             pose: Some([a.to_array(), b.to_array()]),
+            depth: 0,
         };
         if self.edit(Edit::Add(handle))
             && let Some(doc) = &self.doc
@@ -952,16 +972,16 @@ impl EditorApp {
         Some(move || {
             let clock = Instant::now();
             let result = (|| -> Result<()> {
-                let prepared = pipeline::prepare(&image, &project, None)?;
+                let warper = pipeline::prepare_warper(&image, &project, None, &|_| {})?;
                 // A 16-bit picture exports with 16 bits, as `c2warp render` does.
                 if let Some(deep) = deep {
-                    let warped = pipeline::warp_picture(&deep, &prepared.rig)?;
+                    let warped = pipeline::warp_picture(&deep, &warper)?;
                     if cancel.is_set() {
                         anyhow::bail!("cancelled");
                     }
                     render::save_png_atomic(&path, &warped)?;
                 } else {
-                    let warped = pipeline::warp(&image, &prepared.rig)?;
+                    let warped = pipeline::warp(&image, &warper)?;
                     if cancel.is_set() {
                         anyhow::bail!("cancelled");
                     }
@@ -1026,7 +1046,7 @@ impl EditorApp {
                 rows,
                 nodes,
                 weights,
-                triangles: rig.domain().triangles().to_vec(),
+                triangles: doc.draw_order(),
                 source_size: [doc.image.width(), doc.image.height()],
             };
             gpu.mesh = Versioned {
@@ -1207,6 +1227,7 @@ mod tests {
             translate,
             rotate: 0.0,
             scale: 1.0,
+            depth: 0,
         }
     }
 

@@ -329,6 +329,15 @@ impl EditorApp {
                 let _ = self.edit(crate::document::Edit::Pose(i, rest));
                 ui.close();
             }
+            ui.separator();
+            if ui.button("Bring forward").clicked() {
+                self.change_depth(i, 1);
+                ui.close();
+            }
+            if ui.button("Send backward").clicked() {
+                self.change_depth(i, -1);
+                ui.close();
+            }
         } else if let Some(at) = self.context_point
             && ui.button("Add point handle here").clicked()
         {
@@ -375,6 +384,7 @@ impl EditorApp {
                     translate,
                     rotate,
                     scale,
+                    depth,
                 },
                 grip,
             ) => {
@@ -391,9 +401,10 @@ impl EditorApp {
                     translate,
                     rotate,
                     scale,
+                    depth,
                 }
             }
-            (HandleSpec::Bar { rest, .. }, grip) => {
+            (HandleSpec::Bar { rest, depth, .. }, grip) => {
                 let pose = match grip {
                     Grip::Move => [a + delta, b + delta],
                     Grip::End(0) => [a + delta, b],
@@ -410,6 +421,7 @@ impl EditorApp {
                 HandleSpec::Bar {
                     rest,
                     pose: Some(pose.map(|p| p.to_array())),
+                    depth,
                 }
             }
         };

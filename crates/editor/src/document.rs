@@ -186,6 +186,13 @@ impl Document {
         self.mesh_version
     }
 
+    /// The mesh's triangles in drawing order, back to front, by the handles' depths
+    /// (see [`pipeline::order`]).
+    pub fn draw_order(&self) -> Vec<[u32; 3]> {
+        let depths: Vec<i32> = self.project.handles.iter().map(HandleSpec::depth).collect();
+        pipeline::draw_order(&self.rig, &depths)
+    }
+
     /// The method in use.
     pub fn method(&self) -> Method {
         self.project.method
@@ -423,6 +430,11 @@ impl Document {
                 .iter()
                 .zip(&self.project.handles)
                 .all(|(a, b)| same_rest(a, b));
+        let depths_changed = project.handles.iter().map(HandleSpec::depth).ne(self
+            .project
+            .handles
+            .iter()
+            .map(HandleSpec::depth));
         if new.density != old.density {
             let mut with_virtuals = project.clone();
             if exact {
@@ -467,6 +479,10 @@ impl Document {
             if same_rest {
                 self.project = project;
                 self.pose_version += 1;
+                if depths_changed {
+                    // The triangles' drawing order changed: the mesh is uploaded anew.
+                    self.weights_version += 1;
+                }
                 return self.sync_method();
             }
         }
@@ -678,13 +694,18 @@ pub fn same_rest(a: &HandleSpec, b: &HandleSpec) -> bool {
 /// The handle with its pose reset.
 pub fn at_rest(h: &HandleSpec) -> HandleSpec {
     match *h {
-        HandleSpec::Point { rest, .. } => HandleSpec::Point {
+        HandleSpec::Point { rest, depth, .. } => HandleSpec::Point {
             rest,
             translate: [0.0; 2],
             rotate: 0.0,
             scale: 1.0,
+            depth,
         },
-        HandleSpec::Bar { rest, .. } => HandleSpec::Bar { rest, pose: None },
+        HandleSpec::Bar { rest, depth, .. } => HandleSpec::Bar {
+            rest,
+            pose: None,
+            depth,
+        },
     }
 }
 
@@ -697,7 +718,7 @@ pub fn posed(h: &HandleSpec) -> [DVec2; 2] {
             let p = DVec2::from(rest) + DVec2::from(translate);
             [p, p]
         }
-        HandleSpec::Bar { rest, pose } => pose.unwrap_or(rest).map(DVec2::from),
+        HandleSpec::Bar { rest, pose, .. } => pose.unwrap_or(rest).map(DVec2::from),
     }
 }
 
@@ -725,6 +746,7 @@ mod tests {
             translate: [0.0; 2],
             rotate: 0.0,
             scale: 1.0,
+            depth: 0,
         }
     }
 
@@ -760,6 +782,7 @@ mod tests {
         let bar = HandleSpec::Bar {
             rest: [[20.0, 20.0], [20.0, 20.0]],
             pose: None,
+            depth: 0,
         };
         assert!(doc.apply(Edit::Add(bar)).is_err(), "zero-length bar");
         let close = doc.rig().domain().mean_edge_length();
@@ -781,6 +804,7 @@ mod tests {
                 translate,
                 rotate,
                 scale,
+                depth: 0,
             },
         )
     }

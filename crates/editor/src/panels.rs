@@ -387,17 +387,30 @@ impl EditorApp {
         ui.heading("Show");
         self.overlay_toggles(ui);
         ui.separator();
+        let mut forward = None;
         if let Some(i) = self.selected
             && let Some(doc) = &self.doc
             && let Some(h) = doc.project().handles.get(i)
         {
             ui.heading(format!("Handle {}", i + 1));
+            let depth = h.depth();
+            ui.horizontal(|ui| {
+                ui.label(format!("depth {depth}"))
+                    .on_hover_text("Where the warped picture overlaps itself, handles of greater depth are in front");
+                if ui.button("Bring forward").clicked() {
+                    forward = Some(1);
+                }
+                if ui.button("Send backward").clicked() {
+                    forward = Some(-1);
+                }
+            });
             match h {
                 project::HandleSpec::Point {
                     rest,
                     translate,
                     rotate,
                     scale,
+                    ..
                 } => {
                     ui.label(format!("point at ({:.1}, {:.1})", rest[0], rest[1]));
                     ui.label(format!(
@@ -417,6 +430,9 @@ impl EditorApp {
                     ));
                 }
             }
+        }
+        if let (Some(i), Some(by)) = (self.selected, forward) {
+            self.change_depth(i, by);
         }
     }
 

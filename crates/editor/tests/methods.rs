@@ -6,6 +6,7 @@ mod support;
 
 use egui::{Key, Modifiers};
 use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
 use glam::DVec2;
 use pipeline::{ArapRig, Deformer};
 use project::Method;
@@ -235,4 +236,53 @@ fn arap_with_no_handles_one_handle_and_paint_under_c2() {
         "{message:?}"
     );
     state.sanity_check().expect("consistent");
+}
+
+#[test]
+fn bringing_a_handle_forward_puts_its_part_in_front() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    support::write_lizard(dir.path());
+    // The hind leg dragged over the body.
+    std::fs::write(
+        dir.path().join("project.json"),
+        r#"{"version": 1, "image": "lizard.png", "density": 4000, "handles": [
+            {"type": "bar", "rest": [[110, 130], [250, 250]]},
+            {"type": "point", "rest": [440, 238]},
+            {"type": "point", "rest": [685, 590]},
+            {"type": "point", "rest": [190, 470], "translate": [140, -150], "depth": -1}]}"#,
+    )
+    .expect("write project");
+    let mut h = editor(dir.path());
+    h.get_by_label("File").click();
+    h.run();
+    click_label(&mut h, "Open project…");
+    support::settle(&mut h);
+    assert_eq!(
+        h.state().document().expect("doc").project().handles.len(),
+        4
+    );
+    h.state_mut().selected = Some(3);
+    h.run();
+    let behind = shot(&mut h);
+    click_label(&mut h, "Bring forward");
+    click_label(&mut h, "Bring forward");
+    let doc = h.state().document().expect("doc");
+    assert_eq!(doc.project().handles[3].depth(), 1);
+    let in_front = shot(&mut h);
+    assert!(
+        changed(&behind, &in_front) > 0.0005,
+        "the leg comes in front ({})",
+        changed(&behind, &in_front)
+    );
+    h.snapshot("editor_leg_in_front");
+    // One undo step each.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert_eq!(
+        h.state().document().expect("doc").project().handles[3].depth(),
+        -1
+    );
+    assert_eq!(changed(&behind, &shot(&mut h)), 0.0);
+    h.state().sanity_check().expect("consistent");
 }

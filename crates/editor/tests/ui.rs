@@ -149,7 +149,11 @@ fn an_editing_session() {
     let picture = pipeline::load_image(&lizard).expect("picture");
     let project = pipeline::load_project(&dir.path().join("project.json")).expect("project");
     let prepared = pipeline::prepare(&picture, &project, None).expect("rig");
-    let expected = pipeline::warp(&picture, &prepared.rig).expect("warp");
+    let expected = pipeline::warp(
+        &picture,
+        &pipeline::Warper::new(prepared.rig, &project).expect("C²"),
+    )
+    .expect("warp");
     assert_eq!(exported.dimensions(), picture.dimensions());
     assert!(
         exported == expected,

@@ -145,6 +145,7 @@ fn main() {
                     translate: [0.0, 0.0],
                     rotate: 0.0,
                     scale: 1.0,
+                    depth: 0,
                 })
                 .collect(),
             density: Some(density),

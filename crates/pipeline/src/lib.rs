@@ -2,6 +2,7 @@
 //! the editor share, so an export from either gives the same pixels.
 
 pub mod method;
+pub mod order;
 
 use std::io::{BufReader, Read};
 use std::path::Path;
@@ -14,6 +15,7 @@ use project::{HandleSpec, MetricChoice, Middle, Project};
 use render::Picture;
 
 pub use method::{ArapRig, ArapTimes, Deformer, Method, Output, deformer};
+pub use order::draw_order;
 use weights_core::{
     Basis, Domain, Handle, Metric, MiddleControls, Rig, RigOptions, Similarity, VirtualHandle,
 };
@@ -148,6 +150,7 @@ pub fn handles(project: &Project) -> Vec<Handle> {
                 translate,
                 rotate,
                 scale,
+                ..
             } => Handle::Point {
                 rest: DVec2::from(rest),
                 transform: Similarity {
@@ -156,7 +159,7 @@ pub fn handles(project: &Project) -> Vec<Handle> {
                     scale,
                 },
             },
-            HandleSpec::Bar { rest, pose } => {
+            HandleSpec::Bar { rest, pose, .. } => {
                 let rest = rest.map(DVec2::from);
                 Handle::Bar {
                     rest,
@@ -301,14 +304,64 @@ pub fn prepare_with_progress(
     Ok(Prepared { rig })
 }
 
-/// The mesh's vertices at rest in f32: its texture coordinates.
-fn rest_positions(deformer: &dyn Deformer) -> Vec<Vec2> {
-    deformer
-        .domain()
-        .positions()
-        .iter()
-        .map(|p| p.as_vec2())
-        .collect()
+/// A picture's mesh with a method set up on it and the order its triangles are drawn
+/// in: what [`warp`], [`warp_picture`] and [`warp_gpu`] draw.
+pub struct Warper {
+    /// The method, posed.
+    pub deformer: Box<dyn Deformer>,
+    /// The mesh's triangles, back to front (see [`order`]).
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl Warper {
+    /// Sets up `project`'s method (its rigidity included) on the rig `prepare` built,
+    /// with the overlap order of its handles' depths.
+    ///
+    /// # Errors
+    /// What the method refuses.
+    pub fn new(rig: Rig, project: &Project) -> Result<Self> {
+        let depths: Vec<i32> = project.handles.iter().map(HandleSpec::depth).collect();
+        let triangles = draw_order(&rig, &depths);
+        let deformer = deformer(project.method, rig, &project.rigidity)?;
+        Ok(Self {
+            deformer,
+            triangles,
+        })
+    }
+
+    /// The mesh's vertices at rest in f32: its texture coordinates.
+    fn rest(&self) -> Vec<Vec2> {
+        self.deformer
+            .domain()
+            .positions()
+            .iter()
+            .map(|p| p.as_vec2())
+            .collect()
+    }
+
+    /// The deformed positions in f32 for drawing.
+    fn deformed(&self) -> Result<Vec<Vec2>> {
+        let deformed = self.deformer.deformed();
+        if deformed.iter().any(|p| !p.is_finite()) {
+            bail!("the deformation produced non-finite positions");
+        }
+        Ok(deformed.iter().map(|p| p.as_vec2()).collect())
+    }
+}
+
+/// Meshes `image` for `project`, weights it and sets up the project's method: the
+/// whole way from a picture and a rig file to something to draw.
+///
+/// # Errors
+/// As [`prepare`], and what the method refuses.
+pub fn prepare_warper(
+    image: &RgbaImage,
+    project: &Project,
+    density: Option<usize>,
+    progress: &(dyn Fn(weights_core::Progress) + Sync),
+) -> Result<Warper> {
+    let prepared = prepare_with_progress(image, project, density, progress)?;
+    Warper::new(prepared.rig, project)
 }
 
 /// The image warped by the current pose on the GPU (or a software adapter): for C²
@@ -317,12 +370,12 @@ fn rest_positions(deformer: &dyn Deformer) -> Vec<Vec2> {
 ///
 /// # Errors
 /// No adapter, or a GPU failure.
-pub fn warp_gpu(image: &RgbaImage, deformer: &dyn Deformer) -> Result<RgbaImage> {
+pub fn warp_gpu(image: &RgbaImage, warper: &Warper) -> Result<RgbaImage> {
     let gpu = render::GpuContext::new()?;
-    let rest = rest_positions(deformer);
-    let triangles = deformer.domain().triangles();
+    let rest = warper.rest();
+    let triangles = &warper.triangles;
     let (w, h) = image.dimensions();
-    match deformer.output() {
+    match warper.deformer.output() {
         Output::Skinned(rig) => {
             let (rows, nodes, weights) = rig.weight_table();
             let mesh = render::SkinnedMesh {
@@ -335,7 +388,7 @@ pub fn warp_gpu(image: &RgbaImage, deformer: &dyn Deformer) -> Result<RgbaImage>
             Ok(gpu.warp_skinned(image, &mesh, &rig.node_affines(), w, h)?)
         }
         Output::Positions(_) => {
-            let deformed = deformed_f32(deformer)?;
+            let deformed = warper.deformed()?;
             let mesh = render::WarpMesh {
                 rest: &rest,
                 deformed: &deformed,
@@ -353,13 +406,13 @@ pub fn warp_gpu(image: &RgbaImage, deformer: &dyn Deformer) -> Result<RgbaImage>
 ///
 /// # Errors
 /// Only if the deformation produced non-finite positions.
-pub fn warp_picture(picture: &Picture, deformer: &dyn Deformer) -> Result<Picture> {
-    let rest = rest_positions(deformer);
-    let deformed = deformed_f32(deformer)?;
+pub fn warp_picture(picture: &Picture, warper: &Warper) -> Result<Picture> {
+    let rest = warper.rest();
+    let deformed = warper.deformed()?;
     let mesh = render::WarpMesh {
         rest: &rest,
         deformed: &deformed,
-        triangles: deformer.domain().triangles(),
+        triangles: &warper.triangles,
     };
     let (w, h) = picture.dimensions();
     Ok(render::warp_picture(
@@ -371,26 +424,17 @@ pub fn warp_picture(picture: &Picture, deformer: &dyn Deformer) -> Result<Pictur
     )?)
 }
 
-/// The deformed positions in f32 for drawing.
-fn deformed_f32(deformer: &dyn Deformer) -> Result<Vec<Vec2>> {
-    let deformed = deformer.deformed();
-    if deformed.iter().any(|p| !p.is_finite()) {
-        bail!("the deformation produced non-finite positions");
-    }
-    Ok(deformed.iter().map(|p| p.as_vec2()).collect())
-}
-
 /// The image warped by the current pose, at the image's full resolution.
 ///
 /// # Errors
 /// Only if the deformation produced non-finite positions.
-pub fn warp(image: &RgbaImage, deformer: &dyn Deformer) -> Result<RgbaImage> {
-    let rest = rest_positions(deformer);
-    let deformed = deformed_f32(deformer)?;
+pub fn warp(image: &RgbaImage, warper: &Warper) -> Result<RgbaImage> {
+    let rest = warper.rest();
+    let deformed = warper.deformed()?;
     let mesh = render::WarpMesh {
         rest: &rest,
         deformed: &deformed,
-        triangles: deformer.domain().triangles(),
+        triangles: &warper.triangles,
     };
     let (w, h) = image.dimensions();
     Ok(render::warp_cpu(
@@ -458,6 +502,7 @@ mod tests {
             translate: [0.0, 0.0],
             rotate: 0.0,
             scale: 1.0,
+            depth: 0,
         };
         project.handles.push(point(DVec2::new(446.0, 238.0)));
         project.virtual_handles = placed

@@ -246,7 +246,9 @@ fn identity_keeps_every_visible_pixel(name: &str, img: &RgbaImage) {
             let project = Project::from_json(rig).unwrap();
             let prepared = pipeline::prepare(img, &project, Some(density))
                 .unwrap_or_else(|e| panic!("{name} at density {density}: {e:#}"));
-            let out = pipeline::warp(img, &prepared.rig).unwrap();
+            let vertices = prepared.rig.domain().len();
+            let out = pipeline::warp(img, &pipeline::Warper::new(prepared.rig, &project).unwrap())
+                .unwrap();
             let mut lost = 0;
             let mut first = None;
             for (x, y, p) in img.enumerate_pixels() {
@@ -264,7 +266,7 @@ fn identity_keeps_every_visible_pixel(name: &str, img: &RgbaImage) {
                 "{name}, density {density}, {} handle(s), {} mesh vertices: {lost} of \
                  {visible} visible pixels changed, first {:?}",
                 project.handles.len(),
-                prepared.rig.domain().len(),
+                vertices,
                 first.unwrap()
             );
         }

@@ -139,6 +139,10 @@ pub enum HandleSpec {
         /// Uniform scale about the rest position.
         #[serde(default = "one")]
         scale: f64,
+        /// Overlap order: where warped parts overlap, the part nearest a handle of
+        /// greater depth is drawn in front.
+        #[serde(default, skip_serializing_if = "is_zero")]
+        depth: i32,
     },
     /// A bar (segment) handle.
     Bar {
@@ -147,7 +151,32 @@ pub enum HandleSpec {
         /// Posed end points (default: at rest).
         #[serde(default)]
         pose: Option<[[f64; 2]; 2]>,
+        /// Overlap order, as for a point handle.
+        #[serde(default, skip_serializing_if = "is_zero")]
+        depth: i32,
     },
+}
+
+impl HandleSpec {
+    /// The handle's overlap depth.
+    pub fn depth(&self) -> i32 {
+        match *self {
+            HandleSpec::Point { depth, .. } | HandleSpec::Bar { depth, .. } => depth,
+        }
+    }
+
+    /// The same handle with depth `depth`.
+    pub fn with_depth(&self, depth: i32) -> Self {
+        let mut h = self.clone();
+        match &mut h {
+            HandleSpec::Point { depth: d, .. } | HandleSpec::Bar { depth: d, .. } => *d = depth,
+        }
+        h
+    }
+}
+
+fn is_zero(x: &i32) -> bool {
+    *x == 0
 }
 
 fn one() -> f64 {
@@ -370,6 +399,7 @@ impl Project {
                     translate,
                     rotate,
                     scale,
+                    ..
                 } => {
                     if *scale <= 0.0 {
                         return bad(format!("handle {i}: scale must be positive, got {scale}"));
@@ -379,7 +409,7 @@ impl Project {
                         vec![translate[0], translate[1], *rotate, *scale],
                     )
                 }
-                HandleSpec::Bar { rest, pose } => {
+                HandleSpec::Bar { rest, pose, .. } => {
                     if rest[0] == rest[1] {
                         return bad(format!("handle {i}: bar has zero length"));
                     }
@@ -473,10 +503,12 @@ mod tests {
                     translate: [0.1, -3.0 / 7.0],
                     rotate: std::f64::consts::PI / 3.0,
                     scale: 1.1,
+                    depth: 0,
                 },
                 HandleSpec::Bar {
                     rest: [[1.0, 2.0], [30.0, 40.0]],
                     pose: Some([[1.0 / 3.0, 2.0], [31.0, 41.0]]),
+                    depth: 0,
                 },
             ],
             virtual_handles: vec![[5.0, 6.0], [0.1, 0.2]],
@@ -535,7 +567,8 @@ mod tests {
                 rest: [1.0, 2.0],
                 translate: [0.0, 0.0],
                 rotate: 0.0,
-                scale: 1.0
+                scale: 1.0,
+                depth: 0
             }
         );
     }
@@ -674,6 +707,7 @@ mod tests {
             translate: [0.0, 0.0],
             rotate: 0.0,
             scale: 1.0,
+            depth: 0,
         };
         let mut p = Project {
             handles: vec![point; MAX_HANDLES],
