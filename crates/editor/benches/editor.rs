@@ -5,7 +5,10 @@
 //!   frame of the real app (input, layout, the edit, the pose upload data, overlays,
 //!   tessellation) (`drag_frame`);
 //! - exporting a 4096 × 4096 picture: mesh, weights, full-resolution CPU drawing, PNG
-//!   encoding, atomic write (`export`).
+//!   encoding, atomic write (`export`);
+//! - switching the built-in picture's posed rig from C² weights to ARAP (registration,
+//!   compilation, the pose, the positions for the GPU) and one ARAP drag frame's
+//!   update (`method_switch`).
 
 use std::hint::black_box;
 use std::time::{Duration, Instant};
@@ -145,9 +148,38 @@ fn export(c: &mut Criterion) {
     );
 }
 
+fn method_switch(c: &mut Criterion) {
+    let mut doc = Document::built_in().expect("the built-in picture");
+    c.bench_function("editor/switch_to_arap/lizard_20k", |b| {
+        b.iter(|| {
+            doc.apply(Edit::Method(project::Method::Arap))
+                .expect("ARAP");
+            black_box(doc.deformer().deformed());
+            doc.apply(Edit::Method(project::Method::C2)).expect("C²");
+        })
+    });
+    doc.apply(Edit::Method(project::Method::Arap))
+        .expect("ARAP");
+    let mut dx = 0.0;
+    c.bench_function("editor/arap_drag_update/lizard_20k", |b| {
+        b.iter(|| {
+            dx = if dx > 20.0 { 0.0 } else { dx + 1.0 };
+            let handle = HandleSpec::Point {
+                rest: [440.0, 238.0],
+                translate: [-20.0 + dx, -60.0],
+                rotate: 0.0,
+                scale: 1.0,
+                depth: 0,
+            };
+            doc.apply(Edit::Pose(2, handle)).expect("pose");
+            black_box(doc.deformer().deformed().len())
+        })
+    });
+}
+
 criterion_group! {
     name = benches;
     config = quick();
-    targets = insert_handle, drag_frame, export
+    targets = insert_handle, drag_frame, export, method_switch
 }
 criterion_main!(benches);

@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use anyhow::{Context as _, Result};
 use glam::DVec2;
-use project::HandleSpec;
+use project::{HandleSpec, Method};
 
 use crate::dialogs::{Answer, BuiltinDialog, Dialogs, FileAction, NativeDialogs, Shown};
 use crate::document::{Document, Edit, posed};
@@ -428,6 +428,28 @@ impl EditorApp {
                 });
                 return true;
             }
+        }
+        // Setting up ARAP (registration and factorisation) or repainting it takes a
+        // noticeable time on a large mesh: on the worker too.
+        if let (Edit::Method(Method::Arap) | Edit::Rigidity(_), Some(doc)) = (&edit, &self.doc)
+            && doc.rig().domain().len() > self.large_mesh
+            && (doc.method() == Method::Arap || matches!(edit, Edit::Method(_)))
+        {
+            let before = doc.snapshot();
+            let mut copy = doc.clone();
+            let label = match edit {
+                Edit::Method(_) => "Setting up ARAP",
+                _ => "Repainting rigidity",
+            }
+            .to_owned();
+            self.start_job(label, CancelFlag::default(), move || {
+                let document = copy.apply(edit).map(|()| copy);
+                Outcome::Rebuilt {
+                    cause: Rebuild::Edit { before },
+                    document,
+                }
+            });
+            return true;
         }
         let Some(doc) = &mut self.doc else {
             return false;

@@ -40,12 +40,13 @@ pub(crate) struct BrushStroke {
     posed: Vec<DVec2>,
 }
 
-/// The painted triangles, by the (mesh, strokes) they were found for.
+/// The painted triangles, by the (GPU mesh version, strokes) they were found for: the
+/// GPU mesh's version is new for every mesh of every document.
 #[derive(Clone, Default)]
 pub(crate) struct PaintedCache {
     key: Option<(u64, Vec<RigidityStroke>)>,
-    /// Each painted triangle with its weight.
-    triangles: Arc<Vec<(u32, f64)>>,
+    /// Each painted triangle's corners with its weight.
+    triangles: Arc<Vec<([u32; 3], f64)>>,
 }
 
 /// `strokes` with every point within `radius` plus the stroke's own radius of the
@@ -181,6 +182,11 @@ impl EditorApp {
         }
     }
 
+    /// The triangles the painted-rigidity overlay drew last (their corners).
+    pub fn painted_triangles(&self) -> Vec<[u32; 3]> {
+        self.painted.triangles.iter().map(|&(t, _)| t).collect()
+    }
+
     /// Draws the painted triangles, translucent, where the pose puts them (and the
     /// stroke being painted).
     pub(crate) fn paint_rigidity(&mut self, painter: &egui::Painter) {
@@ -189,14 +195,15 @@ impl EditorApp {
         if strokes.is_empty() && self.brush_stroke.is_none() {
             return;
         }
-        let key = (doc.mesh_version(), strokes.clone());
+        let key = (self.gpu.mesh.version, strokes.clone());
         if self.painted.key.as_ref() != Some(&key) {
-            let weights = pipeline::method::rigidity_weights(doc.rig().domain(), strokes);
+            let domain = doc.rig().domain();
+            let weights = pipeline::method::rigidity_weights(domain, strokes);
             let painted = weights
                 .iter()
-                .enumerate()
-                .filter(|(_, w)| **w != 1.0)
-                .map(|(t, &w)| (t as u32, w))
+                .zip(domain.triangles())
+                .filter(|(w, _)| **w != 1.0)
+                .map(|(&w, &t)| (t, w))
                 .collect();
             self.painted = PaintedCache {
                 key: Some(key),
@@ -204,10 +211,16 @@ impl EditorApp {
             };
         }
         let painted = self.painted.triangles.clone();
-        let triangles = doc.rig().domain().triangles().to_vec();
         let deformed = doc.deformed();
         let mut mesh = Mesh::default();
         for &(t, w) in painted.iter() {
+            let Some(corners) = t
+                .iter()
+                .map(|&v| deformed.get(v as usize))
+                .collect::<Option<Vec<_>>>()
+            else {
+                continue;
+            };
             // Stiffer is more opaque: 10 → faint, 10⁴ → strong; below 1 blue.
             let strength = (w.log10().abs() / 4.0).clamp(0.15, 1.0);
             let alpha = (40.0 + 70.0 * strength) as u8;
@@ -217,9 +230,8 @@ impl EditorApp {
                 Color32::from_rgba_unmultiplied(40, 140, 255, alpha)
             };
             let base = mesh.vertices.len() as u32;
-            for &v in &triangles[t as usize] {
-                let p = self.viewport.to_screen(deformed[v as usize]);
-                mesh.colored_vertex(p, color);
+            for &&p in &corners {
+                mesh.colored_vertex(self.viewport.to_screen(p), color);
             }
             mesh.add_triangle(base, base + 1, base + 2);
         }

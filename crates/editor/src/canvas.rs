@@ -34,7 +34,8 @@ impl EditorApp {
         self.viewport.canvas = rect;
         // A fitted view stays fitted when the window changes size (the first frames of
         // a new window, a maximise), until the user pans or zooms.
-        if (self.needs_fit || (resized && self.view_fitted))
+        // Not in the middle of a drag: the picture would move under the pointer.
+        if (self.needs_fit || (resized && self.view_fitted && self.drag.is_none()))
             && let Some(doc) = &self.doc
         {
             self.viewport.fit([doc.image.width(), doc.image.height()]);

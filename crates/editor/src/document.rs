@@ -295,11 +295,16 @@ impl Document {
     }
 
     /// Whether going to `project` (same picture and density) rebuilds the rig rather
-    /// than updating it: new weighting parameters, or — for a step through the
-    /// history, `exact` — another set of handles.
+    /// than updating it: new weighting parameters, ARAP set up or repainted, or — for
+    /// a step through the history, `exact` — another set of handles.
     pub fn rebuilds_for(&self, project: &Project, exact: bool) -> bool {
         let new = Settings::of(project);
         if new != self.settings() {
+            return true;
+        }
+        if project.method == Method::Arap
+            && (self.project.method != Method::Arap || project.rigidity != self.project.rigidity)
+        {
             return true;
         }
         exact

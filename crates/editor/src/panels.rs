@@ -394,7 +394,9 @@ impl EditorApp {
         {
             ui.heading(format!("Handle {}", i + 1));
             let depth = h.depth();
-            ui.horizontal(|ui| {
+            // Wrapped, so selecting a handle never widens the panel (which would
+            // shrink the canvas and refit the view under the pointer mid-drag).
+            ui.horizontal_wrapped(|ui| {
                 ui.label(format!("depth {depth}"))
                     .on_hover_text("Where the warped picture overlaps itself, handles of greater depth are in front");
                 if ui.button("Bring forward").clicked() {

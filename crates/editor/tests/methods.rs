@@ -122,24 +122,31 @@ fn a_drag_under_arap_moves_the_handle_and_keeps_the_compiled_system() {
         .document()
         .and_then(|d| d.arap_times())
         .expect("ARAP");
-    // Drag the first handle (a point) by 20 pixels.
-    let first = h.state().document().expect("doc").node_position(0);
-    let (from, to) = (
-        at(&h, first.x, first.y),
-        at(&h, first.x + 20.0, first.y + 10.0),
-    );
+    // Handle 2 is a point at (440, 238) moved by (-20, -60); drag it 20 px right and
+    // 10 px down.
+    let translate = |h: &Harness<'_, EditorApp>| support::translate(&support::handles(h)[2]);
+    let before = translate(&h);
+    let now = DVec2::new(440.0, 238.0) + before;
+    let (from, to) = (at(&h, now.x, now.y), at(&h, now.x + 20.0, now.y + 10.0));
     drag(&mut h, from, to, Modifiers::NONE);
-    let doc = h.state().document().expect("doc");
-    let moved = doc.node_position(0);
+    let moved = translate(&h) - before;
     assert!(
-        (moved - first - DVec2::new(20.0, 10.0)).length() < 2.0,
-        "{first} -> {moved}"
+        (moved - DVec2::new(20.0, 10.0)).length() < 2.0,
+        "moved by {moved}"
     );
+    let doc = h.state().document().expect("doc");
     let after = doc.arap_times().expect("ARAP");
     assert_eq!(
         after.compile_ms, compile.compile_ms,
         "a translation drag recompiles nothing"
     );
+    // The handle's vertex sits exactly where the handle's translation puts it.
+    let domain = doc.rig().domain();
+    let v = domain
+        .nearest_vertex(DVec2::new(440.0, 238.0))
+        .expect("a vertex") as usize;
+    let expected = domain.positions()[v] + translate(&h);
+    assert!((doc.deformer().deformed()[v] - expected).length() < 1e-9);
     h.state().sanity_check().expect("consistent");
 }
 
@@ -284,5 +291,95 @@ fn bringing_a_handle_forward_puts_its_part_in_front() {
         -1
     );
     assert_eq!(changed(&behind, &shot(&mut h)), 0.0);
+    h.state().sanity_check().expect("consistent");
+}
+
+#[test]
+fn an_arap_export_is_what_the_pipeline_draws_for_the_saved_project() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    click_label(&mut h, "ARAP");
+    h.get_by_label("File").click();
+    h.run();
+    click_label(&mut h, "Export PNG…");
+    support::settle(&mut h);
+    let exported = image::open(dir.path().join("warped.png"))
+        .expect("an exported PNG")
+        .to_rgba8();
+    let doc = h.state().document().expect("doc");
+    let project = doc.project_for_saving(None);
+    assert_eq!(project.method, Method::Arap);
+    let warper = pipeline::prepare_warper(&doc.image, &project, None, &|_| {}).expect("ARAP");
+    let expected = pipeline::warp(&doc.image, &warper).expect("warp");
+    assert!(exported == expected, "the export is ARAP's picture");
+    let c2 = {
+        let mut project = project.clone();
+        project.method = Method::C2;
+        let warper = pipeline::prepare_warper(&doc.image, &project, None, &|_| {}).expect("C²");
+        pipeline::warp(&doc.image, &warper).expect("warp")
+    };
+    assert!(changed(&c2, &exported) > 0.001, "and not C²'s");
+}
+
+#[test]
+fn on_a_large_mesh_arap_is_set_up_on_the_worker_and_undone_there() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    // Count the built-in picture's mesh as large.
+    h.state_mut().large_mesh = 1000;
+    h.get_by_label("ARAP").click();
+    h.step();
+    assert!(h.state().is_busy(), "set up on the worker");
+    assert_eq!(
+        h.state().busy_with().map(|(l, _)| l),
+        Some("Setting up ARAP")
+    );
+    support::settle(&mut h);
+    assert_eq!(method(&h), Method::Arap);
+    h.state().sanity_check().expect("consistent");
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert_eq!(method(&h), Method::C2, "switching back is instant");
+    h.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
+    h.step();
+    assert!(h.state().is_busy(), "redo sets ARAP up on the worker");
+    support::settle(&mut h);
+    assert_eq!(method(&h), Method::Arap);
+    h.state().sanity_check().expect("consistent");
+}
+
+/// Found by the monkey: the painted overlay kept the triangles of the mesh it was
+/// painted on after a new density re-meshed the picture.
+#[test]
+fn painted_rigidity_survives_a_new_density() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    h.key_press(Key::R);
+    h.run();
+    // A wide stroke over most of the picture, so the painted triangles' indices run
+    // past the smaller mesh's.
+    h.state_mut().brush.radius = 200.0;
+    let (a, b) = (at(&h, 100.0, 100.0), at(&h, 600.0, 500.0));
+    drag(&mut h, a, b, Modifiers::NONE);
+    let mut settings = h.state().document().expect("doc").settings();
+    settings.density = 3000;
+    assert!(h.state_mut().edit(editor::Edit::Settings(settings)));
+    support::settle(&mut h);
+    for _ in 0..3 {
+        h.run();
+    }
+    let doc = h.state().document().expect("doc");
+    assert!(doc.rig().domain().len() < 4000);
+    assert_eq!(doc.project().rigidity.len(), 1);
+    // The overlay shows the triangles painted on the new mesh.
+    let domain = doc.rig().domain();
+    let fresh: Vec<[u32; 3]> = pipeline::method::rigidity_weights(domain, &doc.project().rigidity)
+        .iter()
+        .zip(domain.triangles())
+        .filter(|(w, _)| **w != 1.0)
+        .map(|(_, &t)| t)
+        .collect();
+    assert!(!fresh.is_empty());
+    assert_eq!(h.state().painted_triangles(), fresh);
     h.state().sanity_check().expect("consistent");
 }
