@@ -121,6 +121,8 @@ const LABELS: &[&str] = &[
     "C² weights",
     "ARAP",
     "Clear rigidity",
+    "Bring forward",
+    "Send backward",
     "Painted rigidity",
     "Delete handle",
     "Clear all handles",
