@@ -121,9 +121,11 @@ pub struct ArapTimes {
 ///   similarity about its rest position takes it, so the surroundings turn and scale
 ///   with the handle as an artist expects (with rotate = 0 and scale = 1 it pins the
 ///   one vertex, exactly the paper);
-/// - a bar pins the vertices along it (the nearest vertex to every point of the bar,
-///   at a spacing of a quarter of the mean edge), each to where the similarity taking
-///   the rest ends to the posed ends takes it;
+/// - a bar pins its samples — the points the C² weights sample it at
+///   ([`weights_core::bar_samples`] at [`weights_core::bar_spacing`]: its ends and up to
+///   15 points between, which the meshes of [`crate::prepare`] and `c2warp --mesh` have
+///   as vertices; elsewhere the nearest vertex), each to where the similarity taking the
+///   rest ends to the posed ends takes it;
 /// - a vertex claimed by two handles belongs to the first.
 ///
 /// Changing which vertices are pinned recompiles (factorises); a pose of the same pins
@@ -332,7 +334,6 @@ fn pins(
             pins.push((v, h));
         }
     };
-    let step = 0.25 * domain.mean_edge_length();
     for (h, handle) in handles.iter().enumerate() {
         match *handle {
             Handle::Point { rest, transform } => {
@@ -355,14 +356,8 @@ fn pins(
                     rest.iter().chain(&pose).all(|p| p.is_finite()),
                     "bar {h} has a non-finite position or pose"
                 );
-                let length = rest[0].distance(rest[1]);
-                let pieces = if step > 0.0 {
-                    ((length / step).ceil() as usize).clamp(1, 1 << 16)
-                } else {
-                    1
-                };
-                for i in 0..=pieces {
-                    let p = rest[0].lerp(rest[1], i as f64 / pieces as f64);
+                let spacing = weights_core::bar_spacing(handles, h);
+                for (_, p) in weights_core::bar_samples(rest, spacing) {
                     let v = domain
                         .nearest_vertex(p)
                         .with_context(|| format!("bar {h} is off the mesh"))?;
