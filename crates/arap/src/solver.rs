@@ -126,15 +126,27 @@ impl Entry for Complex {
 }
 
 /// One supernode of the factor: columns `start..start + size` share the row pattern
-/// `pattern[rows..rows + rows_len]` below their diagonal block; their values are a
-/// column-major `(size + rows_len) × size` block at `values`.
+/// `pattern[rows..rows + rows_len]` below their diagonal block. faer stores their
+/// values as a column-major `(size + rows_len) × size` block at `faer_values`, the
+/// diagonal block's upper triangle included; [`Cholesky`] keeps them packed at
+/// `values`, each column from its diagonal entry down (column `c` holds
+/// `size + rows_len − c` entries), so that the substitutions read nothing unused.
 #[derive(Clone, Copy, Debug)]
 struct Supernode {
     start: u32,
     size: u32,
     rows: u32,
     rows_len: u32,
+    faer_values: usize,
     values: usize,
+}
+
+impl Supernode {
+    /// Number of packed entries.
+    fn packed_len(&self) -> usize {
+        let (size, ld) = (self.size as usize, (self.size + self.rows_len) as usize);
+        size * ld - size * (size - 1) / 2
+    }
 }
 
 /// What both steps' factors share: they have one pattern and one ordering, so one
@@ -151,6 +163,8 @@ struct Layout {
     pattern: Vec<u32>,
     /// The most rows below any supernode's diagonal block.
     widest: usize,
+    /// Number of packed entries of a factor.
+    len: usize,
 }
 
 fn failed(e: &dyn std::fmt::Debug) -> ArapError {
@@ -183,17 +197,21 @@ impl Structure {
         };
         let mut supernodes = Vec::with_capacity(sn.n_supernodes());
         let mut rows = Vec::new();
+        let mut len = 0;
         for s in 0..sn.n_supernodes() {
             let node = sn.supernode(s);
             let start = sn.supernode_begin()[s] as usize;
             let end = sn.supernode_end()[s] as usize;
-            supernodes.push(Supernode {
+            let supernode = Supernode {
                 start: start as u32,
                 size: (end - start) as u32,
                 rows: rows.len() as u32,
                 rows_len: node.pattern().len() as u32,
-                values: sn.col_ptr_for_val()[s] as usize,
-            });
+                faer_values: sn.col_ptr_for_val()[s] as usize,
+                values: len,
+            };
+            len += supernode.packed_len();
+            supernodes.push(supernode);
             rows.extend_from_slice(node.pattern());
         }
         let widest = supernodes
@@ -208,6 +226,7 @@ impl Structure {
                 supernodes,
                 pattern: rows,
                 widest,
+                len,
             }),
         })
     }
@@ -253,9 +272,25 @@ impl<T: Entry> Cholesky<T> {
                 Default::default(),
             )
             .map_err(|e| failed(&e))?;
+        let layout = &structure.layout;
+        let mut values = Vec::new();
+        values
+            .try_reserve_exact(layout.len)
+            .map_err(|e| failed(&e))?;
+        for s in &layout.supernodes {
+            let (size, ld) = (s.size as usize, (s.size + s.rows_len) as usize);
+            for c in 0..size {
+                let column = s.faer_values + c * ld;
+                values.extend(
+                    factor[column + c..column + ld]
+                        .iter()
+                        .map(|&v| T::from_faer(v)),
+                );
+            }
+        }
         Ok(Self {
-            layout: Arc::clone(&structure.layout),
-            values: factor.into_iter().map(T::from_faer).collect(),
+            layout: Arc::clone(layout),
+            values,
         })
     }
 
@@ -282,19 +317,22 @@ impl<T: Entry> Cholesky<T> {
         for s in &layout.supernodes {
             let (start, size, rows_len) = (s.start as usize, s.size as usize, s.rows_len as usize);
             let ld = size + rows_len;
-            let block = &values[s.values..s.values + ld * size];
+            let mut block = &values[s.values..s.values + s.packed_len()];
             let rows = &layout.pattern[s.rows as usize..s.rows as usize + rows_len];
             let tmp = &mut tmp[..rows_len];
             tmp.fill(DVec2::ZERO);
             let xs = &mut x[start..start + size];
             for c in 0..size {
-                let col = &block[c * ld..(c + 1) * ld];
-                let xc = T::div_diagonal(xs[c], col[c]);
+                // Column c from its diagonal entry: the diagonal block, then below.
+                let (col, next) = block.split_at(ld - c);
+                block = next;
+                let (inside, below) = col.split_at(size - c);
+                let xc = T::div_diagonal(xs[c], inside[0]);
                 xs[c] = xc;
-                for (xr, &l) in xs[c + 1..].iter_mut().zip(&col[c + 1..size]) {
+                for (xr, &l) in xs[c + 1..].iter_mut().zip(&inside[1..]) {
                     *xr -= l.mul(xc);
                 }
-                for (t, &l) in tmp.iter_mut().zip(&col[size..]) {
+                for (t, &l) in tmp.iter_mut().zip(below) {
                     *t += l.mul(xc);
                 }
             }
@@ -306,7 +344,7 @@ impl<T: Entry> Cholesky<T> {
         for s in layout.supernodes.iter().rev() {
             let (start, size, rows_len) = (s.start as usize, s.size as usize, s.rows_len as usize);
             let ld = size + rows_len;
-            let block = &values[s.values..s.values + ld * size];
+            let mut block = &values[s.values..s.values + s.packed_len()];
             let rows = &layout.pattern[s.rows as usize..s.rows as usize + rows_len];
             let tmp = &mut tmp[..rows_len];
             for (t, &i) in tmp.iter_mut().zip(rows) {
@@ -314,15 +352,18 @@ impl<T: Entry> Cholesky<T> {
             }
             let xs = &mut x[start..start + size];
             for c in (0..size).rev() {
-                let col = &block[c * ld..(c + 1) * ld];
+                // Column c is the last ld − c entries of what is left.
+                let (rest, col) = block.split_at(block.len() - (ld - c));
+                block = rest;
+                let (inside, below) = col.split_at(size - c);
                 let mut acc = xs[c];
-                for (&l, &t) in col[size..].iter().zip(tmp.iter()) {
+                for (&l, &t) in below.iter().zip(tmp.iter()) {
                     acc -= l.conj_mul(t);
                 }
-                for (&l, &xr) in col[c + 1..size].iter().zip(&xs[c + 1..]) {
+                for (&l, &xr) in inside[1..].iter().zip(&xs[c + 1..]) {
                     acc -= l.conj_mul(xr);
                 }
-                xs[c] = T::div_diagonal(acc, col[c]);
+                xs[c] = T::div_diagonal(acc, inside[0]);
             }
         }
     }
