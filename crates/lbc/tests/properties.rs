@@ -207,9 +207,6 @@ fn converged_objective_is_stable() {
         (a - b).abs() <= 0.005 * b,
         "objective {a} vs {b} with a 10× tighter threshold"
     );
-    // The solution is optimal, not just feasible: the smooth starting point (and
-    // the least-norm one) are worse.
-    assert!(b <= a * (1.0 + 1e-9) || (a - b).abs() <= 0.005 * b);
 }
 
 #[test]
