@@ -34,7 +34,7 @@ pub struct Domain {
 impl Domain {
     /// Triangulates the cage's interior with spade: a constrained Delaunay
     /// triangulation with the cage edges as constraints, refined (smallest angle
-    /// about 25°) until no triangle is larger than `area / target_vertices`, which
+    /// about 25°) until no triangle is larger than `0.85·area / target_vertices`, which
     /// gives roughly `target_vertices` vertices (refinement splits cage edges too, so
     /// they become chains of boundary edges). Triangles outside the polygon are
     /// dropped.
@@ -64,7 +64,9 @@ impl Domain {
             cdt.add_constraint(a, b);
         }
         let target = target_vertices.max(cage.len());
-        let max_area = cage.area() / target as f64;
+        // Refined triangles average below the cap; 0.85 was measured to land near
+        // the target on stars and rectangles (±10%).
+        let max_area = 0.85 * cage.area() / target as f64;
         let params = RefinementParameters::<f64>::new()
             .exclude_outer_faces(true)
             .with_angle_limit(AngleLimit::from_deg(25.0))
