@@ -1,0 +1,374 @@
+//! The coordinates' defining properties on convex and strongly concave cages, the
+//! solver's convergence, and refusal of bad cages.
+
+use glam::DVec2;
+use lbc::{
+    Cage, Coordinates, DEFAULT_TOLERANCE, Domain, LbcError, Settings, geodesic_distances, solve,
+    solve_with_distances,
+};
+use proptest::prelude::*;
+
+fn square() -> Cage {
+    cage(&[(0.0, 0.0), (3.0, 0.0), (3.0, 2.0), (0.0, 2.0)])
+}
+
+fn cage(points: &[(f64, f64)]) -> Cage {
+    Cage::new(points.iter().map(|&(x, y)| DVec2::new(x, y)).collect()).expect("valid cage")
+}
+
+/// A star with alternating radii (strongly concave), clockwise when `reverse`.
+fn star(n: usize, reverse: bool) -> Cage {
+    let mut v: Vec<DVec2> = (0..n)
+        .map(|i| {
+            let a = i as f64 / n as f64 * std::f64::consts::TAU;
+            let r = if i % 2 == 0 { 100.0 } else { 45.0 };
+            DVec2::new(500.0 + r * a.cos(), -20.0 + r * a.sin())
+        })
+        .collect();
+    if reverse {
+        v.reverse();
+    }
+    Cage::new(v).expect("valid star")
+}
+
+/// A U shape: two long arms joined at the bottom.
+fn u_shape() -> Cage {
+    cage(&[
+        (0.0, 0.0),
+        (10.0, 0.0),
+        (10.0, 10.0),
+        (7.0, 10.0),
+        (7.0, 3.0),
+        (3.0, 3.0),
+        (3.0, 10.0),
+        (0.0, 10.0),
+    ])
+}
+
+fn solved(cage: &Cage, target: usize) -> (Domain, Coordinates) {
+    let domain = Domain::triangulate(cage, target).expect("triangulates");
+    let c = solve(&domain, &Settings::default(), &mut |_| true).expect("solves");
+    (domain, c)
+}
+
+fn check_properties(cage: &Cage, domain: &Domain, c: &Coordinates) {
+    let n = cage.len();
+    let (lo, hi) = cage.bounds();
+    let size = (hi - lo).length();
+    assert!(c.report.converged, "{:?}", c.report);
+    for v in 0..domain.positions().len() {
+        let row = c.row(v);
+        let sum: f64 = row.iter().sum();
+        assert!((sum - 1.0).abs() < 1e-9, "partition of unity at {v}: {sum}");
+        assert!(row.iter().all(|&w| w >= 0.0), "negative weight at {v}");
+        let reproduced: DVec2 = row.iter().zip(cage.vertices()).map(|(w, p)| *w * *p).sum();
+        assert!(
+            reproduced.distance(domain.positions()[v]) < 1e-9 * size,
+            "reproduction at {v}"
+        );
+    }
+    // Lagrange property.
+    for (i, &v) in domain.cage_vertices().iter().enumerate() {
+        for (j, &w) in c.row(v as usize).iter().enumerate() {
+            let want = if i == j { 1.0 } else { 0.0 };
+            assert!((w - want).abs() < 1e-9, "w_{j}(c_{i}) = {w}");
+        }
+    }
+    // Linearity on cage edges.
+    let mut on_edges = 0;
+    for (v, on) in domain.on_cage().iter().enumerate() {
+        let Some(at) = on else { continue };
+        on_edges += 1;
+        let e = at.edge as usize;
+        for (j, &w) in c.row(v).iter().enumerate() {
+            let want = if j == e {
+                1.0 - at.t
+            } else if j == (e + 1) % n {
+                at.t
+            } else {
+                0.0
+            };
+            assert!((w - want).abs() < 1e-9, "edge value at {v}");
+        }
+    }
+    assert!(on_edges > n, "cage edges are split into chains");
+    // Linear precision: an affine map of the cage is reproduced inside.
+    let map = |p: DVec2| DVec2::new(1.3 * p.x - 0.4 * p.y + 7.0, 0.2 * p.x + 0.9 * p.y - 3.0);
+    let pose: Vec<DVec2> = cage.vertices().iter().map(|&p| map(p)).collect();
+    let moved = c.deform(&pose).expect("pose fits");
+    for (p, q) in domain.positions().iter().zip(&moved) {
+        assert!(map(*p).distance(*q) < 1e-6 * size, "linear precision");
+    }
+}
+
+#[test]
+fn properties_on_a_convex_cage() {
+    let cage = square();
+    let (domain, c) = solved(&cage, 300);
+    check_properties(&cage, &domain, &c);
+}
+
+#[test]
+fn properties_on_concave_cages_either_orientation() {
+    for reverse in [false, true] {
+        let cage = star(10, reverse);
+        let (domain, c) = solved(&cage, 400);
+        check_properties(&cage, &domain, &c);
+    }
+    let cage = u_shape();
+    let (domain, c) = solved(&cage, 400);
+    check_properties(&cage, &domain, &c);
+}
+
+#[test]
+fn a_triangle_gives_barycentric_coordinates() {
+    let cage = cage(&[(0.0, 0.0), (4.0, 0.0), (1.0, 3.0)]);
+    let (domain, c) = solved(&cage, 60);
+    check_properties(&cage, &domain, &c);
+}
+
+/// On the U, the vertex at the top of the left arm has no weight over the right arm
+/// (mean value coordinates are positive there: they reach across the gap).
+#[test]
+fn locality_on_a_concave_cage() {
+    let cage = u_shape();
+    let (domain, c) = solved(&cage, 600);
+    let i = 7; // (0, 10), top of the left arm.
+    let mut zero_area = 0.0;
+    let mut total = 0.0;
+    let mut right_arm_nonzero = 0;
+    for t in domain.triangles() {
+        let p = t.map(|v| domain.positions()[v as usize]);
+        let area = 0.5 * (p[1] - p[0]).perp_dot(p[2] - p[0]);
+        total += area;
+        if t.iter().all(|&v| c.row(v as usize)[i] == 0.0) {
+            zero_area += area;
+        }
+    }
+    for (v, p) in domain.positions().iter().enumerate() {
+        if p.x > 7.0 && p.y > 3.0 && domain.on_cage()[v].is_none() {
+            let w = c.row(v)[i];
+            assert!(mean_value(&cage, *p)[i] > 1e-6, "MVC is global at {p}");
+            if w != 0.0 {
+                right_arm_nonzero += 1;
+            }
+        }
+    }
+    assert_eq!(right_arm_nonzero, 0, "the far arm ignores the vertex");
+    assert!(
+        zero_area > 0.5 * total,
+        "exactly zero on {:.0}% of the area",
+        100.0 * zero_area / total
+    );
+}
+
+/// Mean value coordinates (Hormann and Floater 2006) at an interior point.
+fn mean_value(cage: &Cage, x: DVec2) -> Vec<f64> {
+    let c = cage.vertices();
+    let n = c.len();
+    let s: Vec<DVec2> = c.iter().map(|p| *p - x).collect();
+    let r: Vec<f64> = s.iter().map(|v| v.length()).collect();
+    let tan_half = |i: usize| {
+        let j = (i + 1) % n;
+        let a = s[i].perp_dot(s[j]);
+        let d = s[i].dot(s[j]);
+        a / (r[i] * r[j] + d)
+    };
+    let mut w: Vec<f64> = (0..n)
+        .map(|i| (tan_half((i + n - 1) % n) + tan_half(i)) / r[i])
+        .collect();
+    let sum: f64 = w.iter().sum();
+    w.iter_mut().for_each(|x| *x /= sum);
+    w
+}
+
+#[test]
+fn converged_objective_is_stable() {
+    let cage = star(12, false);
+    let domain = Domain::triangulate(&cage, 700).expect("triangulates");
+    let d = geodesic_distances(&domain).expect("geodesics");
+    let run = |tolerance: f64| {
+        let settings = Settings {
+            tolerance,
+            ..Settings::default()
+        };
+        solve_with_distances(&domain, &d, &settings, &mut |_| true).expect("solves")
+    };
+    let normal = run(DEFAULT_TOLERANCE);
+    let tight = run(DEFAULT_TOLERANCE / 10.0);
+    for c in [&normal, &tight] {
+        let last = c.report.last.expect("iterated");
+        assert!(c.report.converged);
+        assert!(last.primal_residual <= last.primal_threshold);
+        assert!(last.dual_residual <= last.dual_threshold);
+    }
+    let (a, b) = (normal.report.objective, tight.report.objective);
+    assert!(
+        (a - b).abs() <= 0.005 * b,
+        "objective {a} vs {b} with a 10× tighter threshold"
+    );
+}
+
+#[test]
+fn progress_can_cancel() {
+    let domain = Domain::triangulate(&star(8, false), 200).expect("triangulates");
+    let mut seen = 0;
+    let result = solve(&domain, &Settings::default(), &mut |p| {
+        seen = p.iteration;
+        p.iteration < 5
+    });
+    assert_eq!(result.err(), Some(LbcError::Cancelled));
+    assert_eq!(seen, 5);
+}
+
+#[test]
+fn compact_rows_drop_small_weights_and_renormalise() {
+    let cage = star(10, false);
+    let (domain, c) = solved(&cage, 400);
+    let compact = c.compact();
+    let n = cage.len();
+    let (lo, hi) = cage.bounds();
+    let size = (hi - lo).length();
+    assert!(compact.len() < domain.positions().len() * n / 2);
+    for v in 0..compact.vertices() {
+        let row = compact.row(v);
+        let sum: f64 = row.iter().map(|e| e.1).sum();
+        assert!((sum - 1.0).abs() < 1e-12);
+        assert!(row.iter().all(|e| e.1 >= 1e-3 / n as f64));
+    }
+    let pose: Vec<DVec2> = cage.vertices().iter().map(|p| *p * 2.0).collect();
+    let moved = compact.deform(&pose).expect("pose fits");
+    for (p, q) in domain.positions().iter().zip(&moved) {
+        // Within the dropped weight (≤ 10⁻³ in all) times the pose's size.
+        assert!((*p * 2.0).distance(*q) < 2e-3 * 2.0 * size);
+    }
+    assert!(matches!(
+        compact.deform(&pose[1..]),
+        Err(LbcError::BadPose { .. })
+    ));
+}
+
+#[test]
+fn a_given_mesh_is_used_as_is() {
+    // A 3 × 2 grid of unit squares over [0, 3] × [0, 2], vertices shuffled.
+    let mut positions = Vec::new();
+    for y in 0..3 {
+        for x in 0..4 {
+            positions.push(DVec2::new(x as f64, y as f64));
+        }
+    }
+    let mut triangles = Vec::new();
+    for y in 0..2u32 {
+        for x in 0..3u32 {
+            let a = y * 4 + x;
+            triangles.push([a, a + 1, a + 5]);
+            triangles.push([a, a + 5, a + 4]);
+        }
+    }
+    let perm: Vec<u32> = (0..12u32).map(|v| (v * 5) % 12).collect();
+    let mut shuffled = vec![DVec2::ZERO; 12];
+    for (old, &new) in perm.iter().enumerate() {
+        shuffled[new as usize] = positions[old];
+    }
+    let triangles: Vec<[u32; 3]> = triangles
+        .iter()
+        .map(|t| t.map(|v| perm[v as usize]))
+        .collect();
+    let cage = square();
+    let domain = Domain::from_mesh(&cage, shuffled, triangles).expect("valid mesh");
+    assert_eq!(
+        domain.cage_vertices(),
+        &[perm[0], perm[3], perm[11], perm[8]]
+    );
+    let c = solve(&domain, &Settings::default(), &mut |_| true).expect("solves");
+    check_properties_small(&cage, &domain, &c);
+    let missing = Domain::from_mesh(
+        &cage,
+        vec![DVec2::ZERO, DVec2::X, DVec2::Y],
+        vec![[0, 1, 2]],
+    );
+    assert!(matches!(
+        missing,
+        Err(LbcError::CageVertexNotInMesh { vertex: 1 })
+    ));
+}
+
+fn check_properties_small(cage: &Cage, domain: &Domain, c: &Coordinates) {
+    for v in 0..domain.positions().len() {
+        let row = c.row(v);
+        assert!((row.iter().sum::<f64>() - 1.0).abs() < 1e-9);
+        assert!(row.iter().all(|&w| w >= 0.0));
+        let p: DVec2 = row.iter().zip(cage.vertices()).map(|(w, p)| *w * *p).sum();
+        assert!(p.distance(domain.positions()[v]) < 1e-9);
+    }
+}
+
+#[test]
+fn bad_cages_are_refused() {
+    let v = |pts: &[(f64, f64)]| pts.iter().map(|&(x, y)| DVec2::new(x, y)).collect();
+    assert_eq!(
+        Cage::new(v(&[(0.0, 0.0), (1.0, 0.0)])),
+        Err(LbcError::TooFewVertices { vertices: 2 })
+    );
+    assert_eq!(
+        Cage::new(v(&[(0.0, 0.0), (1.0, f64::NAN), (0.0, 1.0)])),
+        Err(LbcError::NonFinite { vertex: 1 })
+    );
+    assert_eq!(
+        Cage::new(v(&[(0.0, 0.0), (1.0, 0.0), (2.0, 0.0)])),
+        Err(LbcError::ZeroArea)
+    );
+    assert_eq!(
+        Cage::new(v(&[(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (1.0, 0.0)])),
+        Err(LbcError::RepeatedVertex {
+            first: 1,
+            second: 3
+        })
+    );
+    // A bow tie.
+    assert!(matches!(
+        Cage::new(v(&[(0.0, 0.0), (1.0, 1.0), (1.0, 0.0), (0.0, 1.0)])),
+        Err(LbcError::SelfIntersection { .. })
+    ));
+    // A vertex touching a non-adjacent edge.
+    assert!(matches!(
+        Cage::new(v(&[
+            (0.0, 0.0),
+            (4.0, 0.0),
+            (4.0, 4.0),
+            (2.0, 0.0),
+            (0.0, 4.0)
+        ])),
+        Err(LbcError::SelfIntersection { .. })
+    ));
+    // An edge folding back on its neighbour.
+    assert!(matches!(
+        Cage::new(v(&[(0.0, 0.0), (4.0, 0.0), (2.0, 0.0), (2.0, 3.0)])),
+        Err(LbcError::SelfIntersection { .. })
+    ));
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(8))]
+
+    /// Random star-shaped cages (simple by construction): the hard constraints hold.
+    #[test]
+    fn random_star_shaped_cages(
+        radii in proptest::collection::vec(0.3f64..1.0, 5..9),
+        rotation in 0.0f64..6.0,
+    ) {
+        let n = radii.len();
+        let cage = Cage::new(
+            radii
+                .iter()
+                .enumerate()
+                .map(|(i, r)| {
+                    let a = rotation + i as f64 / n as f64 * std::f64::consts::TAU;
+                    DVec2::new(10.0 * r * a.cos(), 10.0 * r * a.sin())
+                })
+                .collect(),
+        ).expect("star-shaped polygons are simple");
+        let (domain, c) = solved(&cage, 150);
+        check_properties(&cage, &domain, &c);
+    }
+}
