@@ -309,3 +309,196 @@ fn handle_depth_decides_what_is_in_front_on_the_cpu_and_the_gpu_alike() {
         assert!(wrong > share, "{method}: the GPU puts the leg in front too");
     }
 }
+
+/// Where a cage's vertices go.
+type CageMap = fn([f64; 2]) -> [f64; 2];
+
+/// A rig with `method: lbc` and the strip's corners as the cage (posed by `map`).
+fn cage_rig(dir: &Path, name: &str, map: impl Fn([f64; 2]) -> [f64; 2]) -> std::path::PathBuf {
+    let rest = [[0.0, 0.0], [120.0, 0.0], [120.0, 30.0], [0.0, 30.0]];
+    let pose = rest.map(&map);
+    let rig = dir.join(name);
+    fs::write(
+        &rig,
+        serde_json::json!({
+            "version": 1, "method": "lbc", "handles": [],
+            "cage": {"rest": rest, "pose": pose}
+        })
+        .to_string(),
+    )
+    .expect("write rig");
+    rig
+}
+
+#[test]
+fn lbc_weights_on_a_given_mesh_are_local_barycentric_coordinates() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let rig = cage_rig(dir.path(), "cage.json", |p| p);
+    let out = dir.path().join("weights.json");
+    let mesh = data("strip.obj");
+    ok(&[
+        os("weights"),
+        os("--mesh"),
+        mesh.as_os_str(),
+        os("--rig"),
+        rig.as_os_str(),
+        os("-o"),
+        out.as_os_str(),
+    ]);
+    let json: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(&out).expect("read")).expect("json");
+    assert_eq!(json["method"], "lbc");
+    assert_eq!(json["samples"], 52);
+    assert_eq!(json["converged"], true);
+    let nodes = json["nodes"].as_array().expect("nodes");
+    // The cage's corners, in the cage's order, found among the file's vertices.
+    let vertices: Vec<u64> = nodes
+        .iter()
+        .map(|n| n["vertex"].as_u64().expect("v"))
+        .collect();
+    assert_eq!(vertices, [0, 12, 51, 39]);
+    let weights = json["weights"].as_array().expect("weights");
+    let rest = strip_rest();
+    for (v, row) in weights.iter().enumerate() {
+        let row: Vec<(usize, f64)> = row
+            .as_array()
+            .expect("row")
+            .iter()
+            .map(|p| {
+                (
+                    p[0].as_u64().expect("i") as usize,
+                    p[1].as_f64().expect("w"),
+                )
+            })
+            .collect();
+        let sum: f64 = row.iter().map(|p| p.1).sum();
+        assert!((sum - 1.0).abs() < 1e-9, "vertex {v}: {sum}");
+        assert!(row.iter().all(|p| p.1 > 0.0), "vertex {v}: {row:?}");
+        // Linear along the cage's edges: on the bottom edge, only its two corners.
+        if rest[v][1] == 0.0 {
+            assert!(row.iter().all(|p| p.0 <= 1), "vertex {v}: {row:?}");
+            let t = rest[v][0] / 120.0;
+            let w1 = row.iter().find(|p| p.0 == 1).map_or(0.0, |p| p.1);
+            assert!((w1 - t).abs() < 1e-9, "vertex {v}: {w1} vs {t}");
+        }
+    }
+    for (i, &v) in vertices.iter().enumerate() {
+        let row = weights[v as usize].as_array().expect("row");
+        assert_eq!(row.len(), 1, "Lagrange at cage vertex {i}");
+        assert_eq!(row[0][0], i);
+    }
+}
+
+#[test]
+fn lbc_deform_follows_the_cage() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mesh = data("strip.obj");
+    let rest = strip_rest();
+    let cases: [(&str, CageMap, f64); 2] = [
+        // A translation is reproduced exactly: the rows sum to one.
+        ("shift.json", |p| [p[0] + 7.0, p[1] - 3.0], 1e-9),
+        // Another affine map to within the weights dropped by compaction.
+        (
+            "shear.json",
+            |p| [1.2 * p[0] + 0.3 * p[1], 0.9 * p[1] + 5.0],
+            0.5,
+        ),
+    ];
+    for (name, map, tolerance) in cases {
+        let rig = cage_rig(dir.path(), name, map);
+        let out = dir.path().join("deformed.obj");
+        deform(&[os("--mesh"), mesh.as_os_str()], &rig, None, &out);
+        let (moved, faces) = read_obj(&out);
+        assert_eq!(moved.len(), rest.len());
+        assert_eq!(faces.len(), 72);
+        for (p, r) in moved.iter().zip(&rest) {
+            let q = map(*r);
+            assert!(
+                (p[0] - q[0]).hypot(p[1] - q[1]) < tolerance,
+                "{name}: {r:?} went to {p:?}, not {q:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn bad_cages_give_one_clear_line() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("out.obj");
+    let mesh = data("strip.obj");
+    let cases = [
+        (
+            r#"{"version":1,"method":"lbc","handles":[]}"#,
+            "needs a \"cage\"",
+        ),
+        (
+            r#"{"version":1,"method":"lbc","handles":[],"cage":{"rest":[[0,0],[1,1]]}}"#,
+            "a cage needs 3 to 1000 vertices, got 2",
+        ),
+        (
+            r#"{"version":1,"method":"lbc","handles":[],"cage":{"rest":[[0,0],[120,30],[120,0],[0,30]]}}"#,
+            "intersect",
+        ),
+        (
+            r#"{"version":1,"method":"lbc","handles":[],"cage":{"rest":[[0,0],[120,0],[120,30]],"pose":[[0,0]]}}"#,
+            "pose has 1 points for 3 rest vertices",
+        ),
+        (
+            r#"{"version":1,"method":"lbc","handles":[],"cage":{"rest":[[0,0],[121,0],[121,30],[0,30]]}}"#,
+            "not a vertex of the mesh",
+        ),
+    ];
+    for (i, (text, expected)) in cases.into_iter().enumerate() {
+        let rig = dir.path().join(format!("bad{i}.json"));
+        fs::write(&rig, text).expect("write");
+        let line = fails(&[
+            os("deform"),
+            os("--mesh"),
+            mesh.as_os_str(),
+            os("--rig"),
+            rig.as_os_str(),
+            os("-o"),
+            out.as_os_str(),
+        ]);
+        assert!(line.contains(expected), "{text}: {line}");
+        assert!(!out.exists());
+    }
+    // The editor's methods and `render` say LBC is not drawn yet.
+    let rig = cage_rig(dir.path(), "cage.json", |p| p);
+    let line = fails(&render_args(
+        &data("dino.png"),
+        &rig,
+        &dir.path().join("o.png"),
+        &[],
+    ));
+    assert!(line.contains("cage"), "{line}");
+}
+
+#[test]
+fn bench_times_the_cage_solve() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let rig = cage_rig(dir.path(), "cage.json", |p| p);
+    let mesh = data("strip.obj");
+    let out = ok(&[
+        os("bench"),
+        os("--mesh"),
+        mesh.as_os_str(),
+        os("--rig"),
+        rig.as_os_str(),
+    ]);
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    assert_eq!(json["method"], "lbc");
+    assert_eq!(json["cage_vertices"], 4);
+    for key in [
+        "geodesics_ms",
+        "factorisation_ms",
+        "admm_ms",
+        "deform_ms_median",
+    ] {
+        assert!(
+            json[key].as_f64().is_some_and(|t| t >= 0.0),
+            "{key}: {json}"
+        );
+    }
+    assert!(json["admm_iterations"].as_u64().is_some_and(|n| n > 0));
+}

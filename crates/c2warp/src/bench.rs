@@ -83,10 +83,14 @@ pub fn run(
     method: Option<Method>,
 ) -> Result<()> {
     let project = load_project(rig_path)?;
+    let method = method.unwrap_or(project.method);
+    if method == Method::Lbc {
+        return crate::lbc::bench(source, &project);
+    }
     let built = export::build(source, &project, &|_| {})?;
-    match method.unwrap_or(project.method) {
-        Method::C2 => c2(built.rig, positions),
+    match method {
         Method::Arap => arap(built.rig, &project, positions),
+        _ => c2(built.rig, positions),
     }
 }
 

@@ -5,6 +5,7 @@ use std::io::Write as _;
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
+use glam::DVec2;
 use pipeline::{Method, load_project};
 
 use crate::export::{self, Built};
@@ -17,17 +18,34 @@ use crate::{Source, is_stdout};
 pub fn run(source: &Source, rig_path: &Path, method: Option<Method>, output: &Path) -> Result<()> {
     let project = load_project(rig_path)?;
     let method = method.unwrap_or(project.method);
+    if method == Method::Lbc {
+        let solved = crate::lbc::solve(source, &project)?;
+        let deformed = solved.deformed()?;
+        return write_obj(output, method, &deformed, solved.domain.triangles());
+    }
     let progress = crate::progress::Steps::new(3);
     progress.step("meshing and weighting");
     let Built { rig, .. } = export::build(source, &project, &progress.weighting())?;
     progress.step("deforming");
     let deformer = pipeline::deformer(method, rig, &project.rigidity)?;
     let deformed = deformer.deformed();
+    progress.step("writing");
+    write_obj(output, method, &deformed, deformer.domain().triangles())?;
+    progress.finish();
+    Ok(())
+}
+
+/// Writes the deformed mesh as OBJ to `output` (`-`: standard output), atomically
+/// for a regular file.
+fn write_obj(
+    output: &Path,
+    method: Method,
+    deformed: &[DVec2],
+    triangles: &[[u32; 3]],
+) -> Result<()> {
     if let Some(v) = deformed.iter().position(|p| !p.is_finite()) {
         bail!("the deformation sent vertex {v} to a non-finite position");
     }
-    progress.step("writing");
-    let triangles = deformer.domain().triangles();
     let mut text = String::with_capacity(deformed.len() * 40 + triangles.len() * 24);
     let _ = writeln!(
         text,
@@ -36,7 +54,7 @@ pub fn run(source: &Source, rig_path: &Path, method: Option<Method>, output: &Pa
         deformed.len(),
         triangles.len()
     );
-    for p in &deformed {
+    for p in deformed {
         // `{}` prints the shortest decimal that reads back as the same f64.
         let _ = writeln!(text, "v {} {} 0", p.x, p.y);
     }
@@ -52,6 +70,5 @@ pub fn run(source: &Source, rig_path: &Path, method: Option<Method>, output: &Pa
     } else {
         render::write_atomic(output, text.as_bytes())?;
     }
-    progress.finish();
     Ok(())
 }

@@ -141,6 +141,9 @@ struct WeightsOut {
 /// Runs `c2warp weights`.
 pub fn weights(source: &Source, rig_path: &Path, output: &Path) -> Result<()> {
     let project = load_project(rig_path)?;
+    if project.method == project::Method::Lbc {
+        return crate::lbc::weights(source, &project, output);
+    }
     let progress = crate::progress::Steps::new(2);
     progress.step("meshing and weighting");
     let Built { rig, file_vertices } = build(source, &project, &progress.weighting())?;

@@ -3,6 +3,7 @@
 mod bench;
 mod deform;
 mod export;
+mod lbc;
 mod progress;
 mod runtime_dir;
 

@@ -49,6 +49,11 @@ impl Steps {
         }
     }
 
+    /// Replaces the current step's message.
+    pub fn message(&self, message: String) {
+        self.bar.set_message(message);
+    }
+
     /// Clears the counter.
     pub fn finish(&self) {
         self.bar.finish_and_clear();

@@ -422,7 +422,9 @@ impl EditorApp {
                 self.start_job(label, CancelFlag::default(), move || {
                     let document = copy.apply(edit).map(|()| copy);
                     Outcome::Rebuilt {
-                        cause: Rebuild::Edit { before },
+                        cause: Rebuild::Edit {
+                            before: Box::new(before),
+                        },
                         document,
                     }
                 });
@@ -445,7 +447,9 @@ impl EditorApp {
             self.start_job(label, CancelFlag::default(), move || {
                 let document = copy.apply(edit).map(|()| copy);
                 Outcome::Rebuilt {
-                    cause: Rebuild::Edit { before },
+                    cause: Rebuild::Edit {
+                        before: Box::new(before),
+                    },
                     document,
                 }
             });
@@ -719,7 +723,13 @@ impl EditorApp {
         let mut project = doc.project().clone();
         settings.write_to(&mut project);
         let label = format!("Meshing at {} vertices", settings.density);
-        let work = remesh(doc, project, Rebuild::Edit { before });
+        let work = remesh(
+            doc,
+            project,
+            Rebuild::Edit {
+                before: Box::new(before),
+            },
+        );
         self.start_job(label, CancelFlag::default(), work);
     }
 
@@ -811,7 +821,7 @@ impl EditorApp {
                     doc.pose_version = old.pose_version + 1;
                     let current = old.snapshot();
                     match cause {
-                        Rebuild::Edit { before } => self.history.push(before),
+                        Rebuild::Edit { before } => self.history.push(*before),
                         Rebuild::History { back: true } => {
                             self.history.undo(current);
                         }

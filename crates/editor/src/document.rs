@@ -152,6 +152,12 @@ impl Document {
 
     /// This document with its method's deformer set up.
     fn with_method(mut self) -> Result<Self> {
+        if self.project.method == Method::Lbc {
+            bail!(
+                "this project warps by an LBC cage, which the editor cannot show yet \
+                 (`c2warp weights` and `c2warp deform` take it)"
+            );
+        }
         self.sync_method()?;
         Ok(self)
     }
@@ -358,6 +364,7 @@ impl Document {
                 }
             }
             Edit::Settings(settings) => settings.write_to(&mut project),
+            Edit::Method(Method::Lbc) => bail!("the editor has no cage tool yet"),
             Edit::Method(method) => project.method = method,
             Edit::Rigidity(strokes) => project.rigidity = strokes,
         }

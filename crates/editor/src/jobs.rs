@@ -39,7 +39,7 @@ pub(crate) enum Outcome {
 /// Why the picture was re-meshed.
 pub(crate) enum Rebuild {
     /// A new density; `before` is the state to record in the undo history.
-    Edit { before: Project },
+    Edit { before: Box<Project> },
     /// Undo (`back`) or redo to a state with another density.
     History { back: bool },
 }

@@ -444,7 +444,8 @@ impl EditorApp {
         let current = doc.method();
         let mut chosen = current;
         ui.horizontal_wrapped(|ui| {
-            for m in Method::ALL {
+            // LBC needs the cage tool, which the editor does not have yet.
+            for m in [Method::C2, Method::Arap] {
                 ui.selectable_value(&mut chosen, m, m.label())
                     .on_hover_text(match m {
                         Method::C2 => {
@@ -456,6 +457,7 @@ impl EditorApp {
                              shapes keep their proportions; the C² weights' settings do \
                              not apply"
                         }
+                        Method::Lbc => "Local barycentric coordinates of a cage",
                     });
             }
         });

@@ -1,6 +1,7 @@
 //! Image + project → mesh → rig → warped image: the path the `c2warp` command line and
 //! the editor share, so an export from either gives the same pixels.
 
+pub mod cage;
 pub mod method;
 pub mod order;
 

@@ -56,17 +56,20 @@ pub enum Method {
     C2,
     /// As-rigid-as-possible shape manipulation (Igarashi, Moscovich and Hughes 2005).
     Arap,
+    /// Local barycentric coordinates of a cage (Zhang et al. 2014).
+    Lbc,
 }
 
 impl Method {
     /// Every method, in the order a user is offered them.
-    pub const ALL: [Method; 2] = [Method::C2, Method::Arap];
+    pub const ALL: [Method; 3] = [Method::C2, Method::Arap, Method::Lbc];
 
     /// The name in rig files and on the command line.
     pub fn name(self) -> &'static str {
         match self {
             Method::C2 => "c2",
             Method::Arap => "arap",
+            Method::Lbc => "lbc",
         }
     }
 
@@ -75,6 +78,7 @@ impl Method {
         match self {
             Method::C2 => "C² weights",
             Method::Arap => "ARAP",
+            Method::Lbc => "LBC cage",
         }
     }
 }
@@ -86,7 +90,7 @@ impl std::str::FromStr for Method {
         Method::ALL
             .into_iter()
             .find(|m| m.name() == s)
-            .ok_or_else(|| format!("unknown method {s:?} (known: c2, arap)"))
+            .ok_or_else(|| format!("unknown method {s:?} (known: c2, arap, lbc)"))
     }
 }
 
@@ -103,6 +107,45 @@ pub struct RigidityStroke {
     /// The weight of the painted triangles (the paper paints 10000).
     pub weight: f64,
 }
+
+/// A cage for local barycentric coordinates: a simple polygon in image pixels (either
+/// orientation) and where each of its vertices is posed.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CageSpec {
+    /// The cage at rest.
+    pub rest: Vec<[f64; 2]>,
+    /// The posed cage, one point per rest vertex (default: at rest).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pose: Option<Vec<[f64; 2]>>,
+}
+
+/// The locality weighting `τ` of local barycentric coordinates (the paper's eq. 12).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Tau {
+    /// `τ(x) = x²`, the paper's choice.
+    #[default]
+    Square,
+    /// `τ(x) = x`.
+    Linear,
+    /// `τ ≡ 1`.
+    Constant,
+    /// `τ(x) = √x`.
+    Sqrt,
+}
+
+/// Settings of local barycentric coordinates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct LbcSettings {
+    /// The locality weighting.
+    #[serde(default)]
+    pub tau: Tau,
+}
+
+/// The most vertices a cage may have.
+pub const MAX_CAGE_VERTICES: usize = 1000;
 
 /// The largest rigidity weight accepted (the paper paints 10⁴; far beyond, the
 /// systems lose precision).
@@ -235,6 +278,12 @@ pub struct Project {
     /// Painted rigidity (used by ARAP; kept with the file whatever the method).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub rigidity: Vec<RigidityStroke>,
+    /// The cage (used by LBC).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cage: Option<CageSpec>,
+    /// LBC's settings.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lbc: Option<LbcSettings>,
 }
 
 fn is_c2(method: &Method) -> bool {
@@ -257,6 +306,8 @@ impl Default for Project {
             virtual_placed_for: Vec::new(),
             method: Method::C2,
             rigidity: Vec::new(),
+            cage: None,
+            lbc: None,
         }
     }
 }
@@ -451,6 +502,41 @@ impl Project {
         {
             return bad(format!("virtual handle ({}, {}) is not finite", p[0], p[1]));
         }
+        if let Some(cage) = &self.cage {
+            if !(3..=MAX_CAGE_VERTICES).contains(&cage.rest.len()) {
+                return bad(format!(
+                    "a cage needs 3 to {MAX_CAGE_VERTICES} vertices, got {}",
+                    cage.rest.len()
+                ));
+            }
+            if let Some(pose) = &cage.pose
+                && pose.len() != cage.rest.len()
+            {
+                return bad(format!(
+                    "the cage's pose has {} points for {} rest vertices",
+                    pose.len(),
+                    cage.rest.len()
+                ));
+            }
+            let all = cage.rest.iter().chain(cage.pose.iter().flatten());
+            if all
+                .clone()
+                .flatten()
+                .any(|x| !x.is_finite() || x.abs() > MAX_POSE)
+            {
+                return bad(format!(
+                    "cage coordinates must be finite numbers within ±{MAX_POSE:e} pixels"
+                ));
+            }
+            if let Some(p) = cage.rest.iter().find(|p| !inside(**p)) {
+                return bad(format!(
+                    "cage vertex ({}, {}) lies outside the image",
+                    p[0], p[1]
+                ));
+            }
+        } else if self.method == Method::Lbc {
+            return bad("method \"lbc\" needs a \"cage\"".into());
+        }
         let points: usize = self.rigidity.iter().map(|s| s.stroke.len()).sum();
         if points > MAX_STROKE_POINTS {
             return bad(format!(
@@ -514,6 +600,11 @@ mod tests {
             virtual_handles: vec![[5.0, 6.0], [0.1, 0.2]],
             virtual_placed_for: vec![Some(1), None],
             method: Method::Arap,
+            cage: Some(CageSpec {
+                rest: vec![[0.0, 0.0], [50.5, 0.0], [25.0, 1.0 / 3.0]],
+                pose: Some(vec![[1.0, 0.0], [50.5, 2.0], [25.0, 40.0]]),
+            }),
+            lbc: Some(LbcSettings { tau: Tau::Sqrt }),
             rigidity: vec![
                 RigidityStroke {
                     stroke: vec![[3.0, 4.0], [10.25, 1.0 / 3.0]],
@@ -660,6 +751,26 @@ mod tests {
             (
                 r#"{"version":1,"handles":[],"rigidity":[{"stroke":[[1,1]],"radius":2}]}"#,
                 "missing field `weight`",
+            ),
+            (
+                r#"{"version":1,"method":"lbc","handles":[]}"#,
+                "needs a \"cage\"",
+            ),
+            (
+                r#"{"version":1,"handles":[],"cage":{"rest":[[0,0],[1,0]]}}"#,
+                "3 to 1000 vertices, got 2",
+            ),
+            (
+                r#"{"version":1,"handles":[],"cage":{"rest":[[0,0],[1,0],[0,1]],"pose":[[0,0]]}}"#,
+                "pose has 1 points for 3",
+            ),
+            (
+                r#"{"version":1,"handles":[],"cage":{"rest":[[0,0],[1,0],[0,1e300]]}}"#,
+                "finite numbers within",
+            ),
+            (
+                r#"{"version":1,"handles":[],"lbc":{"tau":"cubic"}}"#,
+                "unknown variant `cubic`",
             ),
         ];
         for (text, expected) in cases {

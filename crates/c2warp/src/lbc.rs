@@ -1,0 +1,168 @@
+//! The command line's side of LBC cages: the cage's inside meshed (or read), the
+//! coordinates solved with a progress counter, and `c2warp weights` / `bench` output.
+
+use std::io::Write as _;
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use pipeline::cage::{CageCoordinates, CageMesh, cage_coordinates};
+use project::Project;
+use serde::Serialize;
+
+use crate::Source;
+
+/// Mesh vertices inside a cage when neither `--density` nor the rig names a count:
+/// the solve's time grows quickly with it (a few seconds at this size).
+pub const DEFAULT_CAGE_VERTICES: usize = 2000;
+
+/// Meshes the inside of `project`'s cage (`--image`: triangulated to `--density`, the
+/// rig's `density` or [`DEFAULT_CAGE_VERTICES`]; `--mesh`: the file's triangulation,
+/// as is) and solves its coordinates, with a progress counter.
+pub fn solve(source: &Source, project: &Project) -> Result<CageCoordinates> {
+    let mesh = if let Some(path) = &source.image {
+        let image = pipeline::load_image(path)?;
+        project.validate(Some(image.dimensions()))?;
+        let target_vertices = source
+            .density
+            .or(project.density)
+            .unwrap_or(DEFAULT_CAGE_VERTICES);
+        project::validate_density(target_vertices)?;
+        CageMesh::Triangulate { target_vertices }
+    } else {
+        let path = source.mesh.as_deref().context("give --mesh or --image")?;
+        let mesh = pipeline::load_obj(path)?;
+        mesh.sanity_check()
+            .with_context(|| format!("mesh {}", path.display()))?;
+        CageMesh::Given {
+            positions: mesh.vertices,
+            triangles: mesh.triangles,
+        }
+    };
+    let progress = crate::progress::Steps::new(1);
+    progress.step("solving the cage's coordinates");
+    let solved = cage_coordinates(project, mesh, &mut |p| {
+        progress.message(format!(
+            "solving the cage's coordinates: iteration {}, residuals {:.1e} / {:.1e}",
+            p.iteration, p.primal_residual, p.dual_residual
+        ));
+        true
+    })?;
+    progress.finish();
+    Ok(solved)
+}
+
+#[derive(Serialize)]
+struct CageNode {
+    index: usize,
+    kind: &'static str,
+    vertex: u32,
+    position: [f64; 2],
+}
+
+#[derive(Serialize)]
+struct LbcWeights {
+    method: &'static str,
+    samples: usize,
+    file_vertices: usize,
+    nodes: Vec<CageNode>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    vertices: Option<Vec<[f64; 2]>>,
+    weights: Vec<Vec<(u32, f64)>>,
+    iterations: usize,
+    converged: bool,
+    objective: f64,
+}
+
+/// `c2warp weights` for a cage: the nodes are the cage's vertices in order; every mesh
+/// vertex lists its non-zero `[cage vertex, weight]` pairs.
+pub fn weights(source: &Source, project: &Project, output: &Path) -> Result<()> {
+    let solved = solve(source, project)?;
+    let positions = solved.domain.positions();
+    let nodes = solved
+        .domain
+        .cage_vertices()
+        .iter()
+        .enumerate()
+        .map(|(index, &vertex)| CageNode {
+            index,
+            kind: "cage",
+            vertex,
+            position: positions[vertex as usize].to_array(),
+        })
+        .collect();
+    let out = LbcWeights {
+        method: "lbc",
+        samples: positions.len(),
+        file_vertices: positions.len(),
+        nodes,
+        vertices: source
+            .image
+            .as_ref()
+            .map(|_| positions.iter().map(|p| p.to_array()).collect()),
+        weights: (0..positions.len())
+            .map(|v| solved.weights.row(v).to_vec())
+            .collect(),
+        iterations: solved.report.iterations,
+        converged: solved.report.converged,
+        objective: solved.report.objective,
+    };
+    let text = serde_json::to_string(&out)?;
+    if crate::is_stdout(output) {
+        let mut stdout = std::io::stdout().lock();
+        stdout
+            .write_all(text.as_bytes())
+            .and_then(|()| stdout.flush())
+            .context("cannot write to standard output")?;
+    } else {
+        render::write_atomic(output, text.as_bytes())?;
+    }
+    Ok(())
+}
+
+#[derive(Serialize)]
+struct LbcBench {
+    method: &'static str,
+    samples: usize,
+    triangles: usize,
+    cage_vertices: usize,
+    geodesics_ms: f64,
+    factorisation_ms: f64,
+    admm_iterations: usize,
+    admm_ms: f64,
+    projection_ms: f64,
+    converged: bool,
+    nonzeros_per_vertex: f64,
+    deform_ms_median: f64,
+}
+
+/// `c2warp bench` for a cage.
+pub fn bench(source: &Source, project: &Project) -> Result<()> {
+    let solved = solve(source, project)?;
+    let mut deform = Vec::new();
+    for _ in 0..15 {
+        let clock = Instant::now();
+        std::hint::black_box(solved.deformed()?);
+        deform.push(clock.elapsed().as_secs_f64() * 1e3);
+    }
+    deform.sort_by(f64::total_cmp);
+    let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+    let report = &solved.report;
+    let out = LbcBench {
+        method: "lbc",
+        samples: solved.domain.positions().len(),
+        triangles: solved.domain.triangles().len(),
+        cage_vertices: solved.domain.cage_vertices().len(),
+        geodesics_ms: ms(report.geodesics),
+        factorisation_ms: ms(report.factorisation),
+        admm_iterations: report.iterations,
+        admm_ms: ms(report.admm),
+        projection_ms: ms(report.projection),
+        converged: report.converged,
+        nonzeros_per_vertex: solved.weights.len() as f64
+            / solved.domain.positions().len().max(1) as f64,
+        deform_ms_median: deform[deform.len() / 2],
+    };
+    println!("{}", serde_json::to_string_pretty(&out)?);
+    Ok(())
+}
