@@ -251,7 +251,7 @@ fn bad_method_fields_give_one_clear_line_and_keep_the_old_output() {
     assert!(!refused.status.success());
     let stderr = String::from_utf8_lossy(&refused.stderr);
     assert!(
-        stderr.contains("unknown method \"c3\" (known: c2, arap)"),
+        stderr.contains("unknown method \"c3\" (known: c2, arap, lbc)"),
         "{stderr}"
     );
     assert_eq!(fs::read(&out).expect("read"), b"precious");
@@ -463,15 +463,6 @@ fn bad_cages_give_one_clear_line() {
         assert!(line.contains(expected), "{text}: {line}");
         assert!(!out.exists());
     }
-    // The editor's methods and `render` say LBC is not drawn yet.
-    let rig = cage_rig(dir.path(), "cage.json", |p| p);
-    let line = fails(&render_args(
-        &data("dino.png"),
-        &rig,
-        &dir.path().join("o.png"),
-        &[],
-    ));
-    assert!(line.contains("cage"), "{line}");
 }
 
 #[test]
@@ -501,4 +492,68 @@ fn bench_times_the_cage_solve() {
         );
     }
     assert!(json["admm_iterations"].as_u64().is_some_and(|n| n > 0));
+}
+
+#[test]
+fn render_by_a_cage_moves_the_inside_and_keeps_the_outside() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let opaque = data("opaque.png");
+    let picture = load(&opaque);
+    let (w, h) = (f64::from(picture.width()), f64::from(picture.height()));
+    // A quadrilateral in the middle third of the picture.
+    let rest = [
+        [w / 3.0, h / 3.0],
+        [2.0 * w / 3.0, h / 3.0],
+        [2.0 * w / 3.0, 2.0 * h / 3.0],
+        [w / 3.0, 2.0 * h / 3.0],
+    ];
+    let write = |name: &str, pose: [[f64; 2]; 4]| {
+        let rig = dir.path().join(name);
+        fs::write(
+            &rig,
+            serde_json::json!({
+                "version": 1, "method": "lbc", "handles": [], "density": 600,
+                "cage": {"rest": rest, "pose": pose}
+            })
+            .to_string(),
+        )
+        .expect("write rig");
+        rig
+    };
+    // At rest: the picture comes back (up to the odd pixel on the cage's outline).
+    let out = dir.path().join("same.png");
+    ok(&render_args(&opaque, &write("rest.json", rest), &out, &[]));
+    let (_, share) = difference(&load(&out), &picture, 8);
+    assert!(share < 0.01, "{share}");
+    // One corner pulled out: pixels far from both cages stay exactly as they were.
+    let mut pose = rest;
+    pose[2] = [0.8 * w, 0.8 * h];
+    let out = dir.path().join("pulled.png");
+    ok(&render_args(
+        &opaque,
+        &write("pulled.json", pose),
+        &out,
+        &[],
+    ));
+    let warped = load(&out);
+    let (_, moved) = difference(&warped, &picture, 8);
+    assert!(moved > 0.01, "the inside moved ({moved})");
+    for (x, y, p) in picture.enumerate_pixels() {
+        let (fx, fy) = (f64::from(x) / w, f64::from(y) / h);
+        if fx < 0.3 || fy < 0.3 || fx > 0.85 || fy > 0.85 {
+            assert_eq!(
+                warped.get_pixel(x, y),
+                p,
+                "({x}, {y}) is outside both cages"
+            );
+        }
+    }
+    // The GPU does not draw cages.
+    let line = fails(&render_args(
+        &opaque,
+        &write("gpu.json", pose),
+        &out,
+        &["--gpu"],
+    ));
+    assert!(line.contains("--gpu"), "{line}");
 }

@@ -39,6 +39,11 @@ pub fn solve(source: &Source, project: &Project) -> Result<CageCoordinates> {
             triangles: mesh.triangles,
         }
     };
+    solve_on(project, mesh)
+}
+
+/// Solves `project`'s cage on `mesh` with a progress counter.
+pub fn solve_on(project: &Project, mesh: CageMesh) -> Result<CageCoordinates> {
     let progress = crate::progress::Steps::new(1);
     progress.step("solving the cage's coordinates");
     let solved = cage_coordinates(project, mesh, &mut |p| {
@@ -72,6 +77,27 @@ struct LbcWeights {
     iterations: usize,
     converged: bool,
     objective: f64,
+}
+
+/// `c2warp render` for a cage: the inside of the rest cage drawn where the posed cage
+/// takes it, the rest of the picture as it is (8 bits per channel, on the CPU).
+pub fn render(
+    picture: &render::Picture,
+    project: &Project,
+    density: Option<usize>,
+    gpu: bool,
+) -> Result<render::Picture> {
+    if gpu {
+        anyhow::bail!("LBC cages are drawn on the CPU: leave out --gpu");
+    }
+    let image = picture.to_rgba8();
+    project.validate(Some(image.dimensions()))?;
+    let target_vertices = density.or(project.density).unwrap_or(DEFAULT_CAGE_VERTICES);
+    project::validate_density(target_vertices)?;
+    let solved = solve_on(project, CageMesh::Triangulate { target_vertices })?;
+    Ok(render::Picture::Rgba8(pipeline::cage::warp_by_cage(
+        &image, &solved,
+    )?))
 }
 
 /// `c2warp weights` for a cage: the nodes are the cage's vertices in order; every mesh

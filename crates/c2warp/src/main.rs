@@ -201,6 +201,10 @@ fn render(
         project.method = method;
     }
     let picture = load_picture(image)?;
+    if project.method == Method::Lbc {
+        let warped = lbc::render(&picture, &project, density, gpu)?;
+        return write_png(output, &warped);
+    }
     warp_and_save(&picture, &project, density, output, gpu)?;
     Ok(())
 }

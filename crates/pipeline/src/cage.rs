@@ -3,8 +3,8 @@
 //! posed cage.
 //!
 //! LBC is a cage method: it moves what lies inside the cage by the cage's vertices;
-//! it has no handles. The command line's `weights`, `deform` and `bench` use it; the
-//! editor's cage tool and drawing a picture by it are not built yet.
+//! it has no handles. The command line's `render`, `weights`, `deform` and `bench`
+//! use it; the editor's cage tool is not built yet.
 
 use anyhow::{Context, Result, bail};
 use glam::DVec2;
@@ -103,4 +103,90 @@ pub fn cage_coordinates(
 /// Whether `project` (with `method` overriding its own) warps by a cage.
 pub fn uses_cage(project: &Project, method: Option<Method>) -> bool {
     method.unwrap_or(project.method) == Method::Lbc
+}
+
+/// The picture warped by a cage, as GIMP's cage tool does it: what lies inside the
+/// rest cage is taken out and drawn where the posed cage takes it; what lies outside
+/// stays as it is, and shows wherever the warped inside does not cover it (the warped
+/// inside is drawn over it, alpha blended). Drawn on the CPU at full resolution, 8 bits
+/// per channel.
+///
+/// # Errors
+/// Non-finite deformed positions, or a picture too large to draw.
+pub fn warp_by_cage(
+    image: &image::RgbaImage,
+    solved: &CageCoordinates,
+) -> Result<image::RgbaImage> {
+    let deformed = solved.deformed()?;
+    if deformed.iter().any(|p| !p.is_finite()) {
+        bail!("the cage sent a vertex to a non-finite position");
+    }
+    let rest: Vec<glam::Vec2> = solved
+        .domain
+        .positions()
+        .iter()
+        .map(|p| p.as_vec2())
+        .collect();
+    let deformed: Vec<glam::Vec2> = deformed.iter().map(|p| p.as_vec2()).collect();
+    let (w, h) = image.dimensions();
+    let layer = render::warp_cpu(
+        image,
+        &render::WarpMesh {
+            rest: &rest,
+            deformed: &deformed,
+            triangles: solved.domain.triangles(),
+        },
+        w,
+        h,
+        &render::RasterOptions::default(),
+    )?;
+    let mut out = image.clone();
+    clear_inside(&mut out, solved.domain.cage().vertices());
+    for (base, top) in out.pixels_mut().zip(layer.pixels()) {
+        *base = over(top.0, base.0).into();
+    }
+    Ok(out)
+}
+
+/// Makes every pixel whose centre lies inside the polygon `cage` transparent (even-odd
+/// rule, one scan line per row).
+fn clear_inside(image: &mut image::RgbaImage, cage: &[DVec2]) {
+    let (w, h) = image.dimensions();
+    let mut crossings = Vec::new();
+    for y in 0..h {
+        let cy = f64::from(y) + 0.5;
+        crossings.clear();
+        for (i, &a) in cage.iter().enumerate() {
+            let b = cage[(i + 1) % cage.len()];
+            if (a.y <= cy) != (b.y <= cy) {
+                crossings.push(a.x + (cy - a.y) / (b.y - a.y) * (b.x - a.x));
+            }
+        }
+        crossings.sort_by(f64::total_cmp);
+        for span in crossings.chunks_exact(2) {
+            // Pixels whose centre x + 0.5 lies in [span[0], span[1]).
+            let first = (span[0] - 0.5).ceil().max(0.0);
+            let last = (span[1] - 0.5).ceil().min(f64::from(w));
+            let (first, last) = (first as u32, last as u32);
+            for x in first..last.max(first) {
+                image.put_pixel(x, y, image::Rgba([0, 0, 0, 0]));
+            }
+        }
+    }
+}
+
+/// `top` over `base`, straight (not premultiplied) alpha.
+fn over(top: [u8; 4], base: [u8; 4]) -> [u8; 4] {
+    let (ta, ba) = (f32::from(top[3]) / 255.0, f32::from(base[3]) / 255.0);
+    let a = ta + ba * (1.0 - ta);
+    if a <= 0.0 {
+        return [0; 4];
+    }
+    let mut out = [0u8; 4];
+    for c in 0..3 {
+        let v = (f32::from(top[c]) * ta + f32::from(base[c]) * ba * (1.0 - ta)) / a;
+        out[c] = v.round().clamp(0.0, 255.0) as u8;
+    }
+    out[3] = (a * 255.0).round() as u8;
+    out
 }

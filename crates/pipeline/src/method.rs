@@ -98,10 +98,7 @@ pub fn deformer(
     Ok(match method {
         Method::C2 => Box::new(rig),
         Method::Arap => Box::new(ArapRig::new(rig.domain().clone(), rig.handles(), rigidity)?),
-        Method::Lbc => anyhow::bail!(
-            "LBC warps by a cage, not by handles: `c2warp weights`, `deform` and `bench` \
-             take it; drawing a picture by a cage is not built yet"
-        ),
+        Method::Lbc => anyhow::bail!("LBC warps by a cage, not by handles (see pipeline::cage)"),
     })
 }
 
