@@ -492,6 +492,12 @@ fn bench_times_the_cage_solve() {
         );
     }
     assert!(json["admm_iterations"].as_u64().is_some_and(|n| n > 0));
+    // P(t) rises from near 0 to 1; Q(1) = 1 (every point has some weight).
+    let p = json["locality_p"].as_array().expect("P");
+    assert_eq!(p.last().and_then(|l| l[1].as_f64()), Some(1.0));
+    let q = json["locality_q"].as_array().expect("Q");
+    assert_eq!(q.len(), 5);
+    assert!((q[1].as_f64().expect("Q(1)") - 1.0).abs() < 1e-9);
 }
 
 #[test]

@@ -160,6 +160,10 @@ struct LbcBench {
     converged: bool,
     nonzeros_per_vertex: f64,
     deform_ms_median: f64,
+    /// The paper's P(t) as `[t, P(t)]` pairs (eq. 20).
+    locality_p: Vec<[f64; 2]>,
+    /// The paper's Q(k) for k = 0, 1, … n (eq. 21).
+    locality_q: Vec<f64>,
 }
 
 /// `c2warp bench` for a cage.
@@ -188,6 +192,14 @@ pub fn bench(source: &Source, project: &Project) -> Result<()> {
         nonzeros_per_vertex: solved.weights.len() as f64
             / solved.domain.positions().len().max(1) as f64,
         deform_ms_median: deform[deform.len() / 2],
+        locality_p: solved
+            .locality
+            .t
+            .iter()
+            .zip(&solved.locality.p)
+            .map(|(&t, &p)| [t, p])
+            .collect(),
+        locality_q: solved.locality.q.clone(),
     };
     println!("{}", serde_json::to_string_pretty(&out)?);
     Ok(())

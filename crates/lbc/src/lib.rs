@@ -29,6 +29,9 @@
 //!    non-negativity to rounding; boundary rows are the exact boundary values.
 //! 5. **Storage** ([`Coordinates::compact`]): weights below `10⁻³/n` dropped and
 //!    each row renormalised, as the paper's Table 1; [`CompactWeights::deform`].
+//! 6. **Locality statistics** ([`locality`]): the paper's `P(t)` and `Q(k)`
+//!    (eqs. 19–21), `P` exact for the piecewise-linear functions, `Q` counted at the
+//!    vertices.
 //!
 //! # Converged, not just stopped
 //!
@@ -101,6 +104,7 @@ mod error;
 mod fem;
 mod geodesic;
 mod solve;
+mod stats;
 
 pub use cage::Cage;
 pub use compact::{CompactWeights, Coordinates};
@@ -108,3 +112,4 @@ pub use domain::{Domain, OnCage};
 pub use error::LbcError;
 pub use geodesic::geodesic_distances;
 pub use solve::{DEFAULT_TOLERANCE, Progress, Report, Settings, Tau, solve, solve_with_distances};
+pub use stats::{Locality, locality};

@@ -372,3 +372,33 @@ proptest! {
         check_properties(&cage, &domain, &c);
     }
 }
+
+/// On a triangle the coordinates are the barycentric ones, linear: `P(t)` is
+/// `1 − (1 − t)²` exactly, and every point but the corners has at least two
+/// non-negligible coordinates.
+#[test]
+fn locality_statistics_of_a_triangle() {
+    let cage = lbc::Cage::new(vec![
+        glam::DVec2::new(0.0, 0.0),
+        glam::DVec2::new(4.0, 0.0),
+        glam::DVec2::new(1.0, 3.0),
+    ])
+    .expect("a triangle");
+    let domain = lbc::Domain::triangulate(&cage, 200).expect("meshed");
+    let coordinates =
+        lbc::solve(&domain, &lbc::Settings::default(), &mut |_| true).expect("solved");
+    let t = [0.0, 0.1, 0.5, 0.9, 1.0];
+    let stats = lbc::locality(&domain, &coordinates, &t);
+    for (&tk, &pk) in t.iter().zip(&stats.p) {
+        let expected = 1.0 - (1.0 - tk) * (1.0 - tk);
+        assert!(
+            (pk - expected).abs() < 1e-6,
+            "P({tk}) = {pk}, not {expected}"
+        );
+    }
+    assert_eq!(stats.q.len(), 4);
+    assert!((stats.q[0] - 1.0).abs() < 1e-12);
+    assert!((stats.q[1] - 1.0).abs() < 1e-12);
+    assert!(stats.q[2] > 0.9, "{:?}", stats.q);
+    assert!(stats.q.windows(2).all(|w| w[0] >= w[1]), "{:?}", stats.q);
+}

@@ -36,6 +36,9 @@ pub struct CageCoordinates {
     pub weights: lbc::CompactWeights,
     /// Iterations, residuals, objective and times of the solve.
     pub report: lbc::Report,
+    /// The paper's locality statistics `P(t)` (at `t` = 0, `10⁻³/n`, 0.01, 0.05, 0.1,
+    /// 0.2, …, 1) and `Q(k)`, of the coordinates before compaction.
+    pub locality: lbc::Locality,
     /// The posed cage (the rest cage where the rig gives no pose).
     pub pose: Vec<DVec2>,
 }
@@ -92,10 +95,15 @@ pub fn cage_coordinates(
     };
     let coordinates = lbc::solve(&domain, &settings, progress)?;
     let report = coordinates.report.clone();
+    let n = coordinates.cage_vertices().max(1) as f64;
+    let mut t = vec![0.0, 1e-3 / n, 0.01, 0.05];
+    t.extend((1..=10).map(|k| f64::from(k) / 10.0));
+    let locality = lbc::locality(&domain, &coordinates, &t);
     Ok(CageCoordinates {
         weights: coordinates.compact(),
         domain,
         report,
+        locality,
         pose,
     })
 }
