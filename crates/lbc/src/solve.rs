@@ -206,8 +206,6 @@ struct Problem {
     k: Vec<DVec3>,
     /// `(KᵀK)⁻¹`.
     ktk_inv: DMat3,
-    /// Rows of `M`: an orthonormal basis of the null space of `Kᵀ`, `(n − 3) × n`.
-    m: Vec<Vec<f64>>,
     /// Solver-frame positions.
     q: Vec<DVec2>,
     /// The caller's length per solver-frame length.
@@ -267,7 +265,6 @@ impl Problem {
             acc + DMat3::from_cols(*r * r.x, *r * r.y, *r * r.z)
         });
         let ktk_inv = ktk.inverse();
-        let m = null_space(&k);
 
         let mut count = vec![0u32; interior.len() + 1];
         for t in &triangles {
@@ -302,7 +299,6 @@ impl Problem {
             phi,
             k,
             ktk_inv,
-            m,
             q,
             scale,
             e: Vec::new(),
@@ -372,49 +368,63 @@ impl Problem {
         )
     }
 
-    /// The Y-update: `Y = (GᵀG + I)⁻¹ [Gᵀ(x − E) + w] Mᵀ`, then the unknown rows of
-    /// `z` become `YM + H`. `x` is per triangle, `w` per unknown row.
-    fn y_update(&self, factor: &Factor, x: &[DVec2], w: &[f64], z: &mut [f64]) {
+    /// The Y-update: `Y = (GᵀG + I)⁻¹ [Gᵀ(x + u1 − E) + w + u2] Mᵀ`, then the unknown
+    /// rows of `z` become `YM + H`. `x`, `u1` are per triangle, `w`, `u2` per unknown
+    /// row; the sums are formed here rather than in buffers of their own (a pass over
+    /// each less per iteration).
+    fn y_update(&self, factor: &Factor, targets: Targets<'_>, z: &mut [f64]) {
         let n = self.n;
-        let r = n - 3;
         let mi = self.interior.len();
-        let mut rhs = vec![0.0; mi * r];
-        rhs.par_chunks_mut(r).enumerate().for_each(|(j, out)| {
-            let mut acc: Vec<f64> = w[j * n..(j + 1) * n].to_vec();
-            for &(s, c) in &self.adj[self.adj_ptr[j] as usize..self.adj_ptr[j + 1] as usize] {
-                let g = self.g[s as usize][c as usize];
-                let base = s as usize * n;
+        let Targets { x, u1, w, u2 } = targets;
+        // `(GᵀG + I)⁻¹` acts on rows (mesh vertices) and `MᵀM` on columns (cage
+        // vertices), so they commute: `Y M = (GᵀG + I)⁻¹ (R MᵀM)`, and `MᵀM` is the
+        // projector onto the null space of `Kᵀ`, `I − K(KᵀK)⁻¹Kᵀ`. Projecting each
+        // row of `R` (3 dot products) costs far less than multiplying by `Mᵀ` and then
+        // by `M` (n − 3 each), for three more right-hand side columns in the solve.
+        let mut y = Mat::<f64>::zeros(mi, n);
+        let mut rhs = vec![0.0; mi * n];
+        rhs.par_chunks_mut(n).enumerate().for_each_init(
+            || vec![0.0; n],
+            |acc, (j, out)| {
                 for i in 0..n {
-                    acc[i] += g.dot(x[base + i] - self.e[base + i]);
+                    acc[i] = w[j * n + i] + u2.map_or(0.0, |u| u[j * n + i]);
                 }
-            }
-            for (o, mrow) in out.iter_mut().zip(&self.m) {
-                *o = mrow.iter().zip(&acc).map(|(a, b)| a * b).sum();
-            }
-        });
-        let mut y = Mat::<f64>::from_fn(mi, r, |j, c| rhs[j * r + c]);
-        factor.solve_in_place(y.as_mut());
-        let rows: Vec<Vec<f64>> = (0..mi)
-            .into_par_iter()
-            .map(|j| {
-                let v = self.interior[j] as usize;
-                let mut row = vec![0.0; n];
-                self.least_norm(self.q[v], &mut row);
-                for (c, mrow) in self.m.iter().enumerate() {
-                    let yc = y[(j, c)];
+                for &(s, c) in &self.adj[self.adj_ptr[j] as usize..self.adj_ptr[j + 1] as usize] {
+                    let g = self.g[s as usize][c as usize];
+                    let base = s as usize * n;
                     for i in 0..n {
-                        row[i] += yc * mrow[i];
+                        let target = u1.map_or(x[base + i], |u| x[base + i] + u[base + i]);
+                        acc[i] += g.dot(target - self.e[base + i]);
                     }
                 }
-                row
-            })
-            .collect();
-        for (j, row) in rows.into_iter().enumerate() {
+                let kt: DVec3 = acc.iter().zip(&self.k).map(|(a, k)| *a * *k).sum();
+                let coef = self.ktk_inv * kt;
+                for ((o, a), k) in out.iter_mut().zip(acc.iter()).zip(&self.k) {
+                    *o = a - k.dot(coef);
+                }
+            },
+        );
+        for c in 0..n {
+            for j in 0..mi {
+                y[(j, c)] = rhs[j * n + c];
+            }
+        }
+        factor.solve_in_place(y.as_mut());
+        let mut rows = vec![0.0; mi * n];
+        rows.par_chunks_mut(n).enumerate().for_each(|(j, row)| {
             let v = self.interior[j] as usize;
-            z[v * n..(v + 1) * n].copy_from_slice(&row);
+            self.least_norm(self.q[v], row);
+            for (i, value) in row.iter_mut().enumerate() {
+                *value += y[(j, i)];
+            }
+        });
+        for (j, row) in rows.chunks_exact(n).enumerate() {
+            let v = self.interior[j] as usize;
+            z[v * n..(v + 1) * n].copy_from_slice(row);
         }
     }
 
+    #[allow(clippy::too_many_lines)]
     fn admm(
         &self,
         factor: &Factor,
@@ -431,7 +441,13 @@ impl Problem {
         // variable and multiplier zero (a regularised harmonic solve).
         let zero_x = vec![DVec2::ZERO; nt * n];
         let zero_w = vec![0.0; mi * n];
-        self.y_update(factor, &zero_x, &zero_w, z);
+        let start = Targets {
+            x: &zero_x,
+            u1: None,
+            w: &zero_w,
+            u2: None,
+        };
+        self.y_update(factor, start, z);
         drop(zero_x);
         drop(zero_w);
         let mut p = vec![DVec2::ZERO; nt * n];
@@ -487,9 +503,13 @@ impl Problem {
             }
             std::mem::swap(&mut p, &mut p_old);
             // Step 2: Y with x̃ + u1 and w̃ + u2 as targets.
-            let tx: Vec<DVec2> = xt.par_iter().zip(&u1).map(|(a, b)| *a + *b).collect();
-            let tw: Vec<f64> = wt.par_iter().zip(&u2).map(|(a, b)| a + b).collect();
-            self.y_update(factor, &tx, &tw, z);
+            let targets = Targets {
+                x: &xt,
+                u1: Some(&u1),
+                w: &wt,
+                u2: Some(&u2),
+            };
+            self.y_update(factor, targets, z);
             self.apply_g(z, &mut p);
             // Step 3: multipliers; residuals (eqs. 26–27).
             let (mut rp, mut rd, mut nx, mut nz, mut nu) = (0.0, 0.0, 0.0, 0.0, 0.0);
@@ -604,46 +624,14 @@ impl Problem {
     }
 }
 
-/// An orthonormal basis of `{v : Σ v_i k_i = 0}` (the null space of `Kᵀ`), by
-/// Gram–Schmidt (twice) of the unit vectors against `K`'s columns and each other.
-fn null_space(k: &[DVec3]) -> Vec<Vec<f64>> {
-    let n = k.len();
-    let mut basis: Vec<Vec<f64>> = Vec::with_capacity(n);
-    // K's columns first, orthonormalised; they are dropped at the end.
-    for c in 0..3 {
-        let col: Vec<f64> = k.iter().map(|r| r[c]).collect();
-        if let Some(v) = orthonormalise(col, &basis) {
-            basis.push(v);
-        }
-    }
-    let range = basis.len();
-    for i in 0..n {
-        if basis.len() == n {
-            break;
-        }
-        let mut e = vec![0.0; n];
-        e[i] = 1.0;
-        if let Some(v) = orthonormalise(e, &basis) {
-            basis.push(v);
-        }
-    }
-    basis.split_off(range)
-}
-
-fn orthonormalise(mut v: Vec<f64>, basis: &[Vec<f64>]) -> Option<Vec<f64>> {
-    let before = v.iter().map(|x| x * x).sum::<f64>().sqrt();
-    for _ in 0..2 {
-        for b in basis {
-            let d: f64 = v.iter().zip(b).map(|(x, y)| x * y).sum();
-            v.iter_mut().zip(b).for_each(|(x, y)| *x -= d * y);
-        }
-    }
-    let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
-    if norm <= 1e-6 * before {
-        return None;
-    }
-    v.iter_mut().for_each(|x| *x /= norm);
-    Some(v)
+/// What the Y-update pulls towards: `x + u1` per triangle and `w + u2` per unknown row
+/// (no multipliers: `x` and `w` alone).
+#[derive(Clone, Copy)]
+struct Targets<'a> {
+    x: &'a [DVec2],
+    u1: Option<&'a [DVec2]>,
+    w: &'a [f64],
+    u2: Option<&'a [f64]>,
 }
 
 /// The Euclidean projection of `w0` onto `{w ≥ 0, Kᵀw = b}`: `w = max(0, w0 + Kν)`
