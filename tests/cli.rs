@@ -207,6 +207,16 @@ fn bench_prints_one_json_object() {
     ] {
         assert!(json.get(key).is_some(), "missing {key}");
     }
+    for (median, p90) in [
+        ("insert_ms_median", "insert_ms_p90"),
+        ("remove_ms_median", "remove_ms_p90"),
+    ] {
+        let (m, p) = (json[median].as_f64(), json[p90].as_f64());
+        assert!(
+            m.zip(p).is_some_and(|(m, p)| p >= m),
+            "{p90} ({p:?}) is at least {median} ({m:?})"
+        );
+    }
     for phase in [
         "distances",
         "voronoi",

@@ -32,8 +32,12 @@ struct Report {
     build_ms: Phases,
     /// Median time to insert one point handle at a random sample, weights up to date.
     insert_ms_median: f64,
+    /// 90th percentile of the insertions.
+    insert_ms_p90: f64,
     /// Median time to remove it again.
     remove_ms_median: f64,
+    /// 90th percentile of the removals.
+    remove_ms_p90: f64,
     /// Positions tried.
     positions: usize,
     /// Median time to deform every sample with the sparse weights.
@@ -42,12 +46,18 @@ struct Report {
     weight_bytes_per_nonzero: f64,
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
+fn median(v: Vec<f64>) -> f64 {
+    quantile(v, 0.5)
+}
+
+/// The `q`-quantile (nearest rank) of `v`; NaN for none.
+fn quantile(mut v: Vec<f64>, q: f64) -> f64 {
     if v.is_empty() {
         return f64::NAN;
     }
     v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
+    let rank = ((q * v.len() as f64).ceil() as usize).clamp(1, v.len());
+    v[rank - 1]
 }
 
 fn ms(t: Instant) -> f64 {
@@ -151,7 +161,7 @@ fn arap(rig: weights_core::Rig, project: &project::Project, poses: usize) -> Res
         pinned_vertices,
         registration_ms,
         compile_ms_median: median(compile),
-        update_ms_p90: sorted[(sorted.len() * 9 / 10).min(sorted.len() - 1)],
+        update_ms_p90: quantile(sorted.clone(), 0.9),
         update_ms_median: median(update),
         poses: sorted.len(),
     };
@@ -210,7 +220,9 @@ fn c2(mut rig: weights_core::Rig, positions: usize) -> Result<()> {
             total: timings.total_ms(),
         },
         positions: insert.len(),
+        insert_ms_p90: quantile(insert.clone(), 0.9),
         insert_ms_median: median(insert),
+        remove_ms_p90: quantile(remove.clone(), 0.9),
         remove_ms_median: median(remove),
         deform_ms_median: median(deform),
         nonzeros: stats.nonzeros,
