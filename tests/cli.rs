@@ -9,12 +9,8 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use support::{
-    c2warp, c2warp_within, data, difference, fails, fails_within, load, mkfifo, ok, render_args,
+    c2warp, c2warp_within, data, difference, fails, fails_within, load, mkfifo, ok, os, render_args,
 };
-
-fn os(s: &str) -> &OsStr {
-    OsStr::new(s)
-}
 
 #[test]
 /// The expected image comes from this renderer; regenerate it (and look at it) when the

@@ -7,11 +7,7 @@ use std::ffi::OsStr;
 use std::fs;
 use std::path::Path;
 
-use support::{c2warp, data, difference, fails, load, ok, render_args};
-
-fn os(s: &str) -> &OsStr {
-    OsStr::new(s)
-}
+use support::{c2warp, data, difference, fails, load, ok, os, render_args};
 
 /// The vertices and faces of an OBJ file written by `c2warp deform`.
 fn read_obj(path: &Path) -> (Vec<[f64; 2]>, Vec<[usize; 3]>) {

@@ -47,6 +47,11 @@ pub fn fails(args: &[&std::ffi::OsStr]) -> String {
     lines[0].to_string()
 }
 
+/// A command-line argument.
+pub fn os(s: &str) -> &std::ffi::OsStr {
+    std::ffi::OsStr::new(s)
+}
+
 /// The arguments of `c2warp render IMAGE --rig RIG -o OUT` followed by `extra`.
 pub fn render_args<'a>(
     image: &'a Path,

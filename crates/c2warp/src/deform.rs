@@ -1,15 +1,14 @@
 //! `c2warp deform`: the deformed mesh as Wavefront OBJ, by any method.
 
 use std::fmt::Write as _;
-use std::io::Write as _;
 use std::path::Path;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use glam::DVec2;
 use pipeline::{Method, load_project};
 
+use crate::Source;
 use crate::export::{self, Built};
-use crate::{Source, is_stdout};
 
 /// Runs `c2warp deform`: meshes (or reads) the samples, sets up `method` (else the
 /// rig's) for the rig's handles and pose, and writes one `v x y 0` line per vertex in
@@ -61,14 +60,6 @@ fn write_obj(
     for t in triangles {
         let _ = writeln!(text, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1);
     }
-    if is_stdout(output) {
-        let mut stdout = std::io::stdout().lock();
-        stdout
-            .write_all(text.as_bytes())
-            .and_then(|()| stdout.flush())
-            .context("cannot write to standard output")?;
-    } else {
-        render::write_atomic(output, text.as_bytes())?;
-    }
+    crate::write_text(output, text.as_bytes())?;
     Ok(())
 }

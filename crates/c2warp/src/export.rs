@@ -1,6 +1,5 @@
 //! `c2warp weights`: the nodes and sparse weights of a rig, as JSON.
 
-use std::io::Write;
 use std::path::Path;
 
 use anyhow::{Context, Result};
@@ -184,15 +183,7 @@ pub fn weights(source: &Source, rig_path: &Path, output: &Path) -> Result<()> {
             .collect(),
     };
     let text = serde_json::to_string(&out)?;
-    if crate::is_stdout(output) {
-        let mut stdout = std::io::stdout().lock();
-        stdout
-            .write_all(text.as_bytes())
-            .and_then(|()| stdout.flush())
-            .context("cannot write to standard output")?;
-    } else {
-        render::write_atomic(output, text.as_bytes())?;
-    }
+    crate::write_text(output, text.as_bytes())?;
     progress.finish();
     Ok(())
 }

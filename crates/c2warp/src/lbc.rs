@@ -1,7 +1,6 @@
 //! The command line's side of LBC cages: the cage's inside meshed (or read), the
 //! coordinates solved with a progress counter, and `c2warp weights` / `bench` output.
 
-use std::io::Write as _;
 use std::path::Path;
 use std::time::Instant;
 
@@ -134,15 +133,7 @@ pub fn weights(source: &Source, project: &Project, output: &Path) -> Result<()> 
         objective: solved.report.objective,
     };
     let text = serde_json::to_string(&out)?;
-    if crate::is_stdout(output) {
-        let mut stdout = std::io::stdout().lock();
-        stdout
-            .write_all(text.as_bytes())
-            .and_then(|()| stdout.flush())
-            .context("cannot write to standard output")?;
-    } else {
-        render::write_atomic(output, text.as_bytes())?;
-    }
+    crate::write_text(output, text.as_bytes())?;
     Ok(())
 }
 

@@ -7,7 +7,7 @@ mod lbc;
 mod progress;
 mod runtime_dir;
 
-use std::io::IsTerminal;
+use std::io::{IsTerminal, Write as _};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -241,6 +241,22 @@ fn warp_and_save(
 /// Whether `output` names standard output (`-`).
 pub(crate) fn is_stdout(output: &Path) -> bool {
     output.as_os_str() == "-"
+}
+
+/// Writes `bytes` (a JSON or OBJ file) to `output`: standard output for `-`, else
+/// through [`render::write_atomic`] (atomic for a regular file, through to a device or
+/// FIFO, to a symbolic link's target).
+pub(crate) fn write_text(output: &Path, bytes: &[u8]) -> Result<()> {
+    if is_stdout(output) {
+        let mut stdout = std::io::stdout().lock();
+        stdout
+            .write_all(bytes)
+            .and_then(|()| stdout.flush())
+            .context("cannot write to standard output")?;
+    } else {
+        render::write_atomic(output, bytes)?;
+    }
+    Ok(())
 }
 
 /// Writes `picture` as a PNG to `output`: standard output for `-` (unless it is a

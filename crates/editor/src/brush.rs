@@ -7,6 +7,7 @@ use std::sync::Arc;
 
 use egui::{Color32, Mesh, PointerButton, Pos2, Shape, Ui};
 use glam::DVec2;
+use pipeline::method::polyline_distance_squared;
 use project::{Method, RigidityStroke};
 
 use crate::app::EditorApp;
@@ -59,7 +60,7 @@ pub fn erase(strokes: &[RigidityStroke], eraser: &[[f64; 2]], radius: f64) -> Ve
         let reach = radius + stroke.radius;
         let mut piece = Vec::new();
         for &p in &stroke.stroke {
-            if polyline_distance(&eraser, DVec2::from(p)) < reach {
+            if polyline_distance_squared(&eraser, DVec2::from(p)) < reach * reach {
                 if !piece.is_empty() {
                     out.push(RigidityStroke {
                         stroke: std::mem::take(&mut piece),
@@ -78,26 +79,6 @@ pub fn erase(strokes: &[RigidityStroke], eraser: &[[f64; 2]], radius: f64) -> Ve
         }
     }
     out
-}
-
-/// The distance from `p` to the polyline through `points` (infinite for none).
-fn polyline_distance(points: &[DVec2], p: DVec2) -> f64 {
-    match points {
-        [] => f64::INFINITY,
-        [a] => a.distance(p),
-        _ => points
-            .windows(2)
-            .map(|w| {
-                let d = w[1] - w[0];
-                let t = if d.length_squared() > 0.0 {
-                    ((p - w[0]).dot(d) / d.length_squared()).clamp(0.0, 1.0)
-                } else {
-                    0.0
-                };
-                (w[0] + d * t).distance(p)
-            })
-            .fold(f64::INFINITY, f64::min),
-    }
 }
 
 impl EditorApp {
@@ -195,8 +176,14 @@ impl EditorApp {
         if strokes.is_empty() && self.brush_stroke.is_none() {
             return;
         }
-        let key = (self.gpu.mesh.version, strokes.clone());
-        if self.painted.key.as_ref() != Some(&key) {
+        let mesh = self.gpu.mesh.version;
+        let fresh = self
+            .painted
+            .key
+            .as_ref()
+            .is_some_and(|(version, painted)| *version == mesh && painted == strokes);
+        if !fresh {
+            let key = (mesh, strokes.clone());
             let domain = doc.rig().domain();
             let weights = pipeline::method::rigidity_weights(domain, strokes);
             let painted = weights

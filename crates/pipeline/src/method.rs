@@ -409,8 +409,8 @@ pub fn rigidity_weights(domain: &Domain, strokes: &[RigidityStroke]) -> Vec<f64>
 }
 
 /// The squared distance from `p` to the polyline through `points` (a point when it
-/// has one).
-fn polyline_distance_squared(points: &[DVec2], p: DVec2) -> f64 {
+/// has one, infinite when it has none): how far a brush stroke reaches.
+pub fn polyline_distance_squared(points: &[DVec2], p: DVec2) -> f64 {
     if points.len() == 1 {
         return points[0].distance_squared(p);
     }
