@@ -3,7 +3,7 @@
 
 use std::time::{Duration, Instant};
 
-use faer::Mat;
+use faer::MatMut;
 use glam::{DMat3, DVec2, DVec3};
 use rayon::prelude::*;
 
@@ -50,16 +50,20 @@ pub struct Settings {
     /// multipliers (Boyd et al. 2011, §3.3.1, without the absolute term).
     pub tolerance: f64,
     /// Iteration cap; the result is returned (projected, `converged: false`) when hit.
+    /// The residuals are measured every 5 iterations, so a solve stops on a multiple
+    /// of 5 (or at the cap).
     pub max_iterations: usize,
     /// Over-relaxation `α` (the paper: 1.5–1.8).
     pub relaxation: f64,
     /// Penalty `μ` to start with (in the solver's frame: cage centred, farthest cage
-    /// vertex at distance 1).
-    pub initial_penalty: f64,
-    /// Residual balancing (Boyd et al. 2011, §3.4.1): every 25 iterations, double `μ`
-    /// if the relative primal residual is ten times the dual one, halve it in the
-    /// opposite case. The Y-update matrix does not depend on `μ`, so this costs no
-    /// refactorisation.
+    /// vertex at distance 1); `None` chooses `‖φ√A‖ / ‖G W₀‖`, the ratio of the
+    /// weights to the gradients of the starting coordinates.
+    pub initial_penalty: Option<f64>,
+    /// Residual balancing (Boyd et al. 2011, §3.4.1): when the relative primal and
+    /// dual residuals differ by more than a factor of 2, multiply `μ` by the square
+    /// root of their ratio (at most 10×), first after 10 iterations, then waiting
+    /// twice as long after each change. The Y-update matrix does not depend on `μ`,
+    /// so this costs no refactorisation.
     pub adaptive_penalty: bool,
 }
 
@@ -70,16 +74,17 @@ impl Default for Settings {
             tolerance: DEFAULT_TOLERANCE,
             max_iterations: 20_000,
             relaxation: 1.65,
-            initial_penalty: 10.0,
+            initial_penalty: None,
             adaptive_penalty: true,
         }
     }
 }
 
 /// The default relative stopping threshold (see the crate docs for why).
-pub const DEFAULT_TOLERANCE: f64 = 1e-4;
+pub const DEFAULT_TOLERANCE: f64 = 1e-3;
 
-/// One ADMM iteration's state, for a progress display.
+/// One ADMM iteration's state, for a progress display. The residuals are those of
+/// the last iteration that measured them (every fifth; infinite before the first).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Progress {
     /// Iterations done.
@@ -210,11 +215,19 @@ struct Problem {
     q: Vec<DVec2>,
     /// The caller's length per solver-frame length.
     scale: f64,
-    /// `Σ_{k on the cage} √A_s ∇λ_k w_i(v_k)`: `E` of eq. (17).
-    e: Vec<DVec2>,
+    /// `Gᵀ E` per unknown row and cage vertex, with `E` of eq. (17) (`G` applied to
+    /// the boundary values alone): the constant part of the Y-update's right-hand
+    /// side.
+    gte: Vec<f64>,
     /// Per unknown row, its `(triangle, corner)` incidences (CSR).
     adj_ptr: Vec<u32>,
     adj: Vec<(u32, u8)>,
+    /// Per unknown row, the weight `β·m_v` of its `W = W̃` split in the augmented
+    /// Lagrangian (`m_v` the lumped mass), and its square root.
+    split: Vec<f64>,
+    root: Vec<f64>,
+    /// `H`: the least-norm rows of the unknown vertices, row-major.
+    h: Vec<f64>,
 }
 
 impl Problem {
@@ -288,7 +301,15 @@ impl Problem {
                 }
             }
         }
+        let mass = elements.lumped_mass(&triangles, q.len());
+        let split: Vec<f64> = interior
+            .iter()
+            .map(|&v| SPLIT_WEIGHT * mass[v as usize])
+            .collect();
+        let root = split.iter().map(|m: &f64| m.sqrt()).collect();
         let mut problem = Self {
+            split,
+            root,
             n,
             triangles,
             interior,
@@ -301,7 +322,8 @@ impl Problem {
             ktk_inv,
             q,
             scale,
-            e: Vec::new(),
+            gte: Vec::new(),
+            h: Vec::new(),
             adj_ptr,
             adj,
         };
@@ -313,7 +335,21 @@ impl Problem {
         }
         let mut e = vec![DVec2::ZERO; problem.triangles.len() * n];
         problem.apply_g(&boundary_only, &mut e);
-        problem.e = e;
+        let mut gte = vec![0.0; problem.interior.len() * n];
+        gte.par_chunks_mut(n).enumerate().for_each(|(j, out)| {
+            for &(s, c) in problem.incidences(j) {
+                let g = problem.g[s as usize][c as usize];
+                for (o, e) in out.iter_mut().zip(&e[s as usize * n..(s as usize + 1) * n]) {
+                    *o += g.dot(*e);
+                }
+            }
+        });
+        problem.gte = gte;
+        let mut h = vec![0.0; problem.interior.len() * n];
+        for (row, &v) in h.chunks_exact_mut(n).zip(&problem.interior) {
+            problem.least_norm(problem.q[v as usize], row);
+        }
+        problem.h = h;
         problem
     }
 
@@ -358,7 +394,10 @@ impl Problem {
     }
 
     fn factorise(&self, domain: &Domain) -> Result<Factor, LbcError> {
-        let ones = vec![1.0; self.q.len()];
+        let mut ones = vec![0.0; self.q.len()];
+        for (j, &v) in self.interior.iter().enumerate() {
+            ones[v as usize] = self.split[j];
+        }
         let row_of = &self.row_of;
         let map = |v: u32| row_of[v as usize].map(|r| r as usize);
         let elements = Elements::new(&self.q, domain.triangles());
@@ -368,63 +407,323 @@ impl Problem {
         )
     }
 
-    /// The Y-update: `Y = (GᵀG + I)⁻¹ [Gᵀ(x + u1 − E) + w + u2] Mᵀ`, then the unknown
-    /// rows of `z` become `YM + H`. `x`, `u1` are per triangle, `w`, `u2` per unknown
-    /// row; the sums are formed here rather than in buffers of their own (a pass over
-    /// each less per iteration).
-    fn y_update(&self, factor: &Factor, targets: Targets<'_>, z: &mut [f64]) {
+    /// Unknown row `j`'s `(triangle, corner)` incidences.
+    fn incidences(&self, j: usize) -> &[(u32, u8)] {
+        &self.adj[self.adj_ptr[j] as usize..self.adj_ptr[j + 1] as usize]
+    }
+
+    /// Length of the triangle part of a state vector (see [`Problem::admm`]).
+    fn triangle_part(&self) -> usize {
+        2 * self.triangles.len() * self.n
+    }
+
+    /// `Gᵀ t₁` for the triangle part `t1` of a state vector, per unknown row (the
+    /// iterations get it from [`Problem::iterate`]'s pass over the triangles
+    /// instead; this is for the start and after a change of the penalty).
+    fn gather(&self, t1: &[f64], gt: &mut [f64]) {
         let n = self.n;
-        let mi = self.interior.len();
-        let Targets { x, u1, w, u2 } = targets;
-        // `(GᵀG + I)⁻¹` acts on rows (mesh vertices) and `MᵀM` on columns (cage
-        // vertices), so they commute: `Y M = (GᵀG + I)⁻¹ (R MᵀM)`, and `MᵀM` is the
-        // projector onto the null space of `Kᵀ`, `I − K(KᵀK)⁻¹Kᵀ`. Projecting each
-        // row of `R` (3 dot products) costs far less than multiplying by `Mᵀ` and then
-        // by `M` (n − 3 each), for three more right-hand side columns in the solve.
-        let mut y = Mat::<f64>::zeros(mi, n);
-        let mut rhs = vec![0.0; mi * n];
-        rhs.par_chunks_mut(n).enumerate().for_each_init(
-            || vec![0.0; n],
-            |acc, (j, out)| {
-                for i in 0..n {
-                    acc[i] = w[j * n + i] + u2.map_or(0.0, |u| u[j * n + i]);
+        gt.par_chunks_mut(n).enumerate().for_each(|(j, acc)| {
+            acc.fill(0.0);
+            for &(s, c) in self.incidences(j) {
+                let g = self.g[s as usize][c as usize];
+                let (tx, ty) = t1[2 * s as usize * n..(2 * s as usize + 2) * n].split_at(n);
+                for ((a, x), y) in acc.iter_mut().zip(tx).zip(ty) {
+                    *a += g.x * x + g.y * y;
                 }
-                for &(s, c) in &self.adj[self.adj_ptr[j] as usize..self.adj_ptr[j + 1] as usize] {
-                    let g = self.g[s as usize][c as usize];
-                    let base = s as usize * n;
-                    for i in 0..n {
-                        let target = u1.map_or(x[base + i], |u| x[base + i] + u[base + i]);
-                        acc[i] += g.dot(target - self.e[base + i]);
-                    }
-                }
-                let kt: DVec3 = acc.iter().zip(&self.k).map(|(a, k)| *a * *k).sum();
-                let coef = self.ktk_inv * kt;
-                for ((o, a), k) in out.iter_mut().zip(acc.iter()).zip(&self.k) {
-                    *o = a - k.dot(coef);
-                }
-            },
-        );
-        for c in 0..n {
-            for j in 0..mi {
-                y[(j, c)] = rhs[j * n + c];
-            }
-        }
-        factor.solve_in_place(y.as_mut());
-        let mut rows = vec![0.0; mi * n];
-        rows.par_chunks_mut(n).enumerate().for_each(|(j, row)| {
-            let v = self.interior[j] as usize;
-            self.least_norm(self.q[v], row);
-            for (i, value) in row.iter_mut().enumerate() {
-                *value += y[(j, i)];
             }
         });
-        for (j, row) in rows.chunks_exact(n).enumerate() {
-            let v = self.interior[j] as usize;
-            z[v * n..(v + 1) * n].copy_from_slice(row);
+    }
+
+    /// The Y-update towards the targets in the state vector `t`: the unknown rows
+    /// of `z` become `YM + H` with
+    /// `Y = (GᵀG + βM)⁻¹ [Gᵀ(t₁ − E) + βM t₂] Mᵀ`, with `Gᵀt₁` from `b.gt`.
+    ///
+    /// `(GᵀG + βM)⁻¹` acts on rows (mesh vertices) and `MᵀM` on columns (cage
+    /// vertices), so they commute: `Y M = (GᵀG + βM)⁻¹ (R MᵀM)`, and `MᵀM` is the
+    /// projector onto the null space of `Kᵀ`, `I − K(KᵀK)⁻¹Kᵀ`. Projecting each row of
+    /// `R` (3 dot products) costs far less than multiplying by `Mᵀ` and then by `M`
+    /// (n − 3 each), for three more right-hand side columns in the solve.
+    ///
+    /// Returns `‖G ΔZ‖² + β‖ΔZ‖²_M` for the change `ΔZ` of the unknown rows since the
+    /// last call, the dual residual's square over `μ²`: with `L = GᵀG + βM` and
+    /// `L Y = R`, it is `ΔY · ΔR`, a sum over the unknown rows rather than a pass over
+    /// every triangle.
+    fn y_update(&self, factor: &Factor, t: &[f64], b: &mut YBuffers, z: &mut [f64]) -> f64 {
+        let n = self.n;
+        let t2 = &t[self.triangle_part()..];
+        let gt = &b.gt;
+        b.rhs.par_chunks_mut(n).enumerate().for_each(|(j, acc)| {
+            let root = self.root[j];
+            let row = j * n..(j + 1) * n;
+            for ((a, t), (e, g)) in acc
+                .iter_mut()
+                .zip(&t2[row.clone()])
+                .zip(self.gte[row.clone()].iter().zip(&gt[row]))
+            {
+                *a = root * t - e + g;
+            }
+            let kt: DVec3 = acc.iter().zip(&self.k).map(|(a, k)| *a * *k).sum();
+            let coef = self.ktk_inv * kt;
+            for (a, k) in acc.iter_mut().zip(&self.k) {
+                *a -= k.dot(coef);
+            }
+        });
+        b.r.copy_from_slice(&b.rhs);
+        let y = MatMut::from_row_major_slice_mut(&mut b.rhs, self.interior.len(), n);
+        let (left, right) = y.split_at_col_mut(n / 2);
+        rayon::join(
+            || factor.solve_in_place(left),
+            || factor.solve_in_place(right),
+        );
+        for ((y, &v), h) in b
+            .rhs
+            .chunks_exact(n)
+            .zip(&self.interior)
+            .zip(self.h.chunks_exact(n))
+        {
+            let v = v as usize;
+            for ((w, y), h) in z[v * n..(v + 1) * n].iter_mut().zip(y).zip(h) {
+                *w = h + y;
+            }
+        }
+        let dual = if b.has_previous {
+            b.rhs
+                .par_chunks(CHUNK)
+                .zip(b.y_previous.par_chunks(CHUNK))
+                .zip(b.r.par_chunks(CHUNK).zip(b.r_previous.par_chunks(CHUNK)))
+                .map(|((y, yp), (r, rp))| {
+                    let mut sum = 0.0;
+                    for k in 0..y.len() {
+                        sum += (y[k] - yp[k]) * (r[k] - rp[k]);
+                    }
+                    sum
+                })
+                .sum()
+        } else {
+            0.0
+        };
+        std::mem::swap(&mut b.r, &mut b.r_previous);
+        std::mem::swap(&mut b.rhs, &mut b.y_previous);
+        b.has_previous = true;
+        dual
+    }
+
+    /// One ADMM iteration as a map of its state: the Y-update from `t` (into `z`),
+    /// then the multipliers `u = t − (Gz, z)`, the X-update by group soft-thresholding
+    /// (eq. 30) and the W-update by clamping (eq. 31), both over-relaxed, and the next
+    /// state `x̃ + u` into `next`; the clamped `W` goes into `clamped`. The residuals
+    /// are summed only when `measure` (they cost about a third of the pass over the
+    /// triangles).
+    #[allow(clippy::too_many_arguments)]
+    fn iterate(
+        &self,
+        factor: &Factor,
+        t: &[f64],
+        z: &mut [f64],
+        next: &mut [f64],
+        clamped: &mut [f64],
+        penalty: f64,
+        alpha: f64,
+        b: &mut YBuffers,
+        measure: bool,
+    ) -> Residuals {
+        let n = self.n;
+        let dual = self.y_update(factor, t, b, z);
+        let z = &*z;
+        let (t1, t2) = t.split_at(self.triangle_part());
+        let (next1, next2) = next.split_at_mut(self.triangle_part());
+        let inverse_penalty = 1.0 / penalty;
+        // The triangles in one contiguous range per part; each part also adds its
+        // triangles' `Gᵀ x̃` terms into its own buffer (the next Y-update's `Gᵀt₁`),
+        // so that no pass gathers them from every triangle again.
+        let per_part = self.triangles.len().div_ceil(b.parts.len()).max(1);
+        let parts = self.triangles.len().div_ceil(per_part).max(1);
+        let gradients = next1
+            .par_chunks_mut(2 * n * per_part)
+            .zip(t1.par_chunks(2 * n * per_part))
+            .zip(b.parts.par_iter_mut())
+            .enumerate()
+            .map(|(part, ((next1, t1), gt))| {
+                gt.fill(0.0);
+                let mut r = Lanes::default();
+                for (k, (out, ts)) in next1
+                    .chunks_exact_mut(2 * n)
+                    .zip(t1.chunks_exact(2 * n))
+                    .enumerate()
+                {
+                    let s = part * per_part + k;
+                    if measure {
+                        self.shrink_triangle::<true>(s, z, ts, out, inverse_penalty, alpha, &mut r);
+                    } else {
+                        self.shrink_triangle::<false>(
+                            s,
+                            z,
+                            ts,
+                            out,
+                            inverse_penalty,
+                            alpha,
+                            &mut r,
+                        );
+                    }
+                    let (ox, oy) = out.split_at(n);
+                    for (corner, &v) in self.triangles[s].iter().enumerate() {
+                        let Some(j) = self.row_of[v as usize] else {
+                            continue;
+                        };
+                        let g = self.g[s][corner];
+                        let row = &mut gt[j as usize * n..(j as usize + 1) * n];
+                        for ((a, x), y) in row.iter_mut().zip(ox).zip(oy) {
+                            *a += g.x * x + g.y * y;
+                        }
+                    }
+                }
+                r.sum()
+            })
+            .reduce(Residuals::default, Residuals::add);
+        {
+            let (first, rest) = b.parts[..parts]
+                .split_first_mut()
+                .expect("one part at least");
+            let rest = &*rest;
+            b.gt.par_chunks_mut(CHUNK)
+                .zip(first.par_chunks(CHUNK))
+                .enumerate()
+                .for_each(|(c, (gt, first))| {
+                    gt.copy_from_slice(first);
+                    for other in rest {
+                        for (a, o) in gt.iter_mut().zip(&other[c * CHUNK..]) {
+                            *a += o;
+                        }
+                    }
+                });
+        }
+        let values = next2
+            .par_chunks_mut(n)
+            .zip(t2.par_chunks(n))
+            .zip(clamped.par_chunks_mut(n))
+            .enumerate()
+            .map(|(j, ((out, tj), wj))| {
+                let v = self.interior[j] as usize;
+                let zj = &z[v * n..(v + 1) * n];
+                let (root, m) = (self.root[j], self.split[j]);
+                let mut r = Lanes::default();
+                let mut one = |i: usize, lane: usize| {
+                    let u = tj[i] / root - zj[i];
+                    let w = (zj[i] - u).max(0.0);
+                    wj[i] = w;
+                    out[i] = root * (alpha * w + (1.0 - alpha) * zj[i] + u);
+                    r.add(lane, [(w - zj[i]).powi(2), w * w, zj[i] * zj[i], u * u]);
+                };
+                for_lanes(n, &mut one);
+                r.sum().scaled(m)
+            })
+            .reduce(Residuals::default, Residuals::add);
+        let mut r = gradients.add(values);
+        r.dual = dual;
+        r
+    }
+
+    /// The X-update of [`Problem::iterate`] on triangle `s`: the gradients `p = Gz`
+    /// from its corners' rows, `u = t − p` from its part `ts` of the state, group
+    /// soft-thresholding of `p − u` by `φ√A/μ`, over-relaxation, and its part of the
+    /// next state `x̃ + u` into `out`; the residual terms go into `r`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn shrink_triangle<const MEASURE: bool>(
+        &self,
+        s: usize,
+        z: &[f64],
+        ts: &[f64],
+        out: &mut [f64],
+        inverse_penalty: f64,
+        alpha: f64,
+        r: &mut Lanes,
+    ) {
+        let n = self.n;
+        let [a, b, c] = self.triangles[s].map(|v| v as usize * n);
+        let (za, zb, zc) = (&z[a..a + n], &z[b..b + n], &z[c..c + n]);
+        let [ga, gb, gc] = self.g[s];
+        let coef = &self.coef[s * n..(s + 1) * n];
+        let (tx, ty) = ts[..2 * n].split_at(n);
+        let (ox, oy) = out[..2 * n].split_at_mut(n);
+        let step = |i: usize| {
+            let p = DVec2::new(
+                ga.x * za[i] + gb.x * zb[i] + gc.x * zc[i],
+                ga.y * za[i] + gb.y * zb[i] + gc.y * zc[i],
+            );
+            shrink(
+                p,
+                DVec2::new(tx[i], ty[i]),
+                coef[i] * inverse_penalty,
+                alpha,
+            )
+        };
+        if MEASURE {
+            for_lanes(n, &mut |i, lane| {
+                let (next, x, p, u) = step(i);
+                (ox[i], oy[i]) = (next.x, next.y);
+                r.add(
+                    lane,
+                    [
+                        (x - p).length_squared(),
+                        x.length_squared(),
+                        p.length_squared(),
+                        u.length_squared(),
+                    ],
+                );
+            });
+        } else {
+            for i in 0..n {
+                let (next, ..) = step(i);
+                (ox[i], oy[i]) = (next.x, next.y);
+            }
         }
     }
 
-    #[allow(clippy::too_many_lines)]
+    /// The state `t` = `x̃ + u` of [`Problem::iterate`]'s `next` when the penalty is
+    /// multiplied by `factor` (the scaled multipliers `u = λ/μ` divide by it):
+    /// `next − u (1 − 1/factor)`, with `u = t − (Gz, z)` recomputed from the
+    /// iteration's input `t` and its `z`.
+    fn rescale(&self, t: &[f64], z: &[f64], next: &mut [f64], factor: f64) {
+        let n = self.n;
+        let keep = 1.0 - 1.0 / factor;
+        let (t1, t2) = t.split_at(self.triangle_part());
+        let (next1, next2) = next.split_at_mut(self.triangle_part());
+        next1
+            .par_chunks_mut(2 * n)
+            .zip(t1.par_chunks(2 * n))
+            .enumerate()
+            .for_each(|(s, (out, ts))| {
+                let t = self.triangles[s].map(|v| v as usize * n);
+                let g = &self.g[s];
+                for i in 0..n {
+                    let p = g[0] * z[t[0] + i] + g[1] * z[t[1] + i] + g[2] * z[t[2] + i];
+                    out[i] -= keep * (ts[i] - p.x);
+                    out[n + i] -= keep * (ts[n + i] - p.y);
+                }
+            });
+        next2
+            .par_chunks_mut(n)
+            .zip(t2.par_chunks(n))
+            .enumerate()
+            .for_each(|(j, (out, tj))| {
+                let v = self.interior[j] as usize;
+                let root = self.root[j];
+                for i in 0..n {
+                    out[i] -= keep * (tj[i] - root * z[v * n + i]);
+                }
+            });
+    }
+
+    /// Appendix B's over-relaxed ADMM from the smoothest coordinates, with residual
+    /// balancing of the penalty. On return `z` holds the last Y-update's rows; the
+    /// result is the last clamped `W` (whose zeros the projection keeps).
+    ///
+    /// The iteration is written as a map of one state vector `t`, the Y-update's
+    /// targets: per triangle `x̃ + u₁` (its `n` x components, then its `n` y
+    /// components), then per unknown row `√(βm)·(w̃ + u₂)`. The Y-update gives `z`
+    /// from `t`, the multipliers are `u = t − (Gz, z)`, and the next state follows
+    /// ([`Problem::iterate`]).
     fn admm(
         &self,
         factor: &Factor,
@@ -434,143 +733,133 @@ impl Problem {
         report: &mut Report,
     ) -> Result<Vec<f64>, LbcError> {
         let n = self.n;
-        let nt = self.triangles.len();
         let mi = self.interior.len();
-        let alpha = settings.relaxation;
-        // Start from the smoothest coordinates: the Y-update with every split
-        // variable and multiplier zero (a regularised harmonic solve).
-        let zero_x = vec![DVec2::ZERO; nt * n];
-        let zero_w = vec![0.0; mi * n];
-        let start = Targets {
-            x: &zero_x,
-            u1: None,
-            w: &zero_w,
-            u2: None,
+        let len = self.triangle_part() + mi * n;
+        let mut buffers = YBuffers {
+            gt: vec![0.0; mi * n],
+            parts: vec![vec![0.0; mi * n]; rayon::current_num_threads().max(1)],
+            rhs: vec![0.0; mi * n],
+            r: vec![0.0; mi * n],
+            r_previous: vec![0.0; mi * n],
+            y_previous: vec![0.0; mi * n],
+            has_previous: false,
         };
-        self.y_update(factor, start, z);
-        drop(zero_x);
-        drop(zero_w);
-        let mut p = vec![DVec2::ZERO; nt * n];
+        // Start from the smoothest coordinates: the Y-update with every split
+        // variable and multiplier zero (a regularised harmonic solve), and the state
+        // whose multipliers are zero, `t = (Gz, √(βM) z)`, which the Y-update maps to
+        // that same `z`.
+        let mut t = vec![0.0; len];
+        self.y_update(factor, &t, &mut buffers, z);
+        let mut p = vec![DVec2::ZERO; self.triangles.len() * n];
         self.apply_g(z, &mut p);
-        let mut p_old = p.clone();
-        let mut zi_old = vec![0.0; mi * n];
-        // Scaled multipliers u = λ/μ.
-        let mut u1 = vec![DVec2::ZERO; nt * n];
-        let mut u2 = vec![0.0; mi * n];
-        let mut x = vec![DVec2::ZERO; nt * n];
-        let mut xt = vec![DVec2::ZERO; nt * n];
-        let mut w = vec![0.0; mi * n];
-        let mut wt = vec![0.0; mi * n];
-        let mut mu = settings.initial_penalty;
-        report.converged = false;
-        let tiny = 1e-14 * (((nt * 2 + mi) * n) as f64).sqrt();
-        for it in 1..=settings.max_iterations {
-            // Step 1: X by group soft-thresholding (eq. 30), W by clamping (eq. 31),
-            // both over-relaxed.
-            x.par_chunks_mut(n)
-                .zip(xt.par_chunks_mut(n))
-                .enumerate()
-                .for_each(|(s, (xs, xts))| {
-                    let base = s * n;
-                    for i in 0..n {
-                        let a = p[base + i] - u1[base + i];
-                        let thr = self.coef[base + i] / mu;
-                        let len = a.length();
-                        let v = if len <= thr {
-                            DVec2::ZERO
-                        } else {
-                            (1.0 - thr / len) * a
-                        };
-                        xs[i] = v;
-                        xts[i] = alpha * v + (1.0 - alpha) * p[base + i];
-                    }
-                });
-            w.par_chunks_mut(n)
-                .zip(wt.par_chunks_mut(n))
-                .enumerate()
-                .for_each(|(j, (wj, wtj))| {
-                    let v = self.interior[j] as usize;
-                    for i in 0..n {
-                        let zi = z[v * n + i];
-                        let val = (zi - u2[j * n + i]).max(0.0);
-                        wj[i] = val;
-                        wtj[i] = alpha * val + (1.0 - alpha) * zi;
-                    }
-                });
-            for j in 0..mi {
-                let v = self.interior[j] as usize;
-                zi_old[j * n..(j + 1) * n].copy_from_slice(&z[v * n..(v + 1) * n]);
-            }
-            std::mem::swap(&mut p, &mut p_old);
-            // Step 2: Y with x̃ + u1 and w̃ + u2 as targets.
-            let targets = Targets {
-                x: &xt,
-                u1: Some(&u1),
-                w: &wt,
-                u2: Some(&u2),
-            };
-            self.y_update(factor, targets, z);
-            self.apply_g(z, &mut p);
-            // Step 3: multipliers; residuals (eqs. 26–27).
-            let (mut rp, mut rd, mut nx, mut nz, mut nu) = (0.0, 0.0, 0.0, 0.0, 0.0);
-            for k in 0..nt * n {
-                u1[k] += xt[k] - p[k];
-                rp += (x[k] - p[k]).length_squared();
-                rd += (p[k] - p_old[k]).length_squared();
-                nx += x[k].length_squared();
-                nz += p[k].length_squared();
-                nu += u1[k].length_squared();
-            }
-            for j in 0..mi {
-                let v = self.interior[j] as usize;
-                for i in 0..n {
-                    let k = j * n + i;
-                    let zn = z[v * n + i];
-                    u2[k] += wt[k] - zn;
-                    rp += (w[k] - zn).powi(2);
-                    rd += (zn - zi_old[k]).powi(2);
-                    nx += w[k] * w[k];
-                    nz += zn * zn;
-                    nu += u2[k] * u2[k];
+        {
+            let (t1, t2) = t.split_at_mut(self.triangle_part());
+            for (ts, ps) in t1.chunks_exact_mut(2 * n).zip(p.chunks_exact(n)) {
+                for (i, p) in ps.iter().enumerate() {
+                    ts[i] = p.x;
+                    ts[n + i] = p.y;
                 }
             }
-            let state = Progress {
+            for (j, &v) in self.interior.iter().enumerate() {
+                let v = v as usize;
+                for i in 0..n {
+                    t2[j * n + i] = self.root[j] * z[v * n + i];
+                }
+            }
+            self.gather(t1, &mut buffers.gt);
+        }
+        // The penalty to start with: the multipliers of the gradient split are
+        // bounded by the weights `φ√A` at the optimum and the split gradients are
+        // near those of the start, so `μ = ‖φ√A‖ / ‖G W₀‖` balances the residuals'
+        // first estimate.
+        let mut mu = settings.initial_penalty.unwrap_or_else(|| {
+            let gradients: f64 = p.iter().map(|p| p.length_squared()).sum();
+            let weights: f64 = self.coef.iter().map(|c| c * c).sum();
+            if gradients > 0.0 {
+                (weights / gradients).sqrt()
+            } else {
+                1.0
+            }
+        });
+        drop(p);
+        let mut next = vec![0.0; len];
+        let mut clamped = vec![0.0; mi * n];
+        let alpha = settings.relaxation;
+        report.converged = false;
+        let tiny = 1e-14 * (len as f64).sqrt();
+        let (mut last_change, mut interval) = (0, PENALTY_INTERVAL);
+        let mut state = None;
+        for it in 1..=settings.max_iterations {
+            let measure = it % MEASURE_EVERY == 0 || it == settings.max_iterations;
+            let r = self.iterate(
+                factor,
+                &t,
+                z,
+                &mut next,
+                &mut clamped,
+                mu,
+                alpha,
+                &mut buffers,
+                measure,
+            );
+            report.iterations = it;
+            if !measure {
+                std::mem::swap(&mut t, &mut next);
+                let mut shown = state.unwrap_or(Progress {
+                    iteration: it,
+                    primal_residual: f64::INFINITY,
+                    dual_residual: f64::INFINITY,
+                    primal_threshold: 0.0,
+                    dual_threshold: 0.0,
+                    penalty: mu,
+                });
+                shown.iteration = it;
+                if !progress(&shown) {
+                    return Err(LbcError::Cancelled);
+                }
+                continue;
+            }
+            let measured = Progress {
                 iteration: it,
-                primal_residual: rp.sqrt(),
-                dual_residual: mu * rd.sqrt(),
-                primal_threshold: settings.tolerance * nx.sqrt().max(nz.sqrt()) + tiny,
-                dual_threshold: settings.tolerance * mu * nu.sqrt() + tiny,
+                primal_residual: r.primal.sqrt(),
+                dual_residual: mu * r.dual.sqrt(),
+                primal_threshold: settings.tolerance * r.split.max(r.unknown).sqrt() + tiny,
+                dual_threshold: settings.tolerance * mu * r.multiplier.sqrt() + tiny,
                 penalty: mu,
             };
-            report.iterations = it;
+            state = Some(measured);
+            let state = measured;
             report.last = Some(state);
             if !progress(&state) {
                 return Err(LbcError::Cancelled);
             }
-            if state.primal_residual <= state.primal_threshold
+            // The first iteration's Y-update returns the start itself (zero dual
+            // residual): it cannot stop there.
+            if it > 1
+                && state.primal_residual <= state.primal_threshold
                 && state.dual_residual <= state.dual_threshold
             {
                 report.converged = true;
                 break;
             }
-            if settings.adaptive_penalty && it % 25 == 0 {
-                let rel_p = state.primal_residual / state.primal_threshold;
-                let rel_d = state.dual_residual / state.dual_threshold;
-                let factor = if rel_p > 10.0 * rel_d {
-                    2.0
-                } else if rel_d > 10.0 * rel_p {
-                    0.5
-                } else {
-                    1.0
-                };
-                if factor != 1.0 {
-                    mu *= factor;
-                    u1.par_iter_mut().for_each(|u| *u /= factor);
-                    u2.par_iter_mut().for_each(|u| *u /= factor);
-                }
+            let ratio = (state.primal_residual / state.primal_threshold)
+                / (state.dual_residual / state.dual_threshold);
+            if settings.adaptive_penalty
+                && it - last_change >= interval
+                && !(1.0 / PENALTY_BAND..=PENALTY_BAND).contains(&ratio)
+            {
+                // Residual balancing: the penalty moves towards equal relative
+                // residuals, by at most a factor of ten, and less and less often.
+                let factor = ratio.sqrt().clamp(0.1, 10.0);
+                mu *= factor;
+                self.rescale(&t, z, &mut next, factor);
+                self.gather(&next[..self.triangle_part()], &mut buffers.gt);
+                last_change = it;
+                interval *= 2;
             }
+            std::mem::swap(&mut t, &mut next);
         }
-        Ok(w)
+        Ok(clamped)
     }
 
     /// Projects every unknown row onto `{w ≥ 0, Σ w_i c_i = x, Σ w_i = 1}`, first
@@ -624,15 +913,134 @@ impl Problem {
     }
 }
 
-/// What the Y-update pulls towards: `x + u1` per triangle and `w + u2` per unknown row
-/// (no multipliers: `x` and `w` alone).
-#[derive(Clone, Copy)]
-struct Targets<'a> {
-    x: &'a [DVec2],
-    u1: Option<&'a [DVec2]>,
-    w: &'a [f64],
-    u2: Option<&'a [f64]>,
+/// The Y-update's right-hand side and solution, and the last ones, for the dual
+/// residual.
+struct YBuffers {
+    /// `Gᵀt₁` of the state the next Y-update starts from.
+    gt: Vec<f64>,
+    /// One `Gᵀt₁` buffer per part of the triangles (see [`Problem::iterate`]).
+    parts: Vec<Vec<f64>>,
+    /// `R`, solved in place into `Y`.
+    rhs: Vec<f64>,
+    /// A copy of `R`.
+    r: Vec<f64>,
+    r_previous: Vec<f64>,
+    y_previous: Vec<f64>,
+    has_previous: bool,
 }
+
+/// Chunk length of the parallel sums over the unknown rows.
+const CHUNK: usize = 1 << 14;
+
+/// Squared norms one iteration adds up, for the residuals and their thresholds.
+#[derive(Clone, Copy, Debug, Default)]
+struct Residuals {
+    /// `‖X − GZ‖² + ‖W − Z‖²_βM`.
+    primal: f64,
+    /// `‖G(Z − Z_prev)‖² + ‖Z − Z_prev‖²_βM`.
+    dual: f64,
+    /// `‖X‖² + ‖W‖²_βM`.
+    split: f64,
+    /// `‖GZ‖² + ‖Z‖²_βM`.
+    unknown: f64,
+    /// `‖u‖²`, scaled multipliers.
+    multiplier: f64,
+}
+
+impl Residuals {
+    fn scaled(self, m: f64) -> Self {
+        Self {
+            primal: m * self.primal,
+            dual: m * self.dual,
+            split: m * self.split,
+            unknown: m * self.unknown,
+            multiplier: m * self.multiplier,
+        }
+    }
+
+    fn add(self, o: Self) -> Self {
+        Self {
+            primal: self.primal + o.primal,
+            dual: self.dual + o.dual,
+            split: self.split + o.split,
+            unknown: self.unknown + o.unknown,
+            multiplier: self.multiplier + o.multiplier,
+        }
+    }
+}
+
+/// How many independent running sums [`Lanes`] keeps per term, so that a loop adding
+/// to them can run in SIMD lanes (floating-point sums in one accumulator cannot be
+/// reordered, which keeps a loop scalar).
+const LANES: usize = 8;
+
+/// Running sums of [`Residuals`]' terms but the dual one, [`LANES`] partial sums each.
+#[derive(Default)]
+struct Lanes([[f64; LANES]; 4]);
+
+impl Lanes {
+    #[inline(always)]
+    fn add(&mut self, lane: usize, terms: [f64; 4]) {
+        for (a, t) in self.0.iter_mut().zip(terms) {
+            a[lane] += t;
+        }
+    }
+
+    fn sum(&self) -> Residuals {
+        let [primal, split, unknown, multiplier] = self.0.map(|a| a.iter().sum());
+        Residuals {
+            primal,
+            dual: 0.0,
+            split,
+            unknown,
+            multiplier,
+        }
+    }
+}
+
+/// One entry of the X-update: from the gradient `p` and the state `t`, the
+/// multiplier `u = t − p`, `x` = `p − u` group soft-thresholded by `threshold`, and
+/// the next state `αx + (1 − α)p + u`. Returns `(next, x, p, u)`.
+#[inline(always)]
+fn shrink(p: DVec2, t: DVec2, threshold: f64, alpha: f64) -> (DVec2, DVec2, DVec2, DVec2) {
+    let u = t - p;
+    let a = p - u;
+    let keep = (1.0 - threshold / a.length().max(f64::MIN_POSITIVE)).max(0.0);
+    let x = keep * a;
+    (alpha * x + (1.0 - alpha) * p + u, x, p, u)
+}
+
+/// Calls `f(i, lane)` for `i` in `0..n`, in blocks of [`LANES`] with `lane` the
+/// position in the block (a fixed-length inner loop the compiler vectorises), the
+/// remainder in lane 0.
+#[inline(always)]
+fn for_lanes(n: usize, f: &mut impl FnMut(usize, usize)) {
+    let blocks = n / LANES;
+    for b in 0..blocks {
+        for lane in 0..LANES {
+            f(b * LANES + lane, lane);
+        }
+    }
+    for i in blocks * LANES..n {
+        f(i, 0);
+    }
+}
+
+/// `β`: the `W = W̃` split enters the augmented Lagrangian as `β‖W − W̃‖²_M`, the
+/// squared L² norm of the difference (lumped mass `M`), so that the Y-update matrix
+/// `GᵀG + βM` discretises `−Δ + β` at any mesh resolution.
+const SPLIT_WEIGHT: f64 = 1.0;
+
+/// The residuals are measured (and the stopping test and residual balancing run)
+/// every this many iterations.
+const MEASURE_EVERY: usize = 5;
+
+/// Residual balancing waits this many iterations before its first change of the
+/// penalty, and twice as long after each change (changes that never stop can keep
+/// ADMM from converging)…
+const PENALTY_INTERVAL: usize = 10;
+/// …and moves the penalty when their relative sizes differ by more than this factor.
+const PENALTY_BAND: f64 = 2.0;
 
 /// The Euclidean projection of `w0` onto `{w ≥ 0, Kᵀw = b}`: `w = max(0, w0 + Kν)`
 /// with `ν` minimising the (convex, piecewise quadratic) dual
