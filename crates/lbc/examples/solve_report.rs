@@ -3,7 +3,7 @@
 //!
 //! ```text
 //! cargo run --release -p lbc --example solve_report -- [--tolerance T] [--only NAME]
-//!     [--vertices N] [--penalty MU] [--trace]
+//!     [--vertices N] [--penalty MU] [--relaxation ALPHA] [--trace]
 //! ```
 //!
 //! `--penalty` fixes `μ` (no residual balancing); `--trace` prints the residuals as
@@ -30,6 +30,7 @@ fn main() {
         tolerance: number("--tolerance").unwrap_or(lbc::DEFAULT_TOLERANCE),
         initial_penalty: penalty,
         adaptive_penalty: penalty.is_none(),
+        relaxation: number("--relaxation").unwrap_or(Settings::default().relaxation),
         ..Settings::default()
     };
     let trace = args.iter().any(|a| a == "--trace");
