@@ -209,6 +209,8 @@ struct Seen {
     cells: u64,
     /// Whether the frame showed the cage tool's view.
     cage_view: bool,
+    /// Whether a solved cage warped it.
+    warping: bool,
     /// The picture and solved cage the backdrop was made from (held, so that a new
     /// one is a new allocation), so that editing an unsolved cage does not upload the
     /// picture again.
@@ -375,7 +377,7 @@ impl EditorApp {
             let mesh = &self.gpu.mesh.value;
             let (samples, what) = if !self.seen.cage_view {
                 (doc.rig().domain().len(), "the rig")
-            } else if doc.method() == Method::Lbc {
+            } else if self.seen.warping {
                 let solved = doc.cage_solution().map(|s| s.domain.positions().len());
                 (solved.unwrap_or(0), "the cage's mesh")
             } else {
@@ -1302,13 +1304,11 @@ impl EditorApp {
     /// the CPU side of what a frame uploads; the canvas calls it every frame.
     pub fn update_gpu_frame(&mut self) {
         let cage_view = self.cage_view();
+        let warping = self.cage_warping();
         let focus = self.cage.focus();
         let Some(doc) = &self.doc else { return };
-        // The cage's mesh with its coordinates, when LBC warps the picture.
-        let cage = doc
-            .cage_solution()
-            .filter(|_| cage_view && doc.method() == Method::Lbc)
-            .cloned();
+        // The cage's mesh with its coordinates, when it warps the picture.
+        let cage = doc.cage_solution().filter(|_| warping).cloned();
         let counter = &mut self.next_version;
         let mut bump = || {
             *counter += 1;
@@ -1324,8 +1324,10 @@ impl EditorApp {
                 value: doc.image.clone(),
             };
         }
-        let weights_changed =
-            image_is_new || weights != seen.weights || cage_view != seen.cage_view;
+        let weights_changed = image_is_new
+            || weights != seen.weights
+            || cage_view != seen.cage_view
+            || warping != seen.warping;
         if weights_changed && cage_view {
             let size = [doc.image.width(), doc.image.height()];
             let mesh = match &cage {
@@ -1457,6 +1459,7 @@ impl EditorApp {
         seen.weights = weights;
         seen.pose = doc.pose_version;
         seen.cage_view = cage_view;
+        seen.warping = warping;
     }
 }
 

@@ -273,6 +273,12 @@ impl EditorApp {
         self.tool == Tool::Cage || self.doc.as_ref().is_some_and(|d| d.method() == Method::Lbc)
     }
 
+    /// Whether a solved cage warps the view: LBC with its cage solved, and no new
+    /// polygon being drawn (that is drawn over the picture at rest).
+    pub(crate) fn cage_warping(&self) -> bool {
+        self.cage.draft.is_none() && self.doc.as_ref().is_some_and(|d| d.cage_warps())
+    }
+
     /// The cage's vertices as the tool shows them: rest positions while drawing or
     /// editing at rest, posed ones when posing.
     fn shown_cage(&self) -> Vec<DVec2> {
@@ -756,7 +762,7 @@ impl EditorApp {
     pub(crate) fn paint_cage(&mut self, painter: &egui::Painter, pointer: Option<Pos2>) {
         let state = self.cage_state();
         let v = self.viewport;
-        let warps = self.doc.as_ref().is_some_and(|d| d.cage_warps());
+        let warps = self.cage_warping();
         if warps && self.show.heat && self.show.contour {
             self.paint_contour(painter);
         }
@@ -883,10 +889,10 @@ impl EditorApp {
     /// The coordinates of the cage mesh's vertex under the pointer, beside it.
     pub(crate) fn cage_hover(&mut self, pointer: Pos2) -> Option<String> {
         let at = self.viewport.to_image(pointer);
-        let doc = self.doc.as_mut()?;
-        if !doc.cage_warps() {
+        if !self.cage_warping() {
             return None;
         }
+        let doc = self.doc.as_mut()?;
         let deformed = doc.cage_deformed()?.to_vec();
         let solution = doc.cage_solution()?.clone();
         let positions = solution.domain.positions();
@@ -912,7 +918,7 @@ impl EditorApp {
         row.sort_by(|a, b| b.1.total_cmp(&a.1));
         let rest = positions[vertex];
         let mut text = format!(
-            "cage mesh vertex {vertex} at ({:.1}, {:.1}): {} coordinates",
+            "vertex {vertex} at ({:.1}, {:.1}): {} coordinates",
             rest.x,
             rest.y,
             row.len()

@@ -86,9 +86,7 @@ impl EditorApp {
         if self.has_gpu {
             let (scale, offset) = self.viewport.device_map();
             let shown = if cage_view {
-                self.cage
-                    .focus()
-                    .filter(|_| self.doc.as_ref().is_some_and(|d| d.cage_warps()))
+                self.cage.focus().filter(|_| self.cage_warping())
             } else {
                 self.selected
             };
@@ -604,6 +602,8 @@ impl EditorApp {
         if corner.y + size.y > canvas.max.y {
             corner.y = pos.y - 16.0 - size.y;
         }
+        // Never past the canvas's left or top edge, where it would be cut.
+        corner = corner.max(canvas.min);
         let frame = Rect::from_min_size(corner, size);
         painter.rect_filled(frame, 4.0, Color32::from_black_alpha(200));
         painter.galley(corner + Vec2::splat(6.0), galley, Color32::from_gray(230));

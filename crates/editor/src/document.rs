@@ -1278,6 +1278,108 @@ mod tests {
         }
     }
 
+    /// A rectangle on [`document`]'s picture.
+    fn cage(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<[f64; 2]> {
+        vec![[x0, y0], [x1, y0], [x1, y1], [x0, y1]]
+    }
+
+    #[test]
+    fn a_cage_is_solved_once_per_rest_cage_and_found_again_after_an_undo() {
+        let mut doc = document();
+        let rest = cage(8.0, 8.0, 56.0, 40.0);
+        doc.apply(Edit::Cage {
+            rest: rest.clone(),
+            vertices: 120,
+        })
+        .expect("a cage");
+        assert_eq!(doc.method(), Method::Lbc);
+        assert_eq!(doc.project().lbc.and_then(|l| l.density), Some(120));
+        assert!(doc.cage_solution().is_none(), "not solved until asked");
+        doc.solve_cage(&mut |_| true).expect("solved");
+        let solved = doc.cage_solution().expect("solved").clone();
+        doc.sanity_check().expect("consistent");
+
+        // A pose moves the cage's mesh and keeps the coordinates.
+        let (weights, pose_version) = (doc.weights_version, doc.pose_version);
+        let mut pose = rest.clone();
+        pose[2] = [60.0, 46.0];
+        doc.apply(Edit::CagePose(pose.clone())).expect("posed");
+        assert!(Arc::ptr_eq(doc.cage_solution().expect("kept"), &solved));
+        assert_eq!(doc.weights_version, weights);
+        assert!(doc.pose_version > pose_version);
+        let corner = solved.domain.cage_vertices()[2] as usize;
+        let moved = doc.cage_deformed().expect("solved")[corner];
+        assert!((moved - DVec2::new(60.0, 46.0)).length() < 1e-9, "{moved}");
+        let posed = doc.snapshot();
+
+        // Another rest cage needs a solve; the pose goes back to rest.
+        doc.apply(Edit::Cage {
+            rest: cage(4.0, 4.0, 30.0, 30.0),
+            vertices: 500,
+        })
+        .expect("another cage");
+        assert!(doc.cage_solution().is_none());
+        assert_eq!(doc.cage().and_then(|c| c.pose.clone()), None);
+        assert_eq!(
+            doc.project().lbc.and_then(|l| l.density),
+            Some(120),
+            "the project's count stays"
+        );
+        // Back to the solved cage: its coordinates are found, not solved again.
+        doc.undo_to(posed.clone()).expect("undo");
+        assert!(Arc::ptr_eq(doc.cage_solution().expect("found"), &solved));
+        assert_eq!(doc.snapshot(), posed);
+        doc.sanity_check().expect("consistent");
+    }
+
+    #[test]
+    fn bad_cage_edits_change_nothing() {
+        let mut doc = document();
+        assert!(
+            doc.apply(Edit::Method(Method::Lbc)).is_err(),
+            "LBC needs a cage"
+        );
+        assert!(doc.apply(Edit::CagePose(cage(0.0, 0.0, 1.0, 1.0))).is_err());
+        let off = Edit::Cage {
+            rest: cage(8.0, 8.0, 90.0, 40.0),
+            vertices: 100,
+        };
+        assert!(doc.apply(off).is_err(), "off the picture");
+        let two = Edit::Cage {
+            rest: vec![[1.0, 1.0], [5.0, 5.0]],
+            vertices: 100,
+        };
+        assert!(doc.apply(two).is_err(), "two vertices");
+        assert!(doc.cage().is_none());
+        let rest = cage(8.0, 8.0, 56.0, 40.0);
+        doc.apply(Edit::Cage {
+            rest: rest.clone(),
+            vertices: 100,
+        })
+        .expect("a cage");
+        let before = doc.project().clone();
+        assert!(doc.apply(Edit::CagePose(vec![[1.0, 1.0]])).is_err());
+        assert!(
+            doc.apply(Edit::CagePose(vec![[f64::NAN, 1.0]; 4])).is_err(),
+            "NaN"
+        );
+        assert_eq!(doc.project(), &before);
+        // A crossing cage is kept (to be fixed) but cannot be solved.
+        let bow = vec![[8.0, 8.0], [56.0, 8.0], [8.0, 40.0], [56.0, 40.0]];
+        doc.apply(Edit::Cage {
+            rest: bow,
+            vertices: 100,
+        })
+        .expect("kept");
+        let err = doc.solve_cage(&mut |_| true).expect_err("crossing");
+        assert!(err.to_string().contains("intersect"), "{err}");
+        // Clearing the cage goes back to C².
+        doc.apply(Edit::ClearCage).expect("cleared");
+        assert_eq!(doc.method(), Method::C2);
+        assert!(doc.cage().is_none());
+        doc.sanity_check().expect("consistent");
+    }
+
     #[test]
     fn segment_distances() {
         let p = |x, y| DVec2::new(x, y);

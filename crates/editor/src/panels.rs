@@ -394,28 +394,48 @@ impl EditorApp {
             let mut tool = self.tool;
             // Under LBC the cage moves the picture: handles wait for C² or ARAP.
             let handles = self.doc.as_ref().is_none_or(|d| d.method() != Method::Lbc);
-            ui.add_enabled_ui(handles, |ui| {
-                ui.selectable_value(&mut tool, Tool::Puppet, "Puppet")
-                    .on_hover_text(
-                        "Click the picture to add a handle; drag a handle to move it; \
-                         Alt-click a handle to delete it; drag empty canvas to pan",
-                    );
-                ui.selectable_value(&mut tool, Tool::Select, "Select")
-                    .on_hover_text("Like Puppet, but a click on the picture adds nothing");
-                ui.selectable_value(&mut tool, Tool::AddPoint, "Add point");
-                ui.selectable_value(&mut tool, Tool::AddBar, "Add bar")
-                    .on_hover_text("Drag from one end of the bar to the other");
-                ui.selectable_value(&mut tool, Tool::Rigidity, "Rigidity")
-                    .on_hover_text(
-                        "Paint stiffness (ARAP): painted parts keep their shape; Alt-drag \
-                         erases. One undo step per stroke",
-                    );
-            });
-            ui.selectable_value(&mut tool, Tool::Cage, "Cage")
-                .on_hover_text(
+            let tools = [
+                (
+                    Tool::Puppet,
+                    "Puppet",
+                    "Click the picture to add a handle; drag a handle to move it; \
+                     Alt-click a handle to delete it; drag empty canvas to pan",
+                ),
+                (
+                    Tool::Select,
+                    "Select",
+                    "Like Puppet, but a click on the picture adds nothing",
+                ),
+                (Tool::AddPoint, "Add point", "Click to add a point handle"),
+                (
+                    Tool::AddBar,
+                    "Add bar",
+                    "Drag from one end of the bar to the other",
+                ),
+                (
+                    Tool::Rigidity,
+                    "Rigidity",
+                    "Paint stiffness (ARAP): painted parts keep their shape; Alt-drag \
+                     erases. One undo step per stroke",
+                ),
+                (
+                    Tool::Cage,
+                    "Cage",
                     "LBC's cage (K): click a polygon around the subject, adjust it, \
                      solve it, then drag its vertices to warp what lies inside",
-                );
+                ),
+            ];
+            for (t, label, hover) in tools {
+                let enabled = handles || t == Tool::Cage;
+                let button = egui::Button::selectable(tool == t, label);
+                if ui
+                    .add_enabled(enabled, button)
+                    .on_hover_text(hover)
+                    .clicked()
+                {
+                    tool = t;
+                }
+            }
             if tool != self.tool {
                 self.set_tool(tool);
             }
