@@ -101,6 +101,8 @@ pub struct CageTool {
     pub(crate) edit_rest: bool,
     /// How many vertices "Cage from outline" makes.
     pub outline_vertices: usize,
+    /// The "Vertices inside" slider's value while it is dragged.
+    pub(crate) density_draft: Option<usize>,
     /// The support contour of the heat map's vertex, by (vertex, weights version):
     /// segments between points on mesh edges `(a, b, t)`, `t` from `a` to `b`.
     pub(crate) contour: Option<CachedContour>,
@@ -115,6 +117,7 @@ impl Default for CageTool {
             boxing: None,
             edit_rest: false,
             outline_vertices: 16,
+            density_draft: None,
             contour: None,
         }
     }
@@ -503,7 +506,8 @@ impl EditorApp {
                 let draft = self.cage.draft.get_or_insert_with(Vec::new);
                 if draft.len() >= 3 && draft.first().is_some_and(near) {
                     self.close_cage();
-                } else if !draft.last().is_some_and(near) {
+                } else if !draft.iter().any(near) {
+                    // A click on a vertex already drawn adds none on top of it.
                     draft.push(at);
                 }
             }
@@ -1005,15 +1009,10 @@ impl EditorApp {
                         self.toggle_cage_rest();
                     }
                 }
-                if ui.button("Reset cage pose").clicked() {
-                    self.reset_cage_pose();
-                }
+                // Reset pose and Clear cage are among the edit buttons above.
                 if ui.button("New cage").clicked() {
                     self.cage.selected.clear();
                     self.cage.draft = Some(Vec::new());
-                }
-                if ui.button("Clear cage").clicked() {
-                    self.clear_cage();
                 }
             }
         });
@@ -1045,9 +1044,11 @@ impl EditorApp {
                     ui.selectable_value(&mut settings.tau, tau, tau_name(tau));
                 }
             });
-        let mut density = settings
+        let current_density = settings
             .density
             .unwrap_or(pipeline::cage::DEFAULT_CAGE_VERTICES);
+        // The slider's value while it is dragged; applied when it is released.
+        let mut density = self.cage.density_draft.unwrap_or(current_density);
         let r = ui
             .add(
                 egui::Slider::new(&mut density, 100..=20_000)
@@ -1060,6 +1061,9 @@ impl EditorApp {
             );
         if r.drag_stopped() || (r.changed() && !r.dragged()) {
             settings.density = Some(density);
+            self.cage.density_draft = None;
+        } else if density != current_density {
+            self.cage.density_draft = Some(density);
         }
         if settings != current {
             let _ = self.edit(Edit::Lbc(settings));
@@ -1153,6 +1157,12 @@ impl EditorApp {
         let response = plot("locality-q", "k", "Q(k)")
             .include_x(0.0)
             .include_x(n as f64)
+            // k counts cage vertices: marks at whole numbers.
+            .x_grid_spacer(egui_plot::uniform_grid_spacer(|input| {
+                let span = (input.bounds.1 - input.bounds.0).max(1.0);
+                let unit = 10f64.powf((span / 50.0).log10().ceil().max(0.0));
+                [unit, 5.0 * unit, 10.0 * unit]
+            }))
             .show(ui, |plot| {
                 plot.line(egui_plot::Line::new("Q(k)", q.clone()).color(SELECTED));
                 plot.points(

@@ -256,12 +256,34 @@ fn a_box_selected_group_moves_together_and_reset_pose_brings_it_back() {
     click_label(&mut h, "Reset pose");
     assert_eq!(pose(&h), None);
     h.state().sanity_check().expect("consistent");
+
+    // Clearing the solved cage goes back to C²; undoing it finds the coordinates
+    // again, with no new solve.
+    click_label(&mut h, "Clear cage");
+    let doc = h.state().document().expect("doc");
+    assert!(doc.cage().is_none());
+    assert_eq!(doc.method(), Method::C2);
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.step();
+    assert!(!h.state().is_busy());
+    assert_eq!(h.state().cage_state(), CageState::Posed);
+    h.state().sanity_check().expect("consistent");
 }
 
 #[test]
 fn a_crossing_cage_is_refused_and_can_be_fixed() {
     let dir = tempfile::tempdir().expect("temp dir");
     let mut h = editor(dir.path());
+    // Two vertices are no cage (a click on the first adds nothing).
+    draw_cage(&mut h, &[[200.0, 200.0], [400.0, 200.0]]);
+    assert_eq!(h.state().cage_draft().map(<[DVec2]>::len), Some(2));
+    h.key_press(Key::Enter);
+    h.run();
+    let message = h.state().message.clone().expect("a message");
+    assert!(message.text.contains("at least 3"), "{message:?}");
+    h.key_press(Key::Escape);
+    h.run();
+    assert!(h.state().cage_draft().is_none(), "Escape drops the polygon");
     // A bow tie.
     let bow = [
         [200.0, 200.0],
@@ -325,6 +347,8 @@ fn a_cancelled_solve_leaves_everything_as_it_was() {
     h.step();
     assert!(h.state().is_busy());
     assert!(!h.state_mut().edit(Edit::Method(Method::C2)));
+    h.state_mut().undo();
+    assert_eq!(h.state().history_len(), undo, "no undo under a solve");
     h.state_mut().cancel_job();
     h.run();
     assert_eq!(h.state().document().expect("doc").method(), Method::Lbc);

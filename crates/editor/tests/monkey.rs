@@ -154,7 +154,6 @@ const LABELS: &[&str] = &[
     "Solve",
     "Edit the rest cage",
     "Pose the cage",
-    "Reset cage pose",
     "New cage",
     "Clear cage",
     "Cage from outline",
