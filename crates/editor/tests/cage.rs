@@ -466,3 +466,50 @@ fn the_cage_view_shows_the_heat_map_contour_and_locality_plots() {
     );
     h.snapshot("editor_cage");
 }
+
+#[test]
+fn undo_to_a_posed_cage_whose_coordinates_were_forgotten_solves_it_first() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = solved_body(dir.path());
+    let from = at(&h, BODY[1][0], BODY[1][1]);
+    drag(&mut h, from, from + Vec2::new(25.0, -20.0), Modifiers::NONE);
+    let posed = pose(&h).expect("posed");
+    // Four more cages, each solved: the editor keeps four, so the first is forgotten.
+    for shift in 1..=4 {
+        let rest = BODY
+            .iter()
+            .map(|p| [p[0] + 5.0 * f64::from(shift), p[1]])
+            .collect();
+        assert!(h.state_mut().edit(Edit::Cage {
+            rest,
+            vertices: DENSITY
+        }));
+        h.state_mut().solve_cage();
+        settle(&mut h);
+        assert_eq!(h.state().cage_state(), CageState::Posed);
+    }
+    let (undo, _) = h.state().history_len();
+    // Back through the later cages (kept, so at once), then to the posed first one.
+    for _ in 0..3 {
+        h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+        h.step();
+        assert!(!h.state().is_busy(), "a kept cage needs no solve");
+    }
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.step();
+    assert!(
+        h.state().is_busy(),
+        "the forgotten cage is solved on the worker"
+    );
+    assert_eq!(
+        h.state().history_len().0,
+        undo - 3,
+        "the history waits for the solve"
+    );
+    assert_eq!(pose(&h), None);
+    settle(&mut h);
+    assert_eq!(h.state().history_len().0, undo - 4);
+    assert_eq!(pose(&h).as_ref(), Some(&posed));
+    assert_eq!(h.state().cage_state(), CageState::Posed);
+    h.state().sanity_check().expect("consistent");
+}
