@@ -1,11 +1,15 @@
 #!/usr/bin/env bash
 # Runs the real editor window under Xvfb, drives it with xdotool like a user (select a
 # handle, show its weight, the dual graph, hover for the weights tooltip), and saves a
-# screenshot. Usage: scripts/screenshot.sh [OUT.png]   (default: assets/screenshot.png)
+# screenshot. Usage: scripts/screenshot.sh [OUT.png] [cage]
+# (default: assets/screenshot.png). With `cage`: the cage tool instead — a cage from
+# the lizard's outline, solved, two vertices dragged, the last one's coordinate as a
+# heat map, the locality plots (assets/screenshot-cage.png).
 # Needs what scripts/setup.sh installs.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-assets/screenshot.png}
+mode=${2:-handles}
 cargo build --release --quiet
 display=:97
 Xvfb "$display" -screen 0 1280x820x24 >/dev/null 2>&1 &
@@ -27,6 +31,38 @@ sleep 3
 xdotool windowfocus "$window" || true
 xdotool mousemove 1150 760 click 1
 sleep 0.5
+# Drags from one screen point to another in eight steps, as a hand would.
+drag() {
+  xdotool mousemove "$1" "$2" mousedown 1
+  sleep 0.3
+  for i in 1 2 3 4 5 6 7 8; do
+    xdotool mousemove $(($1 + ($3 - $1) * i / 8)) $(($2 + ($4 - $2) * i / 8))
+    sleep 0.1
+  done
+  xdotool mouseup 1
+  sleep 0.6
+}
+if [ "$mode" = cage ]; then
+  # The cage tool (K), then its panel's "Cage from outline", the heat map (H), Solve
+  # (Enter) and a wait for the solve.
+  xdotool key k
+  sleep 1
+  xdotool mousemove 155 374 click 1
+  sleep 1
+  xdotool key h
+  sleep 0.5
+  xdotool key Return
+  # The solve takes a few seconds in a release build.
+  sleep "${SOLVE_SECONDS:-12}"
+  # The tail's end, then the front leg.
+  drag 842 685 905 610
+  drag 707 309 775 240
+  xdotool mousemove 1100 760
+  sleep 1.5
+  import -window root "$out"
+  echo "screenshot: $out"
+  exit 0
+fi
 for key in n n h g; do
   xdotool key "$key"
   sleep 0.5

@@ -559,3 +559,51 @@ fn render_by_a_cage_moves_the_inside_and_keeps_the_outside() {
     ));
     assert!(line.contains("--gpu"), "{line}");
 }
+
+/// The editor's export of an LBC project (a cage on the built-in lizard, solved and
+/// posed) is what `c2warp render` draws for the project the editor saved: the same
+/// count of mesh vertices inside the cage (`lbc.density`, ahead of the picture's
+/// `density` the editor also writes), the same solve, the same warp.
+#[test]
+fn the_editors_cage_export_is_what_render_draws_for_its_saved_project() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let picture = dir.path().join("lizard.png");
+    fs::write(&picture, pipeline::DEFAULT_IMAGE).expect("write the picture");
+    let mut doc = editor::Document::built_in().expect("the built-in picture");
+    let rest = vec![
+        [220.0, 200.0],
+        [390.0, 190.0],
+        [450.0, 300.0],
+        [390.0, 430.0],
+        [240.0, 430.0],
+        [170.0, 320.0],
+    ];
+    doc.apply(editor::Edit::Cage {
+        rest: rest.clone(),
+        vertices: 300,
+    })
+    .expect("a cage");
+    doc.solve_cage(&mut |_| true).expect("solved");
+    let mut pose = rest.clone();
+    pose[1] = [430.0, 160.0];
+    pose[3] = [370.0, 460.0];
+    doc.apply(editor::Edit::CagePose(pose)).expect("posed");
+    let mut app = editor::EditorApp::with_document(doc);
+    let project = dir.path().join("project.json");
+    app.save_to(&project);
+    let exported = dir.path().join("editor.png");
+    app.export_to(&exported);
+    assert!(exported.exists(), "{:?}", app.message);
+    let saved = fs::read_to_string(&project).expect("saved");
+    assert!(saved.contains(r#""density": 300"#), "{saved}");
+
+    let rendered = dir.path().join("render.png");
+    ok(&render_args(&picture, &project, &rendered, &[]));
+    let (worst, share) = difference(&load(&exported), &load(&rendered), 0);
+    assert!(
+        share < 1e-4,
+        "{share} of the pixels differ, by up to {worst}"
+    );
+    let (_, warped) = difference(&load(&rendered), &load(&picture), 8);
+    assert!(warped > 0.001, "the cage moved the picture ({warped})");
+}

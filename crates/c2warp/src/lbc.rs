@@ -11,21 +11,15 @@ use serde::Serialize;
 
 use crate::Source;
 
-/// Mesh vertices inside a cage when neither `--density` nor the rig names a count:
-/// the solve's time grows quickly with it (a few seconds at this size).
-pub const DEFAULT_CAGE_VERTICES: usize = 2000;
-
 /// Meshes the inside of `project`'s cage (`--image`: triangulated to `--density`, the
-/// rig's `density` or [`DEFAULT_CAGE_VERTICES`]; `--mesh`: the file's triangulation,
-/// as is) and solves its coordinates, with a progress counter.
+/// rig's `lbc.density`, its `density` or [`pipeline::cage::DEFAULT_CAGE_VERTICES`]:
+/// [`pipeline::cage::cage_vertices`]; `--mesh`: the file's triangulation, as is) and
+/// solves its coordinates, with a progress counter.
 pub fn solve(source: &Source, project: &Project) -> Result<CageCoordinates> {
     let mesh = if let Some(path) = &source.image {
         let image = pipeline::load_image(path)?;
         project.validate(Some(image.dimensions()))?;
-        let target_vertices = source
-            .density
-            .or(project.density)
-            .unwrap_or(DEFAULT_CAGE_VERTICES);
+        let target_vertices = pipeline::cage::cage_vertices(project, source.density);
         project::validate_density(target_vertices)?;
         CageMesh::Triangulate { target_vertices }
     } else {
@@ -91,7 +85,7 @@ pub fn render(
     }
     let image = picture.to_rgba8();
     project.validate(Some(image.dimensions()))?;
-    let target_vertices = density.or(project.density).unwrap_or(DEFAULT_CAGE_VERTICES);
+    let target_vertices = pipeline::cage::cage_vertices(project, density);
     project::validate_density(target_vertices)?;
     let solved = solve_on(project, CageMesh::Triangulate { target_vertices })?;
     Ok(render::Picture::Rgba8(pipeline::cage::warp_by_cage(

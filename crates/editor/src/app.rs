@@ -10,9 +10,9 @@ use glam::DVec2;
 use project::{HandleSpec, Method};
 
 use crate::dialogs::{Answer, BuiltinDialog, Dialogs, FileAction, NativeDialogs, Shown};
-use crate::document::{Document, Edit, posed};
+use crate::document::{CageKey, Document, Edit, posed};
 use crate::history::History;
-use crate::jobs::{CancelFlag, Job, Outcome, Rebuild};
+use crate::jobs::{CancelFlag, Job, Outcome, Rebuild, SolveProgress};
 use crate::scene::{GpuFrame, MeshData, SceneResources, Versioned};
 use crate::viewport::Viewport;
 
@@ -31,6 +31,8 @@ pub enum Tool {
     AddBar,
     /// Paint rigidity (ARAP); Alt-drag erases.
     Rigidity,
+    /// Draw, adjust, solve and pose an LBC cage (see [`crate::cage`]).
+    Cage,
 }
 
 /// Which overlays are on.
@@ -52,6 +54,10 @@ pub struct Show {
     pub hover_weights: bool,
     /// Painted rigidity, translucent.
     pub rigidity: bool,
+    /// With the heat map of a cage vertex: its support contour at `10⁻³/n`.
+    pub contour: bool,
+    /// The panel of a solved cage's locality statistics.
+    pub locality: bool,
 }
 
 impl Default for Show {
@@ -65,6 +71,8 @@ impl Default for Show {
             folds: true,
             hover_weights: true,
             rigidity: true,
+            contour: true,
+            locality: true,
         }
     }
 }
@@ -169,6 +177,11 @@ pub struct EditorApp {
     pub brush: crate::brush::Brush,
     pub(crate) brush_stroke: Option<crate::brush::BrushStroke>,
     pub(crate) painted: crate::brush::PaintedCache,
+    /// The cage tool's state.
+    pub(crate) cage: crate::cage::CageTool,
+    /// Mesh vertices inside a new cage, unless the project names a count (the side
+    /// panel changes it per cage): the solve's time grows quickly with it.
+    pub cage_vertices: usize,
     /// Where the built-in file dialog starts when the document has no file of its own
     /// (else the current folder).
     pub default_folder: Option<PathBuf>,
@@ -188,12 +201,23 @@ pub struct EditorApp {
 }
 
 /// Versions the GPU frame was last built from.
-#[derive(Default, PartialEq, Clone, Copy)]
+#[derive(Default, Clone)]
 struct Seen {
     weights: u64,
     pose: u64,
     heat: Option<(usize, u64)>,
     cells: u64,
+    /// Whether the frame showed the cage tool's view.
+    cage_view: bool,
+    /// Whether a solved cage warped it.
+    warping: bool,
+    /// The picture and solved cage the backdrop was made from (held, so that a new
+    /// one is a new allocation), so that editing an unsolved cage does not upload the
+    /// picture again.
+    backdrop: Option<(
+        Arc<image::RgbaImage>,
+        Option<Arc<pipeline::cage::CageCoordinates>>,
+    )>,
 }
 
 impl EditorApp {
@@ -267,6 +291,8 @@ impl EditorApp {
             brush: crate::brush::Brush::default(),
             brush_stroke: None,
             painted: crate::brush::PaintedCache::default(),
+            cage: crate::cage::CageTool::default(),
+            cage_vertices: pipeline::cage::DEFAULT_CAGE_VERTICES,
             default_folder: None,
             gpu: GpuFrame::default(),
             has_gpu,
@@ -346,14 +372,25 @@ impl EditorApp {
         if self.bar_start.is_some() && self.tool != Tool::AddBar {
             anyhow::bail!("a bar is being drawn with the {:?} tool", self.tool);
         }
+        self.cage_sanity_check(doc)?;
         if self.seen.weights == doc.weights_version && self.gpu.mesh.version != 0 {
             let mesh = &self.gpu.mesh.value;
-            let samples = doc.rig().domain().len();
+            let (samples, what) = if !self.seen.cage_view {
+                (doc.rig().domain().len(), "the rig")
+            } else if self.seen.warping {
+                let solved = doc.cage_solution().map(|s| s.domain.positions().len());
+                (solved.unwrap_or(0), "the cage's mesh")
+            } else {
+                (0, "no mesh (a cage being drawn)")
+            };
             if mesh.rest.len() != samples || mesh.rows.len() != samples + 1 {
                 anyhow::bail!(
-                    "the GPU mesh has {} vertices, the rig {samples}",
+                    "the GPU mesh has {} vertices, {what} {samples}",
                     mesh.rest.len()
                 );
+            }
+            if self.seen.cage_view && self.gpu.backdrop.is_none() {
+                anyhow::bail!("the cage's view without the picture at rest under it");
             }
         }
         if self.log.len() > LOG_LIMIT {
@@ -363,6 +400,43 @@ impl EditorApp {
             anyhow::bail!("the view is not finite: {:?}", self.viewport);
         }
         Ok(())
+    }
+
+    /// The cage tool's part of [`EditorApp::sanity_check`]: its selection and drag
+    /// name vertices the cage has, and a polygon is drawn only with the cage tool.
+    fn cage_sanity_check(&self, doc: &Document) -> Result<()> {
+        let count = doc.cage().map_or(0, |c| c.rest.len());
+        if let Some(&i) = self.cage.selected.iter().find(|&&i| i >= count) {
+            anyhow::bail!("cage vertex {i} is selected, but the cage has {count}");
+        }
+        let mut seen = self.cage.selected.clone();
+        seen.sort_unstable();
+        seen.dedup();
+        if seen.len() != self.cage.selected.len() {
+            anyhow::bail!("a cage vertex is selected twice");
+        }
+        if let Some(drag) = &self.cage.drag
+            && (drag.count() != count || drag.vertices().any(|i| i >= count))
+        {
+            anyhow::bail!("a drag holds cage vertices the cage of {count} does not have");
+        }
+        if self.cage.draft.is_some() && self.tool != Tool::Cage {
+            anyhow::bail!("a cage is being drawn with the {:?} tool", self.tool);
+        }
+        if doc.method() == Method::Lbc && self.tool != Tool::Cage {
+            anyhow::bail!("LBC with the {:?} tool", self.tool);
+        }
+        if let Some(draft) = &self.cage.draft
+            && draft.iter().any(|p| !p.is_finite())
+        {
+            anyhow::bail!("a cage being drawn has a non-finite vertex");
+        }
+        Ok(())
+    }
+
+    /// How many steps can be undone and redone.
+    pub fn history_len(&self) -> (usize, usize) {
+        self.history.len()
     }
 
     /// Whether there are changes not saved to a project file.
@@ -470,6 +544,8 @@ impl EditorApp {
                     self.history.push(before);
                     self.dirty = true;
                 }
+                self.cage
+                    .retain_valid(doc.cage().map_or(0, |c| c.rest.len()));
                 if let Some(i) = removes {
                     self.selected = match self.selected {
                         Some(s) if s > i && doc.project().handles.len() > s - 1 => Some(s - 1),
@@ -478,6 +554,7 @@ impl EditorApp {
                     };
                 }
                 self.settings_draft = None;
+                self.sync_tool();
                 true
             }
             Err(e) => {
@@ -540,10 +617,67 @@ impl EditorApp {
         }
     }
 
-    /// Switches tools; a bar being drawn is dropped.
+    /// Switches tools; a bar or a cage being drawn is dropped, a cage drag ends. The
+    /// cage tool is LBC's: picking it with a cage kept in the project chooses LBC (one
+    /// undo step); under LBC, the handle tools wait until C² or ARAP is chosen.
     pub fn set_tool(&mut self, tool: Tool) {
+        let lbc = self.doc.as_ref().is_some_and(|d| d.method() == Method::Lbc);
+        if lbc && tool != Tool::Cage {
+            self.info(
+                "under LBC the cage moves the picture: choose C² weights or ARAP under Method \
+                 to work with handles (the cage stays in the project)",
+            );
+            return;
+        }
+        if tool != Tool::Cage {
+            self.end_cage_gesture();
+            self.cage.draft = None;
+        }
         self.tool = tool;
         self.bar_start = None;
+        if tool == Tool::Cage
+            && !lbc
+            && let Some(doc) = &self.doc
+        {
+            if doc.cage().is_some() {
+                if self.edit(Edit::Method(Method::Lbc)) {
+                    self.info("LBC cage: the cage kept in the project warps the picture");
+                }
+            } else {
+                self.info(
+                    "draw a cage: click around the subject, then click the first vertex \
+                     (or double-click, or press Enter) to close it — or use Cage from \
+                     outline",
+                );
+            }
+        }
+    }
+
+    /// Under LBC the cage tool is the tool (handles act under C² and ARAP): after any
+    /// change that may have chosen LBC (an undo, an opened project), it is picked.
+    pub(crate) fn sync_tool(&mut self) {
+        if self.doc.as_ref().is_some_and(|d| d.method() == Method::Lbc) && self.tool != Tool::Cage {
+            self.finish_drag();
+            self.tool = Tool::Cage;
+            self.bar_start = None;
+            self.brush_stroke = None;
+        }
+    }
+
+    /// Chooses a warping method (one undo step). LBC without a cage starts the cage
+    /// tool, to draw one; leaving LBC leaves the cage tool and keeps the cage.
+    pub fn choose_method(&mut self, method: Method) {
+        let Some(doc) = &self.doc else { return };
+        if method == doc.method() {
+            return;
+        }
+        if method == Method::Lbc {
+            self.set_tool(Tool::Cage);
+            return;
+        }
+        if self.edit(Edit::Method(method)) && self.tool == Tool::Cage {
+            self.set_tool(Tool::Puppet);
+        }
     }
 
     /// Deletes the selected handle.
@@ -587,6 +721,7 @@ impl EditorApp {
     /// change under it.
     pub(crate) fn end_gesture(&mut self) {
         self.finish_drag();
+        self.end_cage_gesture();
         self.bar_start = None;
     }
 
@@ -619,6 +754,17 @@ impl EditorApp {
         let Some(target) = self.history.peek(back) else {
             return;
         };
+        // A posed cage whose coordinates are no longer kept is solved first, on the
+        // worker; the history moves when they are in.
+        if target.method == Method::Lbc
+            && target.cage.as_ref().is_some_and(|c| c.pose.is_some())
+            && let Some(key) = CageKey::of(target)
+            && doc.solution_for(&key).is_none()
+            && key.problem().is_none()
+        {
+            self.start_cage_solve(key, Some(back));
+            return;
+        }
         if crate::document::Settings::of(target).density != doc.settings().density {
             // A new mesh: built on the worker, like the same change from the slider.
             let target = target.clone();
@@ -654,12 +800,15 @@ impl EditorApp {
             Ok(()) => {
                 self.dirty = true;
                 self.settings_draft = None;
+                self.cage
+                    .retain_valid(doc.cage().map_or(0, |c| c.rest.len()));
                 if self
                     .selected
                     .is_some_and(|s| s >= doc.project().handles.len())
                 {
                     self.selected = None;
                 }
+                self.sync_tool();
             }
             Err(e) => {
                 self.history.unpop(back, target);
@@ -681,15 +830,58 @@ impl EditorApp {
     /// Opens a picture or (for `.json`) a project now, waiting for it. On failure the
     /// current document stays and the status line says why.
     pub fn open(&mut self, path: &Path) {
-        let outcome = open_outcome(path.to_path_buf());
+        let outcome = open_outcome(
+            path.to_path_buf(),
+            &CancelFlag::default(),
+            &SolveProgress::default(),
+        );
         self.finish(outcome);
     }
 
-    /// Opens a picture or project on a worker thread; the editor shows progress and
-    /// takes no edits until it is in.
+    /// Opens a picture or project on a worker thread (an LBC project's cage is solved
+    /// there too); the editor shows progress and takes no edits until it is in.
     pub fn open_in_background(&mut self, path: PathBuf) {
         let label = format!("Opening {}", file_name(&path));
-        self.start_job(label, CancelFlag::default(), move || open_outcome(path));
+        let (cancel, progress) = (CancelFlag::default(), SolveProgress::default());
+        let (flag, steps) = (cancel.clone(), progress.clone());
+        let work = move || open_outcome(path, &flag, &steps);
+        self.start_job(label, cancel, work);
+        if let Some(job) = &mut self.job {
+            job.progress = Some(progress);
+        }
+    }
+
+    /// Solves the cage of `key` on the worker, showing its iterations and residuals;
+    /// `then`: undo (`true`) or redo once it is in.
+    pub(crate) fn start_cage_solve(&mut self, key: CageKey, then: Option<bool>) {
+        if let Some(problem) = key.problem() {
+            self.error(&anyhow::anyhow!(problem));
+            return;
+        }
+        let (cancel, progress) = (CancelFlag::default(), SolveProgress::default());
+        let (flag, steps) = (cancel.clone(), progress.clone());
+        let label = format!("Solving the cage ({} vertices inside)", key.vertices);
+        self.start_job(label, cancel, move || {
+            let clock = Instant::now();
+            let solution = crate::document::solve_cage(&key, &mut |step| {
+                steps.set(*step);
+                !flag.is_set()
+            });
+            Outcome::CageSolved {
+                key,
+                solution,
+                then,
+                ms: clock.elapsed().as_secs_f64() * 1e3,
+            }
+        });
+        if let Some(job) = &mut self.job {
+            job.progress = Some(progress);
+        }
+    }
+
+    /// The first and latest iteration of a cage's solve under way.
+    pub fn solve_progress(&self) -> Option<(lbc::Progress, lbc::Progress)> {
+        self.job.as_ref()?.progress.as_ref()?.get()
     }
 
     /// Starts `work` on a worker thread unless a job is running (then says so). Any
@@ -784,6 +976,11 @@ impl EditorApp {
     }
 
     fn finish(&mut self, outcome: Outcome) {
+        self.finish_outcome(outcome);
+        self.sync_tool();
+    }
+
+    fn finish_outcome(&mut self, outcome: Outcome) {
         match outcome {
             Outcome::Opened {
                 path,
@@ -793,10 +990,20 @@ impl EditorApp {
                 let stats = doc.rig().stats();
                 let what = if is_project { "project" } else { "image" };
                 self.end_gesture();
+                let lbc = doc.method() == Method::Lbc;
+                let unsolved = lbc && doc.cage_solution().is_none();
+                let problem = CageKey::of(doc.project()).and_then(|k| k.problem());
                 self.doc = Some(doc);
                 self.history.clear();
                 self.dirty = false;
                 self.selected = None;
+                self.cage = crate::cage::CageTool {
+                    outline_vertices: self.cage.outline_vertices,
+                    ..crate::cage::CageTool::default()
+                };
+                if lbc {
+                    self.tool = Tool::Cage;
+                }
                 self.needs_fit = true;
                 self.settings_draft = None;
                 self.info(format!(
@@ -804,6 +1011,12 @@ impl EditorApp {
                     path.display(),
                     stats.samples
                 ));
+                if unsolved {
+                    let why = problem.unwrap_or_else(|| {
+                        "the cage is not solved: press Solve (Enter) to warp".to_owned()
+                    });
+                    self.error(&anyhow::anyhow!(why));
+                }
             }
             Outcome::Opened {
                 path,
@@ -816,6 +1029,7 @@ impl EditorApp {
             } => {
                 self.end_gesture();
                 if let Some(old) = &self.doc {
+                    doc.keep_solutions_of(old);
                     doc.project_path.clone_from(&old.project_path);
                     doc.weights_version = old.weights_version + 1;
                     doc.pose_version = old.pose_version + 1;
@@ -841,6 +1055,10 @@ impl EditorApp {
                 if self.selected.is_some_and(|s| s >= handles) {
                     self.selected = None;
                 }
+                if let Some(doc) = &self.doc {
+                    self.cage
+                        .retain_valid(doc.cage().map_or(0, |c| c.rest.len()));
+                }
                 self.dirty = true;
                 self.settings_draft = None;
                 let what = if remeshed { "re-meshed" } else { "rebuilt" };
@@ -861,6 +1079,37 @@ impl EditorApp {
                 ms,
             } => self.info(format!("exported {} in {ms:.0} ms", path.display())),
             Outcome::Exported { result: Err(e), .. } => self.error(&e),
+            Outcome::CageSolved {
+                key,
+                solution: Ok(solution),
+                then,
+                ms,
+            } => {
+                let Some(doc) = &mut self.doc else { return };
+                let report = solution.report.clone();
+                let vertices = solution.domain.positions().len();
+                if let Err(e) = doc.add_solution(key, solution) {
+                    self.error(&e);
+                    return;
+                }
+                self.info(format!(
+                    "solved the cage in {:.1} s: {vertices} vertices inside, {} ADMM \
+                     iterations{}; drag a vertex to warp",
+                    ms / 1e3,
+                    report.iterations,
+                    if report.converged {
+                        ""
+                    } else {
+                        " (stopped at the iteration cap, not converged)"
+                    }
+                ));
+                if let Some(back) = then {
+                    self.step_history(back);
+                }
+            }
+            Outcome::CageSolved {
+                solution: Err(e), ..
+            } => self.error(&e.context("cannot solve the cage")),
         }
     }
 
@@ -1001,7 +1250,13 @@ impl EditorApp {
         let project = doc.project_for_saving(None);
         let image = doc.image.clone();
         let deep = doc.deep.clone();
+        let cage = CageKey::of(&project)
+            .filter(|_| project.method == Method::Lbc)
+            .map(|key| (doc.solution_for(&key).cloned(), key, doc.cage_pose()));
         Some(move || {
+            if let Some((solution, key, pose)) = cage {
+                return export_cage(&image, &path, solution, &key, &pose, &cancel);
+            }
             let clock = Instant::now();
             let result = (|| -> Result<()> {
                 let warper = pipeline::prepare_warper(&image, &project, None, &|_| {})?;
@@ -1048,7 +1303,12 @@ impl EditorApp {
     /// change, transforms after a pose change, overlay values when asked for. This is
     /// the CPU side of what a frame uploads; the canvas calls it every frame.
     pub fn update_gpu_frame(&mut self) {
+        let cage_view = self.cage_view();
+        let warping = self.cage_warping();
+        let focus = self.cage.focus();
         let Some(doc) = &self.doc else { return };
+        // The cage's mesh with its coordinates, when it warps the picture.
+        let cage = doc.cage_solution().filter(|_| warping).cloned();
         let counter = &mut self.next_version;
         let mut bump = || {
             *counter += 1;
@@ -1064,8 +1324,52 @@ impl EditorApp {
                 value: doc.image.clone(),
             };
         }
-        let weights_changed = image_is_new || weights != seen.weights;
-        if weights_changed {
+        let weights_changed = image_is_new
+            || weights != seen.weights
+            || cage_view != seen.cage_view
+            || warping != seen.warping;
+        if weights_changed && cage_view {
+            let size = [doc.image.width(), doc.image.height()];
+            let mesh = match &cage {
+                Some(solution) => crate::cage::mesh_data(solution, size),
+                // No cage to warp by: the picture at rest alone.
+                None => MeshData {
+                    rows: vec![0],
+                    source_size: size,
+                    ..MeshData::default()
+                },
+            };
+            gpu.mesh = Versioned {
+                version: bump(),
+                value: Arc::new(mesh),
+            };
+            let same = seen.backdrop.as_ref().is_some_and(|(image, solution)| {
+                Arc::ptr_eq(image, &doc.image)
+                    && match (solution, &cage) {
+                        (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+                        (None, None) => true,
+                        _ => false,
+                    }
+            });
+            if gpu.backdrop.is_none() || !same {
+                let backdrop = match &cage {
+                    Some(solution) => Arc::new(crate::cage::outside_of(
+                        &doc.image,
+                        solution.domain.cage().vertices(),
+                    )),
+                    None => doc.image.clone(),
+                };
+                gpu.backdrop = Some(Versioned {
+                    version: bump(),
+                    value: backdrop,
+                });
+                seen.backdrop = Some((doc.image.clone(), cage.clone()));
+            }
+            seen.heat = None;
+            seen.cells = 0;
+        } else if weights_changed {
+            gpu.backdrop = None;
+            seen.backdrop = None;
             let rig = doc.rig();
             let (rows, nodes, weights) = rig.weight_table();
             let mesh = MeshData {
@@ -1089,11 +1393,17 @@ impl EditorApp {
             seen.cells = 0;
         }
         if weights_changed || doc.pose_version != seen.pose {
+            let affines = match (cage_view, &cage) {
+                (true, Some(_)) => crate::cage::pose_affines(&doc.cage_pose()),
+                (true, None) => Vec::new(),
+                (false, _) => doc.rig().node_affines(),
+            };
             gpu.pose = Versioned {
                 version: bump(),
-                value: Arc::new(doc.rig().node_affines()),
+                value: Arc::new(affines),
             };
             let positions = match doc.deformer().output() {
+                _ if cage_view => Vec::new(),
                 pipeline::Output::Skinned(_) => Vec::new(),
                 pipeline::Output::Positions(p) => p.iter().map(|p| p.as_vec2()).collect(),
             };
@@ -1102,20 +1412,27 @@ impl EditorApp {
                 value: Arc::new(positions),
             };
         }
-        let heat_key = self
-            .selected
-            .filter(|_| self.show.heat)
-            .map(|s| (s, weights));
-        if let Some((handle, _)) = heat_key
+        let shown = if cage_view {
+            focus.filter(|_| cage.is_some())
+        } else {
+            self.selected
+        };
+        let heat_key = shown.filter(|_| self.show.heat).map(|s| (s, weights));
+        if let Some((shown, _)) = heat_key
             && heat_key != seen.heat
         {
+            let values = if cage_view {
+                doc.cage_influence(shown).unwrap_or_default()
+            } else {
+                doc.influence(shown)
+            };
             gpu.heat = Versioned {
                 version: bump(),
-                value: Arc::new(doc.influence(handle)),
+                value: Arc::new(values),
             };
             seen.heat = heat_key;
         }
-        if self.show.cells && seen.cells != weights {
+        if self.show.cells && !cage_view && seen.cells != weights {
             let rig = doc.rig();
             // A sample that no node reaches (a rig without nodes, or a piece of the
             // shape without a handle) has no cell: grey.
@@ -1136,11 +1453,45 @@ impl EditorApp {
         }
         // Keyed by the GPU mesh's version, which no other document shares.
         let mesh_version = gpu.mesh.version;
-        if self.show.dual_graph && self.dual_graph.0 != mesh_version {
+        if self.show.dual_graph && !cage_view && self.dual_graph.0 != mesh_version {
             self.dual_graph = (mesh_version, Arc::new(doc.rig().dual_graph()));
         }
         seen.weights = weights;
         seen.pose = doc.pose_version;
+        seen.cage_view = cage_view;
+        seen.warping = warping;
+    }
+}
+
+/// The export of an LBC project: the picture warped by its cage in `pose`, with the
+/// coordinates already solved for it (else solved here), as `c2warp render` draws the
+/// saved project (8 bits per channel).
+fn export_cage(
+    image: &image::RgbaImage,
+    path: &Path,
+    solution: Option<Arc<pipeline::cage::CageCoordinates>>,
+    key: &CageKey,
+    pose: &[DVec2],
+    cancel: &CancelFlag,
+) -> Outcome {
+    let clock = Instant::now();
+    let result = (|| -> Result<()> {
+        let solution = match solution {
+            Some(solution) => solution,
+            None => crate::document::solve_cage(key, &mut |_| !cancel.is_set())?,
+        };
+        let warped = pipeline::cage::warp_by_cage_posed(image, &solution, pose)?;
+        if cancel.is_set() {
+            anyhow::bail!("cancelled");
+        }
+        render::save_png_atomic(path, &warped)?;
+        Ok(())
+    })()
+    .with_context(|| format!("cannot export {}", path.display()));
+    Outcome::Exported {
+        path: path.to_path_buf(),
+        result,
+        ms: clock.elapsed().as_secs_f64() * 1e3,
     }
 }
 
@@ -1171,13 +1522,24 @@ fn remesh(
     }
 }
 
-/// Opens a picture or (for `.json`) a project.
-fn open_outcome(path: PathBuf) -> Outcome {
+/// Opens a picture or (for `.json`) a project; an LBC project's cage is solved (a cage
+/// that cannot be is left unsolved, for the user to fix).
+fn open_outcome(path: PathBuf, cancel: &CancelFlag, progress: &SolveProgress) -> Outcome {
     let is_project = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("json"));
     let document = if is_project {
-        Document::open_project(&path)
+        Document::open_project(&path).map(|mut doc| {
+            let solvable = CageKey::of(doc.project()).is_some_and(|k| k.problem().is_none());
+            if doc.method() == Method::Lbc && solvable {
+                // Failing (cancelled) leaves the cage unsolved.
+                let _ = doc.solve_cage(&mut |step| {
+                    progress.set(*step);
+                    !cancel.is_set()
+                });
+            }
+            doc
+        })
     } else {
         Document::open_image(&path)
     };
@@ -1189,7 +1551,7 @@ fn open_outcome(path: PathBuf) -> Outcome {
 }
 
 /// `project` without its virtual handles (what [`Document::project`] holds).
-fn without_virtuals(project: &project::Project) -> project::Project {
+pub(crate) fn without_virtuals(project: &project::Project) -> project::Project {
     project::Project {
         virtual_handles: Vec::new(),
         virtual_placed_for: Vec::new(),

@@ -82,11 +82,17 @@ impl EditorApp {
                 painter.image(checker.id(), visible, uv, Color32::WHITE);
             }
         }
+        let cage_view = self.cage_view();
         if self.has_gpu {
             let (scale, offset) = self.viewport.device_map();
-            let overlay = if self.show.heat && self.selected.is_some() {
+            let shown = if cage_view {
+                self.cage.focus().filter(|_| self.cage_warping())
+            } else {
+                self.selected
+            };
+            let overlay = if self.show.heat && shown.is_some() {
                 render::Overlay::Heat
-            } else if self.show.cells {
+            } else if self.show.cells && !cage_view {
                 render::Overlay::Cells
             } else {
                 render::Overlay::None
@@ -114,10 +120,15 @@ impl EditorApp {
                 Color32::LIGHT_RED,
             );
         }
-        if self.show.rigidity {
-            self.paint_rigidity(&painter);
+        if cage_view {
+            let pointer = ui.input(|i| i.pointer.latest_pos());
+            self.paint_cage(&painter, pointer);
+        } else {
+            if self.show.rigidity {
+                self.paint_rigidity(&painter);
+            }
+            self.paint_overlays(&painter);
         }
-        self.paint_overlays(&painter);
         if let (Some(a), Some(b)) = (self.bar_start, ui.input(|i| i.pointer.latest_pos())) {
             let a = self.viewport.to_screen(a);
             painter.line_segment([a, b], Stroke::new(4.0, SELECTED));
@@ -125,10 +136,21 @@ impl EditorApp {
         if let Some((what, seconds)) = self.busy_with().filter(|(_, s)| *s > 0.25) {
             // A short job (a rebuild at a low density) shows only in the status bar.
             painter.rect_filled(rect, 0.0, Color32::from_black_alpha(120));
+            let mut text = format!("{what}… {seconds:.1} s");
+            if let Some((_, last)) = self.solve_progress() {
+                text.push_str(&format!(
+                    "\niteration {}: residuals {:.1e} / {:.1e} (to reach {:.1e} / {:.1e})\nEscape cancels",
+                    last.iteration,
+                    last.primal_residual,
+                    last.dual_residual,
+                    last.primal_threshold,
+                    last.dual_threshold
+                ));
+            }
             painter.text(
                 rect.center(),
                 egui::Align2::CENTER_CENTER,
-                format!("{what}… {seconds:.1} s"),
+                text,
                 egui::FontId::proportional(20.0),
                 Color32::WHITE,
             );
@@ -230,12 +252,15 @@ impl EditorApp {
         if self.tool == Tool::Rigidity {
             self.brush_input(ui, response);
         }
+        if self.tool == Tool::Cage {
+            self.cage_input(ui, response);
+        }
         if response.drag_started_by(PointerButton::Middle)
             || (response.drag_started_by(PointerButton::Primary) && space)
         {
             self.panning = true;
         } else if response.drag_started_by(PointerButton::Primary)
-            && !matches!(self.tool, Tool::AddBar | Tool::Rigidity)
+            && !matches!(self.tool, Tool::AddBar | Tool::Rigidity | Tool::Cage)
             && let Some(pos) = press
         {
             match self.hit(pos) {
@@ -260,7 +285,7 @@ impl EditorApp {
         {
             let hit = self.hit(pos).map(|(i, _)| i);
             match (self.tool, hit) {
-                (Tool::AddBar | Tool::Rigidity, _) => {}
+                (Tool::AddBar | Tool::Rigidity | Tool::Cage, _) => {}
                 (_, Some(i)) if modifiers.alt => {
                     // The Puppet Warp convention: Alt-click deletes a handle.
                     self.selected = Some(i);
@@ -278,6 +303,10 @@ impl EditorApp {
                 (Tool::Select, None) => self.selected = None,
                 (Tool::AddPoint, None) => self.add_point(self.viewport.to_image(pos)),
             }
+        }
+        if self.tool == Tool::Cage {
+            // The cage tool sets its own cursor and has no handle menu.
+            return;
         }
         if response.secondary_clicked()
             && let Some(pos) = response.interact_pointer_pos()
@@ -503,6 +532,36 @@ impl EditorApp {
         );
     }
 
+    /// The C² weights of the mesh vertex under screen point `pos`, as text.
+    fn handle_weights_at(&mut self, pos: Pos2) -> Option<String> {
+        let doc = self.doc.as_mut()?;
+        let (rest, _, _) = doc.unwarp(self.viewport.to_image(pos))?;
+        let rig = doc.rig();
+        let vertex = rig.domain().nearest_vertex(rest)?;
+        let mut weights: Vec<(usize, f64)> = rig.weights(vertex as usize).collect();
+        weights.sort_by(|a, b| b.1.total_cmp(&a.1));
+        let lines: Vec<String> = weights
+            .iter()
+            .take(5)
+            .map(|&(k, w)| format!("{:>6.3}  {}", w, node_name(rig, k)))
+            .collect();
+        let more = weights.len().saturating_sub(5);
+        let mut text = format!(
+            "vertex {vertex} at ({:.1}, {:.1}): {} weights",
+            rest.x,
+            rest.y,
+            weights.len()
+        );
+        for line in &lines {
+            text.push('\n');
+            text.push_str(line);
+        }
+        if more > 0 {
+            text.push_str(&format!("\n… and {more} smaller"));
+        }
+        Some(text)
+    }
+
     /// A box beside the pointer with the weights of the mesh vertex under it.
     fn hover_weights(&mut self, ui: &Ui, response: &egui::Response) {
         self.hover_readout = None;
@@ -512,37 +571,20 @@ impl EditorApp {
         let Some(pos) = response.hover_pos() else {
             return;
         };
-        let Some(doc) = &mut self.doc else { return };
-        let Some((rest, _, _)) = doc.unwarp(self.viewport.to_image(pos)) else {
-            return;
+        let text = if self.cage_view() {
+            if self.cage.drag.is_some() || self.cage.boxing.is_some() {
+                return;
+            }
+            match self.cage_hover(pos) {
+                Some(text) => text,
+                None => return,
+            }
+        } else {
+            match self.handle_weights_at(pos) {
+                Some(text) => text,
+                None => return,
+            }
         };
-        let rig = doc.rig();
-        let Some(vertex) = rig.domain().nearest_vertex(rest) else {
-            return;
-        };
-
-        let mut weights: Vec<(usize, f64)> = rig.weights(vertex as usize).collect();
-        weights.sort_by(|a, b| b.1.total_cmp(&a.1));
-        let lines: Vec<String> = weights
-            .iter()
-            .take(5)
-            .map(|&(k, w)| format!("{:>6.3}  {}", w, node_name(rig, k)))
-            .collect();
-        let more = weights.len().saturating_sub(5);
-        let header = format!(
-            "vertex {vertex} at ({:.1}, {:.1}): {} weights",
-            rest.x,
-            rest.y,
-            weights.len()
-        );
-        let mut text = header;
-        for line in &lines {
-            text.push('\n');
-            text.push_str(line);
-        }
-        if more > 0 {
-            text.push_str(&format!("\n… and {more} smaller"));
-        }
         // Painted rather than an egui tooltip: it follows the pointer at once, also
         // while the pointer moves.
         let painter = ui.painter_at(self.viewport.canvas);
@@ -560,6 +602,8 @@ impl EditorApp {
         if corner.y + size.y > canvas.max.y {
             corner.y = pos.y - 16.0 - size.y;
         }
+        // Never past the canvas's left or top edge, where it would be cut.
+        corner = corner.max(canvas.min);
         let frame = Rect::from_min_size(corner, size);
         painter.rect_filled(frame, 4.0, Color32::from_black_alpha(200));
         painter.galley(corner + Vec2::splat(6.0), galley, Color32::from_gray(230));

@@ -2,6 +2,12 @@
 //! them. Every change goes through [`Document::apply`] with an [`Edit`]; the rig is
 //! brought up to date incrementally (handles) or rebuilt (parameters), and a failed
 //! edit leaves the document as it was.
+//!
+//! With LBC chosen the rig file's cage warps the picture. Its coordinates are solved
+//! on request (seconds, on the editor's worker: [`solve_cage`]) and kept by
+//! [`CageKey`] — the rest cage, τ and the vertex count inside — so a new pose costs
+//! nothing but the cage's positions, and an undo back to an earlier cage finds its
+//! coordinates again.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -10,8 +16,11 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use glam::DVec2;
 use image::RgbaImage;
+use pipeline::cage::{CageCoordinates, CageMesh};
 use pipeline::{ArapRig, ArapTimes, Deformer, Method};
-use project::{HandleSpec, MetricChoice, Middle, Project, RigidityStroke};
+use project::{
+    CageSpec, HandleSpec, LbcSettings, MetricChoice, Middle, Project, RigidityStroke, Tau,
+};
 use weights_core::{Domain, NodeKind, Rig, VirtualHandle};
 
 /// The parameters of the weighting a user can change in the side panel.
@@ -74,7 +83,95 @@ pub enum Edit {
     Method(Method),
     /// New painted rigidity (ARAP).
     Rigidity(Vec<RigidityStroke>),
+    /// A new cage at rest, in image pixels: LBC becomes the method, and a rig file
+    /// without a count of mesh vertices inside the cage (`lbc.density`) takes
+    /// `vertices`. Its coordinates are solved separately ([`Document::solve_cage`], or
+    /// [`solve_cage`] on a worker).
+    Cage {
+        /// The cage's vertices at rest.
+        rest: Vec<[f64; 2]>,
+        /// Mesh vertices inside, unless the rig file names a count.
+        vertices: usize,
+    },
+    /// No cage (the method goes back to C² if it was LBC).
+    ClearCage,
+    /// The cage's pose: where each of its vertices goes (image pixels).
+    CagePose(Vec<[f64; 2]>),
+    /// LBC's settings: τ and the vertex count inside the cage.
+    Lbc(LbcSettings),
 }
+
+/// What a cage's coordinates are solved for: the rest cage, τ and the number of mesh
+/// vertices inside it (as `c2warp render` reads them from the rig file).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CageKey {
+    /// The rest cage, image pixels.
+    pub rest: Vec<[f64; 2]>,
+    /// The locality weighting.
+    pub tau: Tau,
+    /// Target mesh vertices inside the cage.
+    pub vertices: usize,
+}
+
+impl CageKey {
+    /// The key of `project`'s cage (`None` without a cage).
+    pub fn of(project: &Project) -> Option<Self> {
+        let cage = project.cage.as_ref()?;
+        Some(Self {
+            rest: cage.rest.clone(),
+            tau: project.lbc.unwrap_or_default().tau,
+            vertices: pipeline::cage::cage_vertices(project, None),
+        })
+    }
+
+    /// Why this cage cannot be solved (not a simple polygon), if it cannot.
+    pub fn problem(&self) -> Option<String> {
+        let points = self.rest.iter().map(|&p| DVec2::from(p)).collect();
+        lbc::Cage::new(points).err().map(|e| {
+            let hint = match e {
+                lbc::LbcError::SelfIntersection { .. } => {
+                    ": move a vertex so that no two edges cross"
+                }
+                lbc::LbcError::RepeatedVertex { .. } => ": move or remove one of them",
+                _ => "",
+            };
+            format!("the cage cannot be solved: {e}{hint}")
+        })
+    }
+}
+
+/// Solves the local barycentric coordinates of `key`'s cage, telling `progress` each
+/// ADMM iteration (it returns `false` to cancel). The same computation as `c2warp
+/// render` does for a rig file with that cage, τ and density.
+///
+/// # Errors
+/// A cage that is not a simple polygon, or a cancelled solve.
+pub fn solve_cage(
+    key: &CageKey,
+    progress: &mut dyn FnMut(&lbc::Progress) -> bool,
+) -> Result<Arc<CageCoordinates>> {
+    let project = Project {
+        method: Method::Lbc,
+        cage: Some(CageSpec {
+            rest: key.rest.clone(),
+            pose: None,
+        }),
+        lbc: Some(LbcSettings {
+            tau: key.tau,
+            density: Some(key.vertices),
+        }),
+        ..Project::default()
+    };
+    let mesh = CageMesh::Triangulate {
+        target_vertices: key.vertices,
+    };
+    Ok(Arc::new(pipeline::cage::cage_coordinates(
+        &project, mesh, progress,
+    )?))
+}
+
+/// Solved cages kept, so an undo or a redo across cage edits needs no new solve.
+const SOLUTIONS_KEPT: usize = 4;
 
 /// An open picture with its rig. Cloning copies the rig (tens of megabytes at a
 /// million vertices): the editor does it to rebuild a large rig on a worker thread.
@@ -106,6 +203,11 @@ pub struct Document {
     /// With ARAP chosen: its deformer, and the mesh version it was set up on. The C²
     /// rig stays beside it: it holds the mesh and the handles, and its heat maps.
     arap: Option<(u64, ArapRig)>,
+    /// Solved cages, the most recent last (at most [`SOLUTIONS_KEPT`]).
+    solutions: Vec<(CageKey, Arc<CageCoordinates>)>,
+    /// The solved cage's mesh deformed by the cage's pose, and the (pose, weights)
+    /// versions it was computed for.
+    cage_deformed: Option<((u64, u64), Vec<DVec2>)>,
 }
 
 impl Document {
@@ -128,6 +230,15 @@ impl Document {
         mut project: Project,
     ) -> Result<Self> {
         let clock = Instant::now();
+        // The cage's density as the command line reads it, before the picture's
+        // density is filled in below (which it would otherwise follow).
+        if project.cage.is_some() {
+            let vertices = pipeline::cage::cage_vertices(&project, None);
+            project.lbc = Some(LbcSettings {
+                density: Some(vertices),
+                ..project.lbc.unwrap_or_default()
+            });
+        }
         project.density = Some(project.density.unwrap_or(pipeline::DEFAULT_DENSITY));
         let prepared = pipeline::prepare(&image, &project, None)?;
         // Virtual handles live in the rig while editing; they are written out on save.
@@ -146,18 +257,15 @@ impl Document {
             deformed: None,
             mesh_version: 1,
             arap: None,
+            solutions: Vec::new(),
+            cage_deformed: None,
         }
         .with_method()
     }
 
-    /// This document with its method's deformer set up.
+    /// This document with its method's deformer set up (an LBC cage is solved
+    /// separately: [`Document::solve_cage`]).
     fn with_method(mut self) -> Result<Self> {
-        if self.project.method == Method::Lbc {
-            bail!(
-                "this project warps by an LBC cage, which the editor cannot show yet \
-                 (`c2warp weights` and `c2warp deform` take it)"
-            );
-        }
         self.sync_method()?;
         Ok(self)
     }
@@ -220,6 +328,141 @@ impl Document {
     /// ARAP's per-triangle rigidity, when ARAP is in use.
     pub fn rigidity(&self) -> Option<&[f64]> {
         self.arap.as_ref().map(|(_, arap)| arap.rigidity())
+    }
+
+    /// The cage, if the rig file has one.
+    pub fn cage(&self) -> Option<&CageSpec> {
+        self.project.cage.as_ref()
+    }
+
+    /// The cage at rest (empty without a cage).
+    pub fn cage_rest(&self) -> Vec<DVec2> {
+        self.cage()
+            .map(|c| c.rest.iter().map(|&p| DVec2::from(p)).collect())
+            .unwrap_or_default()
+    }
+
+    /// Where the cage's vertices are posed (at rest where the rig file gives no pose;
+    /// empty without a cage).
+    pub fn cage_pose(&self) -> Vec<DVec2> {
+        self.cage()
+            .map(|c| {
+                c.pose
+                    .as_ref()
+                    .unwrap_or(&c.rest)
+                    .iter()
+                    .map(|&p| DVec2::from(p))
+                    .collect()
+            })
+            .unwrap_or_default()
+    }
+
+    /// The solved coordinates of the rig file's cage, if they have been solved for
+    /// this rest cage, τ and density.
+    pub fn cage_solution(&self) -> Option<&Arc<CageCoordinates>> {
+        let key = CageKey::of(&self.project)?;
+        self.solution_for(&key)
+    }
+
+    /// The coordinates solved for `key`, if kept.
+    pub fn solution_for(&self, key: &CageKey) -> Option<&Arc<CageCoordinates>> {
+        self.solutions
+            .iter()
+            .rev()
+            .find(|(k, _)| k == key)
+            .map(|(_, s)| s)
+    }
+
+    /// Whether the picture is warped by a solved cage: LBC chosen and its cage solved.
+    pub fn cage_warps(&self) -> bool {
+        self.project.method == Method::Lbc && self.cage_solution().is_some()
+    }
+
+    /// Keeps coordinates solved for `key` (the oldest kept are forgotten). If `key` is
+    /// the rig file's cage, the picture is now warped by it.
+    ///
+    /// # Errors
+    /// Coordinates that do not fit `key` (another number of cage vertices).
+    pub fn add_solution(&mut self, key: CageKey, solution: Arc<CageCoordinates>) -> Result<()> {
+        if solution.weights.cage_vertices() != key.rest.len() {
+            bail!(
+                "coordinates for {} cage vertices solved for a cage of {}",
+                solution.weights.cage_vertices(),
+                key.rest.len()
+            );
+        }
+        self.solutions.retain(|(k, _)| *k != key);
+        if self.solutions.len() >= SOLUTIONS_KEPT {
+            self.solutions.remove(0);
+        }
+        if CageKey::of(&self.project).as_ref() == Some(&key) {
+            self.weights_version += 1;
+            self.pose_version += 1;
+        }
+        self.solutions.push((key, solution));
+        Ok(())
+    }
+
+    /// Takes over the solved cages of `other` (the same picture, rebuilt): solutions
+    /// depend only on the cage, not on the picture's mesh.
+    pub(crate) fn keep_solutions_of(&mut self, other: &Document) {
+        self.solutions.clone_from(&other.solutions);
+    }
+
+    /// Solves the rig file's cage here and now (seconds; the editor does it on its
+    /// worker), unless it is solved already.
+    ///
+    /// # Errors
+    /// No cage, a cage that is not a simple polygon, or a cancelled solve.
+    pub fn solve_cage(&mut self, progress: &mut dyn FnMut(&lbc::Progress) -> bool) -> Result<()> {
+        let Some(key) = CageKey::of(&self.project) else {
+            bail!("there is no cage to solve");
+        };
+        if self.solution_for(&key).is_some() {
+            return Ok(());
+        }
+        if let Some(problem) = key.problem() {
+            bail!(problem);
+        }
+        let solution = solve_cage(&key, progress)?;
+        self.add_solution(key, solution)
+    }
+
+    /// Every vertex of the solved cage's mesh where the cage's pose takes it (cached
+    /// per pose); `None` unless the cage is solved.
+    pub fn cage_deformed(&mut self) -> Option<&[DVec2]> {
+        let version = (self.pose_version, self.weights_version);
+        if self
+            .cage_deformed
+            .as_ref()
+            .is_none_or(|(v, _)| *v != version)
+        {
+            let solution = self.cage_solution()?;
+            let deformed = solution.weights.deform(&self.cage_pose()).ok()?;
+            self.cage_deformed = Some((version, deformed));
+        }
+        self.cage_deformed.as_ref().map(|(_, d)| d.as_slice())
+    }
+
+    /// Cage vertex `i`'s coordinate function at every vertex of the solved cage's mesh
+    /// (its compact rows: zero where the weight fell below `10⁻³/n`); `None` unless the
+    /// cage is solved and has that vertex.
+    pub fn cage_influence(&self, i: usize) -> Option<Vec<f32>> {
+        let weights = &self.cage_solution()?.weights;
+        if i >= weights.cage_vertices() {
+            return None;
+        }
+        Some(
+            (0..weights.vertices())
+                .map(|v| {
+                    weights
+                        .row(v)
+                        .iter()
+                        .find(|&&(k, _)| k as usize == i)
+                        .map_or(0.0, |&(_, w)| w as f32)
+                })
+                .collect(),
+        )
     }
 
     /// The built-in picture with its sample rig.
@@ -364,11 +607,59 @@ impl Document {
                 }
             }
             Edit::Settings(settings) => settings.write_to(&mut project),
-            Edit::Method(Method::Lbc) => bail!("the editor has no cage tool yet"),
+            Edit::Method(Method::Lbc) if project.cage.is_none() => {
+                bail!("LBC warps by a cage: draw one first with the cage tool (K)")
+            }
             Edit::Method(method) => project.method = method,
             Edit::Rigidity(strokes) => project.rigidity = strokes,
+            Edit::Cage { rest, vertices } => {
+                if project.lbc.and_then(|l| l.density).is_none() {
+                    project.lbc = Some(LbcSettings {
+                        density: Some(vertices),
+                        ..project.lbc.unwrap_or_default()
+                    });
+                }
+                project.cage = Some(CageSpec { rest, pose: None });
+                project.method = Method::Lbc;
+                self.check_cage(&project)?;
+            }
+            Edit::ClearCage => {
+                project.cage = None;
+                if project.method == Method::Lbc {
+                    project.method = Method::C2;
+                }
+            }
+            Edit::CagePose(pose) => {
+                let Some(cage) = &mut project.cage else {
+                    bail!("there is no cage to pose");
+                };
+                if pose.len() != cage.rest.len() {
+                    bail!(
+                        "a pose of {} points for a cage of {} vertices",
+                        pose.len(),
+                        cage.rest.len()
+                    );
+                }
+                // At rest is no pose, so that a reset compares equal to a fresh cage.
+                cage.pose = (pose != cage.rest).then_some(pose);
+                self.check_cage(&project)?;
+            }
+            Edit::Lbc(settings) => {
+                project.lbc = Some(settings);
+                self.check_cage(&project)?;
+            }
         }
         self.restore(project)
+    }
+
+    /// Refuses a cage off the picture, with too few or too many vertices, or with
+    /// non-finite points (a cage that crosses itself is kept: it is refused when
+    /// solved, so the user can fix it).
+    fn check_cage(&self, project: &Project) -> Result<()> {
+        project
+            .validate(Some(self.image.dimensions()))
+            .context("the cage")?;
+        Ok(())
     }
 
     /// Refuses a new handle closer to an existing one than two mesh edges: nodes one
@@ -432,6 +723,10 @@ impl Document {
     fn restore_with(&mut self, mut project: Project, exact: bool) -> Result<()> {
         let virtuals = std::mem::take(&mut project.virtual_handles);
         let placed_for = std::mem::take(&mut project.virtual_placed_for);
+        // Another method or another rest cage draws another mesh; another cage pose
+        // moves it.
+        let cage_mesh_changed = project.method != self.project.method
+            || CageKey::of(&project) != CageKey::of(&self.project);
         let clock = Instant::now();
         let old = self.settings();
         let new = Settings::of(&project);
@@ -487,17 +782,21 @@ impl Document {
             };
             self.rig = Rig::new(domain, handles, pipeline::rig_options(&project)?)?;
         } else {
-            self.rig.set_handles(handles)?;
+            if project.handles != self.project.handles {
+                self.rig.set_handles(handles)?;
+            }
             if same_rest {
                 self.project = project;
                 self.pose_version += 1;
-                if depths_changed {
-                    // The triangles' drawing order changed: the mesh is uploaded anew.
+                if depths_changed || cage_mesh_changed {
+                    // The triangles' drawing order changed, or the cage's mesh is
+                    // drawn instead: the mesh is uploaded anew.
                     self.weights_version += 1;
                 }
                 return self.sync_method();
             }
         }
+
         self.project = project;
         self.weights_version += 1;
         self.pose_version += 1;
@@ -554,7 +853,7 @@ impl Document {
             bail!("sample {v} deforms to a non-finite point");
         }
         match (&self.arap, self.project.method) {
-            (None, Method::C2) => {}
+            (None, Method::C2 | Method::Lbc) => {}
             (Some((mesh, arap)), Method::Arap) => {
                 if *mesh != self.mesh_version {
                     bail!("the ARAP deformer was set up on another mesh");
@@ -585,6 +884,59 @@ impl Document {
         }
         if self.weights_version == 0 || self.pose_version == 0 {
             bail!("versions start at 1");
+        }
+        self.cage_sanity_check()
+    }
+
+    /// The cage's part of [`Document::sanity_check`]: kept solutions fit their keys,
+    /// the current one's rows are coordinates, and the pose deforms its mesh to finite
+    /// points.
+    fn cage_sanity_check(&self) -> Result<()> {
+        if self.project.method == Method::Lbc && self.project.cage.is_none() {
+            bail!("LBC without a cage");
+        }
+        if self.solutions.len() > SOLUTIONS_KEPT {
+            bail!("{} solved cages kept", self.solutions.len());
+        }
+        for (i, (key, solution)) in self.solutions.iter().enumerate() {
+            if self.solutions[..i].iter().any(|(k, _)| k == key) {
+                bail!("a cage is kept solved twice");
+            }
+            let (n, weights) = (key.rest.len(), &solution.weights);
+            if weights.cage_vertices() != n || solution.domain.cage().len() != n {
+                bail!("coordinates of another cage kept for a cage of {n} vertices");
+            }
+            if weights.vertices() != solution.domain.positions().len() {
+                bail!(
+                    "{} rows for a cage mesh of {} vertices",
+                    weights.vertices(),
+                    solution.domain.positions().len()
+                );
+            }
+        }
+        if let Some(solution) = self.cage_solution() {
+            let weights = &solution.weights;
+            let rows = weights.vertices();
+            let stride = (rows / 2000).max(1);
+            for v in (0..rows).step_by(stride) {
+                let row = weights.row(v);
+                let mut sum = 0.0;
+                for &(k, w) in row {
+                    if k as usize >= weights.cage_vertices() || !w.is_finite() || w < 0.0 {
+                        bail!("cage mesh vertex {v} has weight {w} on cage vertex {k}");
+                    }
+                    sum += w;
+                }
+                if (sum - 1.0).abs() > 1e-9 {
+                    bail!("the coordinates of cage mesh vertex {v} sum to {sum}");
+                }
+            }
+            let deformed = weights
+                .deform(&self.cage_pose())
+                .context("the cage's pose")?;
+            if let Some(v) = deformed.iter().position(|p| !p.is_finite()) {
+                bail!("the cage sends its mesh vertex {v} to a non-finite point");
+            }
         }
         Ok(())
     }
@@ -924,6 +1276,108 @@ mod tests {
                 "the removed handle's virtual handles go with it"
             );
         }
+    }
+
+    /// A rectangle on [`document`]'s picture.
+    fn cage(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<[f64; 2]> {
+        vec![[x0, y0], [x1, y0], [x1, y1], [x0, y1]]
+    }
+
+    #[test]
+    fn a_cage_is_solved_once_per_rest_cage_and_found_again_after_an_undo() {
+        let mut doc = document();
+        let rest = cage(8.0, 8.0, 56.0, 40.0);
+        doc.apply(Edit::Cage {
+            rest: rest.clone(),
+            vertices: 120,
+        })
+        .expect("a cage");
+        assert_eq!(doc.method(), Method::Lbc);
+        assert_eq!(doc.project().lbc.and_then(|l| l.density), Some(120));
+        assert!(doc.cage_solution().is_none(), "not solved until asked");
+        doc.solve_cage(&mut |_| true).expect("solved");
+        let solved = doc.cage_solution().expect("solved").clone();
+        doc.sanity_check().expect("consistent");
+
+        // A pose moves the cage's mesh and keeps the coordinates.
+        let (weights, pose_version) = (doc.weights_version, doc.pose_version);
+        let mut pose = rest.clone();
+        pose[2] = [60.0, 46.0];
+        doc.apply(Edit::CagePose(pose.clone())).expect("posed");
+        assert!(Arc::ptr_eq(doc.cage_solution().expect("kept"), &solved));
+        assert_eq!(doc.weights_version, weights);
+        assert!(doc.pose_version > pose_version);
+        let corner = solved.domain.cage_vertices()[2] as usize;
+        let moved = doc.cage_deformed().expect("solved")[corner];
+        assert!((moved - DVec2::new(60.0, 46.0)).length() < 1e-9, "{moved}");
+        let posed = doc.snapshot();
+
+        // Another rest cage needs a solve; the pose goes back to rest.
+        doc.apply(Edit::Cage {
+            rest: cage(4.0, 4.0, 30.0, 30.0),
+            vertices: 500,
+        })
+        .expect("another cage");
+        assert!(doc.cage_solution().is_none());
+        assert_eq!(doc.cage().and_then(|c| c.pose.clone()), None);
+        assert_eq!(
+            doc.project().lbc.and_then(|l| l.density),
+            Some(120),
+            "the project's count stays"
+        );
+        // Back to the solved cage: its coordinates are found, not solved again.
+        doc.undo_to(posed.clone()).expect("undo");
+        assert!(Arc::ptr_eq(doc.cage_solution().expect("found"), &solved));
+        assert_eq!(doc.snapshot(), posed);
+        doc.sanity_check().expect("consistent");
+    }
+
+    #[test]
+    fn bad_cage_edits_change_nothing() {
+        let mut doc = document();
+        assert!(
+            doc.apply(Edit::Method(Method::Lbc)).is_err(),
+            "LBC needs a cage"
+        );
+        assert!(doc.apply(Edit::CagePose(cage(0.0, 0.0, 1.0, 1.0))).is_err());
+        let off = Edit::Cage {
+            rest: cage(8.0, 8.0, 90.0, 40.0),
+            vertices: 100,
+        };
+        assert!(doc.apply(off).is_err(), "off the picture");
+        let two = Edit::Cage {
+            rest: vec![[1.0, 1.0], [5.0, 5.0]],
+            vertices: 100,
+        };
+        assert!(doc.apply(two).is_err(), "two vertices");
+        assert!(doc.cage().is_none());
+        let rest = cage(8.0, 8.0, 56.0, 40.0);
+        doc.apply(Edit::Cage {
+            rest: rest.clone(),
+            vertices: 100,
+        })
+        .expect("a cage");
+        let before = doc.project().clone();
+        assert!(doc.apply(Edit::CagePose(vec![[1.0, 1.0]])).is_err());
+        assert!(
+            doc.apply(Edit::CagePose(vec![[f64::NAN, 1.0]; 4])).is_err(),
+            "NaN"
+        );
+        assert_eq!(doc.project(), &before);
+        // A crossing cage is kept (to be fixed) but cannot be solved.
+        let bow = vec![[8.0, 8.0], [56.0, 8.0], [8.0, 40.0], [56.0, 40.0]];
+        doc.apply(Edit::Cage {
+            rest: bow,
+            vertices: 100,
+        })
+        .expect("kept");
+        let err = doc.solve_cage(&mut |_| true).expect_err("crossing");
+        assert!(err.to_string().contains("intersect"), "{err}");
+        // Clearing the cage goes back to C².
+        doc.apply(Edit::ClearCage).expect("cleared");
+        assert_eq!(doc.method(), Method::C2);
+        assert!(doc.cage().is_none());
+        doc.sanity_check().expect("consistent");
     }
 
     #[test]

@@ -62,6 +62,11 @@ impl History {
         }
     }
 
+    /// The number of steps to undo and to redo.
+    pub fn len(&self) -> (usize, usize) {
+        (self.undo.len(), self.redo.len())
+    }
+
     /// Whether there is something to undo.
     pub fn can_undo(&self) -> bool {
         !self.undo.is_empty()

@@ -1,17 +1,19 @@
 //! Work that can take longer than a frame — opening a picture or project, re-meshing at
-//! a new density, exporting — runs on a worker thread; the editor keeps drawing, shows what it is
-//! doing, takes no edits until the result is in, and can cancel it.
+//! a new density, solving a cage, exporting — runs on a worker thread; the editor keeps
+//! drawing, shows what it is doing (a cage's solve: its iterations and residuals), takes
+//! no edits until the result is in, and can cancel it.
 
 use std::path::PathBuf;
-use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use anyhow::Result;
+use pipeline::cage::CageCoordinates;
 use project::Project;
 
-use crate::document::Document;
+use crate::document::{CageKey, Document};
 
 /// What a finished job hands back.
 pub(crate) enum Outcome {
@@ -34,6 +36,35 @@ pub(crate) enum Outcome {
         cause: Rebuild,
         document: Result<Document>,
     },
+    /// A cage's coordinates were solved.
+    CageSolved {
+        key: CageKey,
+        solution: Result<Arc<CageCoordinates>>,
+        /// Undo (`true`) or redo to the state the cage was solved for, now that it is.
+        then: Option<bool>,
+        ms: f64,
+    },
+}
+
+/// The last ADMM iteration of a cage being solved, and the first (to tell how far the
+/// residuals have come), shared by the worker and the window.
+#[derive(Clone, Default)]
+pub(crate) struct SolveProgress(Arc<Mutex<[Option<lbc::Progress>; 2]>>);
+
+impl SolveProgress {
+    /// Records an iteration.
+    pub fn set(&self, progress: lbc::Progress) {
+        if let Ok(mut steps) = self.0.lock() {
+            steps[0].get_or_insert(progress);
+            steps[1] = Some(progress);
+        }
+    }
+
+    /// The first and the latest iteration, once there is one.
+    pub fn get(&self) -> Option<(lbc::Progress, lbc::Progress)> {
+        let steps = *self.0.lock().ok()?;
+        Some((steps[0]?, steps[1]?))
+    }
 }
 
 /// Why the picture was re-meshed.
@@ -67,6 +98,8 @@ pub(crate) struct Job {
     pub started: Instant,
     receiver: mpsc::Receiver<Outcome>,
     cancel: CancelFlag,
+    /// A cage's solve under way, for the progress display.
+    pub progress: Option<SolveProgress>,
 }
 
 impl Job {
@@ -92,6 +125,7 @@ impl Job {
             started: Instant::now(),
             receiver,
             cancel,
+            progress: None,
         }
     }
 

@@ -1,5 +1,6 @@
 //! The C2Warp editor: open a picture, pin point and bar handles on it, drag, rotate and
-//! scale them, insert and remove them while posed, and export the warped PNG.
+//! scale them, insert and remove them while posed, and export the warped PNG; or draw
+//! an LBC cage around the subject, solve it, and pose its vertices.
 //!
 //! The picture is meshed ([`mesh`]), weighted ([`weights_core`]) and drawn as a
 //! skinned textured mesh through an egui wgpu paint callback ([`render::MeshView`]):
@@ -9,6 +10,7 @@
 
 mod app;
 mod brush;
+mod cage;
 mod canvas;
 mod dialogs;
 mod document;
@@ -22,8 +24,9 @@ use std::path::PathBuf;
 
 pub use app::{EditorApp, Message, Pending, Show, Tool};
 pub use brush::{Brush, erase};
+pub use cage::{CageState, CageTool, contour, crossing_edges};
 pub use dialogs::{Answer, Dialogs, FileAction, IMAGES, NativeDialogs, desktop_has_dialogs};
-pub use document::{Document, Edit, Settings, posed};
+pub use document::{CageKey, Document, Edit, Settings, posed, solve_cage};
 pub use panels::SHORTCUTS;
 pub use scene::SceneResources;
 pub use viewport::Viewport;

@@ -24,6 +24,34 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
         "Rigidity brush (ARAP): drag to paint stiffness, Alt + drag to erase",
     ),
     (
+        "K",
+        "Cage tool (LBC): click a polygon around the subject, adjust it, solve, pose it",
+    ),
+    (
+        "Cage: click, Enter",
+        "Add a vertex; click the first vertex, double-click or Enter closes the cage",
+    ),
+    (
+        "Cage: Enter",
+        "Solve the closed cage (Escape cancels the solve)",
+    ),
+    (
+        "Cage: drag a vertex",
+        "At rest: adjust the cage; solved: pose it (a selected group moves together)",
+    ),
+    (
+        "Cage: drag empty canvas",
+        "Select vertices in a box (Shift adds to the selection)",
+    ),
+    (
+        "Cage: click an edge, Alt + click",
+        "At rest: add a vertex there, remove the vertex",
+    ),
+    (
+        "Cage: Backspace / Delete",
+        "Remove the last vertex drawn, or the selected vertices at rest",
+    ),
+    (
         "Drag a handle",
         "Move it (a bar's end: turn and stretch the bar)",
     ),
@@ -40,7 +68,10 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("H", "Show or hide the selected handle's weight (heat map)"),
     ("C", "Show or hide the Voronoi cells"),
     ("G", "Show or hide the dual graph"),
-    ("N, Shift + N", "Select the next / previous handle"),
+    (
+        "N, Shift + N",
+        "Select the next / previous handle (cage vertex)",
+    ),
     ("Ctrl + Z", "Undo"),
     ("Ctrl + Shift + Z, Ctrl + Y", "Redo"),
     ("Ctrl + O", "Open an image"),
@@ -60,6 +91,7 @@ impl eframe::App for EditorApp {
         let clock = Instant::now();
         let ctx = ui.ctx().clone();
         self.poll_job();
+        self.sync_tool();
         self.dropped_files(&ctx);
         let idle = !self.is_busy();
         if !idle {
@@ -90,6 +122,16 @@ impl eframe::App for EditorApp {
                     egui::ScrollArea::vertical().show(ui, |ui| self.side_panel(ui));
                 });
             });
+        // Beside the cage tool's view whenever it shows, so that solving does not
+        // resize the canvas under the pointer.
+        if self.show.locality && self.cage_view() {
+            egui::Panel::right("locality")
+                .resizable(false)
+                .default_size(300.0)
+                .show(ui, |ui| {
+                    egui::ScrollArea::vertical().show(ui, |ui| self.locality_panel(ui));
+                });
+        }
         egui::CentralPanel::default()
             .frame(egui::Frame::NONE)
             .show(ui, |ui| self.canvas_ui(ui));
@@ -173,6 +215,9 @@ impl EditorApp {
         if pressed(ctrl, Key::E) {
             self.export();
         }
+        if self.tool == Tool::Cage {
+            self.cage_keys(ctx);
+        }
         let none = Modifiers::NONE;
         if pressed(none, Key::Delete) || pressed(none, Key::Backspace) {
             self.delete_selected();
@@ -191,6 +236,9 @@ impl EditorApp {
         }
         if pressed(none, Key::R) {
             self.set_tool(Tool::Rigidity);
+        }
+        if pressed(none, Key::K) {
+            self.set_tool(Tool::Cage);
         }
         if pressed(none, Key::F) {
             self.needs_fit = true;
@@ -299,6 +347,10 @@ impl EditorApp {
     }
 
     fn edit_buttons(&mut self, ui: &mut Ui) {
+        if self.doc.as_ref().is_some_and(|d| d.method() == Method::Lbc) {
+            self.cage_edit_buttons(ui);
+            return;
+        }
         if ui
             .add_enabled(self.selected.is_some(), egui::Button::new("Delete handle"))
             .clicked()
@@ -314,37 +366,76 @@ impl EditorApp {
         }
     }
 
+    /// The overlays' checkboxes; with the cage tool's view, the ones that apply to it.
     fn overlay_toggles(&mut self, ui: &mut Ui) {
+        let cage = self.cage_view();
         ui.checkbox(&mut self.show.mesh, "Show mesh");
-        ui.checkbox(&mut self.show.virtual_handles, "Virtual handles");
-        ui.checkbox(&mut self.show.cells, "Voronoi cells");
-        ui.checkbox(&mut self.show.dual_graph, "Dual graph");
+        if !cage {
+            ui.checkbox(&mut self.show.virtual_handles, "Virtual handles");
+            ui.checkbox(&mut self.show.cells, "Voronoi cells");
+            ui.checkbox(&mut self.show.dual_graph, "Dual graph");
+        }
         ui.checkbox(&mut self.show.heat, "Weight heat map")
-            .on_hover_text("The selected handle's weight, with isolines every 0.1");
+            .on_hover_text(if cage {
+                "The selected cage vertex's coordinate, with isolines every 0.1"
+            } else {
+                "The selected handle's weight, with isolines every 0.1"
+            });
         ui.checkbox(&mut self.show.folds, "Fold-overs");
         ui.checkbox(&mut self.show.hover_weights, "Weights under cursor");
-        ui.checkbox(&mut self.show.rigidity, "Painted rigidity");
+        if !cage {
+            ui.checkbox(&mut self.show.rigidity, "Painted rigidity");
+        }
     }
 
     fn side_panel(&mut self, ui: &mut Ui) {
         ui.heading("Tools");
         ui.horizontal_wrapped(|ui| {
             let mut tool = self.tool;
-            ui.selectable_value(&mut tool, Tool::Puppet, "Puppet")
-                .on_hover_text(
+            // Under LBC the cage moves the picture: handles wait for C² or ARAP.
+            let handles = self.doc.as_ref().is_none_or(|d| d.method() != Method::Lbc);
+            let tools = [
+                (
+                    Tool::Puppet,
+                    "Puppet",
                     "Click the picture to add a handle; drag a handle to move it; \
-                 Alt-click a handle to delete it; drag empty canvas to pan",
-                );
-            ui.selectable_value(&mut tool, Tool::Select, "Select")
-                .on_hover_text("Like Puppet, but a click on the picture adds nothing");
-            ui.selectable_value(&mut tool, Tool::AddPoint, "Add point");
-            ui.selectable_value(&mut tool, Tool::AddBar, "Add bar")
-                .on_hover_text("Drag from one end of the bar to the other");
-            ui.selectable_value(&mut tool, Tool::Rigidity, "Rigidity")
-                .on_hover_text(
+                     Alt-click a handle to delete it; drag empty canvas to pan",
+                ),
+                (
+                    Tool::Select,
+                    "Select",
+                    "Like Puppet, but a click on the picture adds nothing",
+                ),
+                (Tool::AddPoint, "Add point", "Click to add a point handle"),
+                (
+                    Tool::AddBar,
+                    "Add bar",
+                    "Drag from one end of the bar to the other",
+                ),
+                (
+                    Tool::Rigidity,
+                    "Rigidity",
                     "Paint stiffness (ARAP): painted parts keep their shape; Alt-drag \
                      erases. One undo step per stroke",
-                );
+                ),
+                (
+                    Tool::Cage,
+                    "Cage",
+                    "LBC's cage (K): click a polygon around the subject, adjust it, \
+                     solve it, then drag its vertices to warp what lies inside",
+                ),
+            ];
+            for (t, label, hover) in tools {
+                let enabled = handles || t == Tool::Cage;
+                let button = egui::Button::selectable(tool == t, label);
+                if ui
+                    .add_enabled(enabled, button)
+                    .on_hover_text(hover)
+                    .clicked()
+                {
+                    tool = t;
+                }
+            }
             if tool != self.tool {
                 self.set_tool(tool);
             }
@@ -381,9 +472,17 @@ impl EditorApp {
         ui.heading("Method");
         self.method_choice(ui);
         ui.separator();
-        ui.heading("Weights");
-        self.parameters(ui);
-        ui.separator();
+        let lbc = self.doc.as_ref().is_some_and(|d| d.method() == Method::Lbc);
+        if lbc || self.tool == Tool::Cage {
+            ui.heading("Cage");
+            self.cage_panel(ui);
+            ui.separator();
+        }
+        if !lbc {
+            ui.heading("Weights");
+            self.parameters(ui);
+            ui.separator();
+        }
         ui.heading("Show");
         self.overlay_toggles(ui);
         ui.separator();
@@ -444,8 +543,7 @@ impl EditorApp {
         let current = doc.method();
         let mut chosen = current;
         ui.horizontal_wrapped(|ui| {
-            // LBC needs the cage tool, which the editor does not have yet.
-            for m in [Method::C2, Method::Arap] {
+            for m in Method::ALL {
                 ui.selectable_value(&mut chosen, m, m.label())
                     .on_hover_text(match m {
                         Method::C2 => {
@@ -457,12 +555,16 @@ impl EditorApp {
                              shapes keep their proportions; the C² weights' settings do \
                              not apply"
                         }
-                        Method::Lbc => "Local barycentric coordinates of a cage",
+                        Method::Lbc => {
+                            "Local barycentric coordinates (Zhang et al. 2014): a cage \
+                             drawn around the subject moves what lies inside it, each \
+                             vertex only its neighbourhood; the outside stays"
+                        }
                     });
             }
         });
         if chosen != current {
-            let _ = self.edit(Edit::Method(chosen));
+            self.choose_method(chosen);
         }
     }
 
@@ -516,15 +618,26 @@ impl EditorApp {
     fn status_bar(&mut self, ui: &mut Ui) {
         ui.horizontal(|ui| {
             if let Some(doc) = &self.doc {
-                let stats = doc.rig().stats();
-                ui.label(format!("{} vertices", stats.samples));
-                ui.separator();
-                ui.label(format!(
-                    "{} handles ({} nodes) + {} virtual",
-                    stats.real_handles, stats.handle_nodes, stats.virtual_nodes
-                ));
-                ui.separator();
-                ui.label(format!("weights updated in {:.1} ms", doc.last_update_ms));
+                if doc.method() == Method::Lbc {
+                    let cage = doc.cage().map_or(0, |c| c.rest.len());
+                    match doc.cage_solution() {
+                        Some(solution) => ui.label(format!(
+                            "cage of {cage} vertices; {} mesh vertices inside",
+                            solution.domain.positions().len()
+                        )),
+                        None => ui.label(format!("cage of {cage} vertices, not solved")),
+                    };
+                } else {
+                    let stats = doc.rig().stats();
+                    ui.label(format!("{} vertices", stats.samples));
+                    ui.separator();
+                    ui.label(format!(
+                        "{} handles ({} nodes) + {} virtual",
+                        stats.real_handles, stats.handle_nodes, stats.virtual_nodes
+                    ));
+                    ui.separator();
+                    ui.label(format!("weights updated in {:.1} ms", doc.last_update_ms));
+                }
                 if let Some(times) = doc.arap_times() {
                     ui.separator();
                     ui.label(format!(
@@ -551,6 +664,18 @@ impl EditorApp {
                 ui.separator();
                 ui.spinner();
                 ui.label(format!("{what}… {seconds:.1} s"));
+                if let Some((first, last)) = self.solve_progress() {
+                    ui.add(
+                        egui::ProgressBar::new(solve_fraction(&first, &last))
+                            .desired_width(120.0)
+                            .text(format!("iteration {}", last.iteration)),
+                    )
+                    .on_hover_text(solve_text(&last));
+                    ui.label(format!(
+                        "residuals {:.1e} / {:.1e}",
+                        last.primal_residual, last.dual_residual
+                    ));
+                }
                 if ui.button("Cancel").on_hover_text("Escape").clicked() {
                     self.cancel_job();
                 }
@@ -668,6 +793,44 @@ impl EditorApp {
             None => {}
         }
     }
+}
+
+/// How far a cage's solve has come, 0 to 1: the share of the way (in orders of
+/// magnitude) from the first iteration's residuals to their thresholds, the slower of
+/// the two.
+pub(crate) fn solve_fraction(first: &lbc::Progress, last: &lbc::Progress) -> f32 {
+    let share = |r0: f64, r: f64, goal: f64| {
+        if r <= goal || r0 <= goal {
+            1.0
+        } else {
+            ((r0 / r).ln() / (r0 / goal).ln()).clamp(0.0, 1.0)
+        }
+    };
+    let primal = share(
+        first.primal_residual,
+        last.primal_residual,
+        last.primal_threshold,
+    );
+    let dual = share(first.dual_residual, last.dual_residual, last.dual_threshold);
+    if primal.is_finite() && dual.is_finite() {
+        primal.min(dual) as f32
+    } else {
+        0.0
+    }
+}
+
+/// One ADMM iteration in words.
+pub(crate) fn solve_text(p: &lbc::Progress) -> String {
+    format!(
+        "ADMM iteration {}: primal residual {:.2e} (to reach {:.2e}), dual residual {:.2e} \
+         (to reach {:.2e}), penalty {:.3}",
+        p.iteration,
+        p.primal_residual,
+        p.primal_threshold,
+        p.dual_residual,
+        p.dual_threshold,
+        p.penalty
+    )
 }
 
 fn metric_name(m: MetricChoice) -> &'static str {

@@ -4,6 +4,11 @@
 //! Every part carries a version; the callback resources remember the versions they
 //! uploaded, so a drag re-uploads only the node transforms (24 bytes a node), or with
 //! ARAP the deformed positions (8 bytes a vertex), and a new handle only the weights.
+//!
+//! For an LBC cage the mesh is the cage's inside with its compact rows, the nodes are
+//! the cage's vertices (no linear part, the posed vertex as translation), and a
+//! backdrop is drawn under it: the picture at rest with the rest cage's inside
+//! cleared, as the export keeps the outside.
 
 use std::sync::Arc;
 
@@ -63,12 +68,17 @@ pub struct GpuFrame {
     /// Deformed positions per vertex, from a method that solves for them (ARAP);
     /// empty when the node transforms skin the mesh.
     pub positions: Versioned<Vec<Vec2>>,
+    /// A picture drawn at rest under the mesh (the cage tool's view), if any.
+    pub backdrop: Option<Versioned<RgbaImage>>,
 }
 
 /// The GPU side, kept in the renderer's callback resources.
 pub struct SceneResources {
     view: MeshView,
     uploaded: [u64; 6],
+    /// Draws [`GpuFrame::backdrop`]: the picture on a rectangle of two triangles.
+    backdrop: MeshView,
+    backdrop_uploaded: u64,
     /// The last upload failure, if any (shown in the status bar).
     pub error: Option<String>,
 }
@@ -80,8 +90,42 @@ impl SceneResources {
         Self {
             view: MeshView::new(device, queue, format, 1),
             uploaded: [0; 6],
+            backdrop: MeshView::new(device, queue, format, 1),
+            backdrop_uploaded: 0,
             error: None,
         }
+    }
+
+    /// Uploads a new backdrop: its picture, on a rectangle of its size that one
+    /// identity transform places.
+    fn set_backdrop(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        picture: &RgbaImage,
+    ) -> Result<(), render::RenderError> {
+        let (w, h) = (picture.width() as f32, picture.height() as f32);
+        let rest = [
+            Vec2::new(0.0, 0.0),
+            Vec2::new(w, 0.0),
+            Vec2::new(w, h),
+            Vec2::new(0.0, h),
+        ];
+        let mesh = SkinnedMesh {
+            rest: &rest,
+            rows: &[0, 1, 2, 3, 4],
+            nodes: &[0; 4],
+            weights: &[1.0; 4],
+            triangles: &[[0, 1, 2], [0, 2, 3]],
+        };
+        self.backdrop.set_texture(device, queue, picture);
+        let identity: Affine = [1.0, 0.0, 0.0, 1.0, 0.0, 0.0];
+        self.backdrop.set_mesh(
+            device,
+            &mesh,
+            &[identity],
+            [picture.width(), picture.height()],
+        )
     }
 
     fn update(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, frame: &GpuFrame) {
@@ -132,6 +176,13 @@ impl SceneResources {
         {
             result = self.view.set_cells(queue, &frame.cells.value);
         }
+        if result.is_ok()
+            && let Some(backdrop) = &frame.backdrop
+            && backdrop.version != self.backdrop_uploaded
+        {
+            result = self.set_backdrop(device, queue, &backdrop.value);
+            self.backdrop_uploaded = backdrop.version;
+        }
         self.error = result.err().map(|e| e.to_string());
         self.uploaded = versions;
     }
@@ -157,6 +208,15 @@ impl egui_wgpu::CallbackTrait for MeshCallback {
         if let Some(scene) = resources.get_mut::<SceneResources>() {
             scene.update(device, queue, &self.frame);
             scene.view.prepare(queue, &self.params);
+            if self.frame.backdrop.is_some() {
+                let plain = ViewParams {
+                    overlay: render::Overlay::None,
+                    show_folds: false,
+                    wireframe: false,
+                    ..self.params
+                };
+                scene.backdrop.prepare(queue, &plain);
+            }
         }
         Vec::new()
     }
@@ -170,6 +230,9 @@ impl egui_wgpu::CallbackTrait for MeshCallback {
         if let Some(scene) = resources.get::<SceneResources>()
             && scene.error.is_none()
         {
+            if self.frame.backdrop.is_some() {
+                scene.backdrop.paint(pass, false);
+            }
             scene.view.paint(pass, self.params.wireframe);
         }
     }

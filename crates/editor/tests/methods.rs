@@ -383,28 +383,3 @@ fn painted_rigidity_survives_a_new_density() {
     assert_eq!(h.state().painted_triangles(), fresh);
     h.state().sanity_check().expect("consistent");
 }
-
-#[test]
-fn a_cage_project_is_refused_with_a_message_and_the_work_stays() {
-    let dir = tempfile::tempdir().expect("temp dir");
-    support::write_lizard(dir.path());
-    std::fs::write(
-        dir.path().join("project.json"),
-        r#"{"version": 1, "image": "lizard.png", "method": "lbc", "handles": [],
-            "cage": {"rest": [[300, 400], [500, 420], [480, 560]]}}"#,
-    )
-    .expect("write project");
-    let mut h = editor(dir.path());
-    let before = h.state().document().expect("doc").project().clone();
-    h.get_by_label("File").click();
-    h.run();
-    click_label(&mut h, "Open project…");
-    support::settle(&mut h);
-    let message = h.state().message.as_ref().map(|m| m.text.clone());
-    assert!(
-        message.as_deref().is_some_and(|m| m.contains("LBC cage")),
-        "{message:?}"
-    );
-    assert_eq!(h.state().document().expect("doc").project(), &before);
-    h.state().sanity_check().expect("consistent");
-}

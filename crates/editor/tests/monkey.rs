@@ -1,10 +1,12 @@
 //! The monkey: the real editor driven by a seeded random sequence of everything a user
 //! can do — every shortcut, toolbar button and checkbox, clicks, drags (plain, Alt,
 //! Shift, middle), Delete or undo in the middle of a drag, new parameters and
-//! densities, opening, saving, exporting, dropped files, cancelled jobs — in every
-//! state (no handles, one, many, after Clear, during a background job). After every
-//! action the editor must not have panicked and [`EditorApp::sanity_check`] must
-//! hold.
+//! densities, opening, saving, exporting, dropped files, cancelled jobs, the cage tool
+//! (polygons clicked and closed or not, cages from the outline, solves finished and
+//! cancelled, vertices and boxes dragged at rest and posed) — in every state (no
+//! handles, one, many, after Clear, no cage, a cage drawn, solved, posed, during a
+//! background job). After every action the editor must not have panicked and
+//! [`EditorApp::sanity_check`] must hold.
 //!
 //! CI runs a short walk. A long one:
 //! `MONKEY_ACTIONS=5000 MONKEY_SEEDS=1,2,3,4,5,6,7,8 cargo test --release -p editor
@@ -21,7 +23,7 @@ use egui::{Key, Modifiers, Pos2, Vec2};
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use glam::DVec2;
-use project::MetricChoice;
+use project::{LbcSettings, MetricChoice, Tau};
 
 use editor::{Answer, Dialogs, Edit, EditorApp, FileAction};
 use support::{Dropped, build};
@@ -144,6 +146,20 @@ const LABELS: &[&str] = &[
     "Replace",
     "Save",
     "Open",
+    "Cage",
+    "LBC cage",
+    "Close cage",
+    "Cancel drawing",
+    "Use the kept cage",
+    "Solve",
+    "Edit the rest cage",
+    "Pose the cage",
+    "New cage",
+    "Clear cage",
+    "Cage from outline",
+    "Cage from outline",
+    "Support contour (0.001/n)",
+    "Locality plots",
 ];
 
 const KEYS: &[(Modifiers, Key)] = &[
@@ -152,6 +168,10 @@ const KEYS: &[(Modifiers, Key)] = &[
     (Modifiers::NONE, Key::P),
     (Modifiers::NONE, Key::B),
     (Modifiers::NONE, Key::R),
+    (Modifiers::NONE, Key::K),
+    (Modifiers::NONE, Key::K),
+    (Modifiers::NONE, Key::Enter),
+    (Modifiers::NONE, Key::Enter),
     (Modifiers::NONE, Key::F),
     (Modifiers::NONE, Key::M),
     (Modifiers::NONE, Key::H),
@@ -180,13 +200,21 @@ impl Monkey {
         }
     }
 
-    /// A point on the canvas: often on or near a handle, else anywhere.
+    /// A point on the canvas: often on or near a handle or a cage vertex (at rest or
+    /// posed), else anywhere.
     fn somewhere(&mut self) -> Pos2 {
         let app = self.h.state();
         let canvas = app.viewport.canvas;
         let handles: Vec<DVec2> = app
             .document()
-            .map(|d| d.project().handles.iter().flat_map(editor::posed).collect())
+            .map(|d| {
+                let mut points: Vec<DVec2> =
+                    d.project().handles.iter().flat_map(editor::posed).collect();
+                points.extend(d.cage_rest());
+                points.extend(d.cage_pose());
+                points.extend(app.cage_draft().unwrap_or_default());
+                points
+            })
             .unwrap_or_default();
         if !handles.is_empty() && self.rng.chance(0.5) {
             let p = *self.rng.pick(&handles);
@@ -223,7 +251,8 @@ impl Monkey {
     /// One random action; returns what it did.
     fn act(&mut self) -> String {
         match self.rng.below(100) {
-            0..=24 => {
+            0..=8 => self.cage(),
+            9..=24 => {
                 let (modifiers, key) = *self.rng.pick(KEYS);
                 self.h.key_press_modifiers(modifiers, key);
                 self.frames(2);
@@ -270,7 +299,8 @@ impl Monkey {
                 self.frames(2);
                 format!("wheel at {pos:?}")
             }
-            85..=89 => self.settings(),
+            85..=87 => self.settings(),
+            88..=89 => self.cage_settings(),
             90..=92 => {
                 let name = *self
                     .rng
@@ -366,6 +396,106 @@ impl Monkey {
         )
     }
 
+    /// Something with the cage tool: a polygon clicked (closed on its first vertex,
+    /// by Enter, by a double click, or left open), a cage from the outline, a solve
+    /// (waited for or not), or a drag from a cage vertex.
+    fn cage(&mut self) -> String {
+        if self.h.state().tool != editor::Tool::Cage {
+            self.h.key_press(Key::K);
+            self.frames(2);
+        }
+        match self.rng.below(6) {
+            0 | 1 => {
+                let canvas = self.h.state().viewport.canvas;
+                let centre = Pos2::new(
+                    canvas.min.x + self.rng.unit() * canvas.width(),
+                    canvas.min.y + self.rng.unit() * canvas.height(),
+                );
+                let n = 3 + self.rng.below(6);
+                let radius = 20.0 + self.rng.unit() * 200.0;
+                // Now and then out of order, so that edges cross.
+                let shuffle = self.rng.chance(0.2);
+                let mut points = Vec::new();
+                for i in 0..n {
+                    let turn = if shuffle {
+                        self.rng.unit()
+                    } else {
+                        i as f32 / n as f32
+                    };
+                    let angle = turn * std::f32::consts::TAU;
+                    let pos = centre + Vec2::angled(angle) * radius;
+                    points.push(pos);
+                    self.h.hover_at(pos);
+                    self.frames(1);
+                    self.button(pos, egui::PointerButton::Primary, true, Modifiers::NONE);
+                    self.frames(1);
+                    self.button(pos, egui::PointerButton::Primary, false, Modifiers::NONE);
+                    self.frames(1);
+                }
+                let close = self.rng.below(4);
+                match close {
+                    0 => {
+                        let first = points[0];
+                        self.h.hover_at(first);
+                        self.frames(1);
+                        self.button(first, egui::PointerButton::Primary, true, Modifiers::NONE);
+                        self.frames(1);
+                        self.button(first, egui::PointerButton::Primary, false, Modifiers::NONE);
+                    }
+                    1 => self.h.key_press(Key::Enter),
+                    2 => {
+                        let last = points[n - 1];
+                        self.button(last, egui::PointerButton::Primary, true, Modifiers::NONE);
+                        self.button(last, egui::PointerButton::Primary, false, Modifiers::NONE);
+                    }
+                    _ => {}
+                }
+                self.frames(2);
+                format!("cage of {n} clicked around {centre:?} (shuffled {shuffle}, close {close})")
+            }
+            2 => {
+                let found = self.h.query_by_label("Cage from outline").is_some();
+                if let Some(node) = self.h.query_by_label("Cage from outline") {
+                    node.click();
+                }
+                self.frames(2);
+                format!("cage from outline (found {found})")
+            }
+            3 => {
+                self.h.key_press(Key::Enter);
+                self.frames(1);
+                let wait = self.rng.chance(0.7);
+                let start = Instant::now();
+                while wait && self.h.state().is_busy() && start.elapsed().as_secs() < 60 {
+                    self.h.step();
+                    std::thread::sleep(std::time::Duration::from_millis(5));
+                }
+                self.frames(1);
+                format!("Enter with the cage tool, waited {wait}")
+            }
+            _ => {
+                // From a cage vertex (somewhere() picks them often) or from empty canvas.
+                self.drag()
+            }
+        }
+    }
+
+    /// New LBC settings (τ, a few mesh vertices inside the cage), as the side panel
+    /// applies them.
+    fn cage_settings(&mut self) -> String {
+        let tau = *self
+            .rng
+            .pick(&[Tau::Square, Tau::Linear, Tau::Sqrt, Tau::Constant]);
+        let density = *self.rng.pick(&[60, 120, 200]);
+        let settings = LbcSettings {
+            tau,
+            density: Some(density),
+        };
+        let applied = self.h.state_mut().edit(Edit::Lbc(settings));
+        self.frames(2);
+        format!("cage settings {settings:?} applied={applied}")
+    }
+
     /// New weighting parameters, as the side panel applies them.
     fn settings(&mut self) -> String {
         let Some(doc) = self.h.state().document() else {
@@ -405,7 +535,9 @@ fn walk(seed: u64, actions: usize) {
     let builder = Harness::builder()
         .with_accessibility_check(false)
         .with_max_steps(10_000);
-    let h = build(builder, Box::new(dialogs), gpu);
+    let mut h = build(builder, Box::new(dialogs), gpu);
+    // New cages are solved on a small mesh, so a debug build solves in a second.
+    h.state_mut().cage_vertices = 120;
     let mut monkey = Monkey {
         h,
         rng,
@@ -420,13 +552,19 @@ fn walk(seed: u64, actions: usize) {
     }
     let clock = Instant::now();
     let mut slowest: Vec<(f64, String)> = Vec::new();
+    // Actions taken in each state of the cage tool: drawing, at rest, posed.
+    let mut cage_states = [0usize; 3];
     for step in 0..actions {
         let result = std::panic::catch_unwind(AssertUnwindSafe(|| {
             let started = Instant::now();
             let what = monkey.act();
             slowest.push((started.elapsed().as_secs_f64(), what.clone()));
             monkey.trail.push(what);
-            monkey.h.state().sanity_check()
+            let app = monkey.h.state();
+            if app.tool == editor::Tool::Cage {
+                cage_states[app.cage_state() as usize] += 1;
+            }
+            app.sanity_check()
         }));
         let failure = match result {
             Ok(Ok(())) => None,
@@ -471,6 +609,10 @@ fn walk(seed: u64, actions: usize) {
     println!(
         "monkey seed {seed}: {actions} actions in {seconds:.1} s ({:.0} actions/s), gpu={gpu}",
         actions as f64 / seconds
+    );
+    println!(
+        "  with the cage tool: {} actions drawing, {} at rest, {} posed",
+        cage_states[0], cage_states[1], cage_states[2]
     );
     slowest.sort_by(|a, b| b.0.total_cmp(&a.0));
     for (s, what) in slowest.iter().take(3) {

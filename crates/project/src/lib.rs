@@ -142,6 +142,12 @@ pub struct LbcSettings {
     /// The locality weighting.
     #[serde(default)]
     pub tau: Tau,
+    /// Target number of mesh vertices inside the cage, where the coordinates are
+    /// solved (default: the rig's `density`, else the tools' cage default). Kept apart
+    /// from `density` so that a project can hold both a picture mesh for handles and a
+    /// much smaller mesh for the cage: the solve's time grows quickly with the count.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density: Option<usize>,
 }
 
 /// The most vertices a cage may have.
@@ -537,6 +543,9 @@ impl Project {
         } else if self.method == Method::Lbc {
             return bad("method \"lbc\" needs a \"cage\"".into());
         }
+        if let Some(d) = self.lbc.and_then(|l| l.density) {
+            validate_density(d)?;
+        }
         let points: usize = self.rigidity.iter().map(|s| s.stroke.len()).sum();
         if points > MAX_STROKE_POINTS {
             return bad(format!(
@@ -604,7 +613,10 @@ mod tests {
                 rest: vec![[0.0, 0.0], [50.5, 0.0], [25.0, 1.0 / 3.0]],
                 pose: Some(vec![[1.0, 0.0], [50.5, 2.0], [25.0, 40.0]]),
             }),
-            lbc: Some(LbcSettings { tau: Tau::Sqrt }),
+            lbc: Some(LbcSettings {
+                tau: Tau::Sqrt,
+                density: Some(500),
+            }),
             rigidity: vec![
                 RigidityStroke {
                     stroke: vec![[3.0, 4.0], [10.25, 1.0 / 3.0]],
@@ -771,6 +783,10 @@ mod tests {
             (
                 r#"{"version":1,"handles":[],"lbc":{"tau":"cubic"}}"#,
                 "unknown variant `cubic`",
+            ),
+            (
+                r#"{"version":1,"handles":[],"lbc":{"density":3}}"#,
+                "density must be between 16",
             ),
         ];
         for (text, expected) in cases {

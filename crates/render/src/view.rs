@@ -391,7 +391,7 @@ impl MeshView {
     ) -> Result<(), RenderError> {
         mesh.validate(transforms)?;
         let size = [source_size[0].max(1) as f32, source_size[1].max(1) as f32];
-        let vertices: Vec<ViewVertex> = mesh
+        let mut vertices: Vec<ViewVertex> = mesh
             .rest
             .iter()
             .map(|p| ViewVertex {
@@ -399,6 +399,13 @@ impl MeshView {
                 uv: [p.x / size[0], p.y / size[1]],
             })
             .collect();
+        if vertices.is_empty() {
+            // Buffers may not be empty; an empty mesh draws nothing (see `paint`).
+            vertices.push(ViewVertex {
+                rest: [0.0; 2],
+                uv: [0.0; 2],
+            });
+        }
         // Every rest triangle gets a positive signed area in image coordinates (y
         // down), which the y flip of `ViewParams::scale` makes clockwise in device
         // coordinates: the pipelines' front face. A fold-over shows its back.
@@ -598,9 +605,12 @@ impl MeshView {
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
     }
 
-    /// Records the draw calls (mesh, then wireframe if asked) into `pass`.
+    /// Records the draw calls (mesh, then wireframe if asked) into `pass`. A mesh
+    /// without vertices draws nothing.
     pub fn paint(&self, pass: &mut wgpu::RenderPass<'_>, wireframe: bool) {
-        let Some(mesh) = &self.mesh else { return };
+        let Some(mesh) = self.mesh.as_ref().filter(|m| m.vertex_count > 0) else {
+            return;
+        };
         pass.set_bind_group(0, &self.texture, &[]);
         pass.set_bind_group(1, &mesh.skin, &[]);
         pass.set_vertex_buffer(0, mesh.vertices.slice(..));
