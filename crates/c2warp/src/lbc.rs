@@ -73,24 +73,25 @@ struct LbcWeights {
 }
 
 /// `c2warp render` for a cage: the inside of the rest cage drawn where the posed cage
-/// takes it, the rest of the picture as it is (8 bits per channel, on the CPU).
+/// takes it, the rest of the picture as it is (8 bits per channel; with `gpu` the
+/// inside is drawn by the GPU's skinning shader from the compact rows).
 pub fn render(
     picture: &render::Picture,
     project: &Project,
     density: Option<usize>,
     gpu: bool,
 ) -> Result<render::Picture> {
-    if gpu {
-        anyhow::bail!("LBC cages are drawn on the CPU: leave out --gpu");
-    }
     let image = picture.to_rgba8();
     project.validate(Some(image.dimensions()))?;
     let target_vertices = pipeline::cage::cage_vertices(project, density);
     project::validate_density(target_vertices)?;
     let solved = solve_on(project, CageMesh::Triangulate { target_vertices })?;
-    Ok(render::Picture::Rgba8(pipeline::cage::warp_by_cage(
-        &image, &solved,
-    )?))
+    let warped = if gpu {
+        pipeline::cage::warp_by_cage_gpu(&image, &solved)?
+    } else {
+        pipeline::cage::warp_by_cage(&image, &solved)?
+    };
+    Ok(render::Picture::Rgba8(warped))
 }
 
 /// `c2warp weights` for a cage: the nodes are the cage's vertices in order; every mesh

@@ -1394,7 +1394,7 @@ impl EditorApp {
         }
         if weights_changed || doc.pose_version != seen.pose {
             let affines = match (cage_view, &cage) {
-                (true, Some(_)) => crate::cage::pose_affines(&doc.cage_pose()),
+                (true, Some(_)) => pipeline::cage::pose_transforms(&doc.cage_pose()),
                 (true, None) => Vec::new(),
                 (false, _) => doc.rig().node_affines(),
             };

@@ -167,18 +167,7 @@ pub fn contour(triangles: &[[u32; 3]], values: &[f32], level: f32) -> Vec<Contou
 /// `(cage vertex, weight)` pairs, so that node transforms with no linear part and the
 /// posed cage vertices as translations give `x' = Σ wᵢ cᵢ'`.
 pub(crate) fn mesh_data(solution: &CageCoordinates, source_size: [u32; 2]) -> MeshData {
-    let weights = &solution.weights;
-    let mut rows = Vec::with_capacity(weights.vertices() + 1);
-    let mut nodes = Vec::with_capacity(weights.len());
-    let mut values = Vec::with_capacity(weights.len());
-    rows.push(0);
-    for v in 0..weights.vertices() {
-        for &(k, w) in weights.row(v) {
-            nodes.push(k);
-            values.push(w as f32);
-        }
-        rows.push(nodes.len() as u32);
-    }
+    let (rows, nodes, weights) = pipeline::cage::skinning_table(&solution.weights);
     MeshData {
         rest: solution
             .domain
@@ -188,18 +177,10 @@ pub(crate) fn mesh_data(solution: &CageCoordinates, source_size: [u32; 2]) -> Me
             .collect(),
         rows,
         nodes,
-        weights: values,
+        weights,
         triangles: solution.domain.triangles().to_vec(),
         source_size,
     }
-}
-
-/// The node transforms that pose the cage: no linear part, the posed vertex as the
-/// translation.
-pub(crate) fn pose_affines(pose: &[DVec2]) -> Vec<render::Affine> {
-    pose.iter()
-        .map(|p| [0.0, 0.0, 0.0, 0.0, p.x as f32, p.y as f32])
-        .collect()
 }
 
 /// The picture as LBC leaves it outside the cage: pixels inside the rest cage cleared
@@ -1246,11 +1227,5 @@ mod tests {
         // A bow tie: edges 1 and 3 cross in the middle.
         let bow = [square[0], square[1], square[3], square[2]];
         assert_eq!(crossing_edges(&bow), vec![(1, 3)]);
-    }
-
-    #[test]
-    fn pose_affines_translate_by_the_posed_vertex() {
-        let a = pose_affines(&[DVec2::new(3.0, -4.0)]);
-        assert_eq!(a, vec![[0.0, 0.0, 0.0, 0.0, 3.0, -4.0]]);
     }
 }

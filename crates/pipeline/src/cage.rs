@@ -165,12 +165,7 @@ pub fn warp_by_cage_posed(
     if deformed.iter().any(|p| !p.is_finite()) {
         bail!("the cage sent a vertex to a non-finite position");
     }
-    let rest: Vec<glam::Vec2> = solved
-        .domain
-        .positions()
-        .iter()
-        .map(|p| p.as_vec2())
-        .collect();
+    let rest = rest_positions(solved);
     let deformed: Vec<glam::Vec2> = deformed.iter().map(|p| p.as_vec2()).collect();
     let (w, h) = image.dimensions();
     let layer = render::warp_cpu(
@@ -184,12 +179,91 @@ pub fn warp_by_cage_posed(
         h,
         &render::RasterOptions::default(),
     )?;
+    Ok(composite(image, solved, &layer))
+}
+
+/// As [`warp_by_cage`], with the inside drawn on a GPU (or a software adapter) by the
+/// skinning shader the C² weights use: the compact rows are its weight rows and each
+/// cage vertex a node whose transform has no linear part and the posed vertex as its
+/// translation ([`skinning_table`], [`pose_transforms`]).
+///
+/// # Errors
+/// No usable adapter, non-finite pose, or a picture too large for the device.
+pub fn warp_by_cage_gpu(
+    image: &image::RgbaImage,
+    solved: &CageCoordinates,
+) -> Result<image::RgbaImage> {
+    if solved.pose.iter().any(|p| !p.is_finite()) {
+        bail!("the cage's pose is not finite");
+    }
+    let gpu = render::GpuContext::new()?;
+    let rest = rest_positions(solved);
+    let (rows, nodes, weights) = skinning_table(&solved.weights);
+    let (w, h) = image.dimensions();
+    let layer = gpu.warp_skinned(
+        image,
+        &render::SkinnedMesh {
+            rest: &rest,
+            rows: &rows,
+            nodes: &nodes,
+            weights: &weights,
+            triangles: solved.domain.triangles(),
+        },
+        &pose_transforms(&solved.pose),
+        w,
+        h,
+    )?;
+    Ok(composite(image, solved, &layer))
+}
+
+/// The compact rows as a skinning shader reads them: row `v` is
+/// `nodes[rows[v]..rows[v + 1]]` with `weights` alongside (cage vertex indices and
+/// their weights), as [`render::SkinnedMesh`] takes them.
+pub fn skinning_table(weights: &lbc::CompactWeights) -> (Vec<u32>, Vec<u32>, Vec<f32>) {
+    let mut rows = Vec::with_capacity(weights.vertices() + 1);
+    let mut nodes = Vec::with_capacity(weights.len());
+    let mut values = Vec::with_capacity(weights.len());
+    rows.push(0);
+    for v in 0..weights.vertices() {
+        for &(k, w) in weights.row(v) {
+            nodes.push(k);
+            values.push(w as f32);
+        }
+        rows.push(nodes.len() as u32);
+    }
+    (rows, nodes, values)
+}
+
+/// The node transforms that pose a cage in the skinning shader: no linear part, the
+/// posed vertex as the translation, so that `Σ wᵢ (Aᵢ x + tᵢ) = Σ wᵢ cᵢ'`.
+pub fn pose_transforms(pose: &[DVec2]) -> Vec<render::Affine> {
+    pose.iter()
+        .map(|p| [0.0, 0.0, 0.0, 0.0, p.x as f32, p.y as f32])
+        .collect()
+}
+
+/// The mesh's rest positions, in single precision for drawing.
+fn rest_positions(solved: &CageCoordinates) -> Vec<glam::Vec2> {
+    solved
+        .domain
+        .positions()
+        .iter()
+        .map(|p| p.as_vec2())
+        .collect()
+}
+
+/// `layer` (the warped inside) over `image` with the inside of the rest cage cleared.
+fn composite(
+    image: &image::RgbaImage,
+    solved: &CageCoordinates,
+    layer: &image::RgbaImage,
+) -> image::RgbaImage {
     let mut out = image.clone();
     clear_inside(&mut out, solved.domain.cage().vertices());
     for (base, top) in out.pixels_mut().zip(layer.pixels()) {
         *base = over(top.0, base.0).into();
     }
-    Ok(out)
+    out
 }
 
 /// Makes every pixel whose centre lies inside the polygon `cage` transparent (even-odd
@@ -410,6 +484,12 @@ fn split_longest_edges(ring: &mut Vec<DVec2>, target: usize) {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn pose_transforms_translate_by_the_posed_vertex() {
+        let a = super::pose_transforms(&[DVec2::new(3.0, -4.0)]);
+        assert_eq!(a, vec![[0.0, 0.0, 0.0, 0.0, 3.0, -4.0]]);
+    }
+
     use super::*;
 
     /// A disc and a thin bar off it, as a cut-out.
