@@ -57,10 +57,19 @@ fn main() {
         let total = start.elapsed();
         let r = &solved.report;
         let compact = solved.compact();
+        let pose: Vec<glam::DVec2> = case.cage.vertices().iter().map(|p| *p * 1.1).collect();
+        let mut deform: Vec<f64> = (0..15)
+            .map(|_| {
+                let clock = Instant::now();
+                std::hint::black_box(compact.deform(&pose).expect("pose fits"));
+                clock.elapsed().as_secs_f64() * 1e3
+            })
+            .collect();
+        deform.sort_by(f64::total_cmp);
         println!(
             "{:12} {:2} cage vertices, {:6} mesh vertices: {:6.3} s (geodesics {:.3} s, \
              factorisation {:.3} s, ADMM {:.3} s = {} iterations × {:.2} ms, projection {:.3} s), \
-             converged {}, objective {:.6e}, {:.2} weights per vertex",
+             converged {}, objective {:.6e}, {:.2} weights per vertex, deformation {:.2} ms",
             case.name,
             case.cage.len(),
             domain.positions().len(),
@@ -74,6 +83,7 @@ fn main() {
             r.converged,
             r.objective,
             compact.len() as f64 / compact.vertices() as f64,
+            deform[deform.len() / 2],
         );
     }
 }
