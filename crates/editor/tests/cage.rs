@@ -13,7 +13,7 @@ use glam::DVec2;
 use project::{LbcSettings, Method, Tau};
 
 use editor::{CageKey, CageState, Edit, EditorApp, Tool};
-use support::{at, click_at, click_label, drag, editor, settle};
+use support::{at, changed, click_at, click_label, drag, editor, settle, shot};
 
 /// The cage clicked around the lizard's body (image pixels, at rest).
 const BODY: [[f64; 2]; 6] = [
@@ -28,29 +28,6 @@ const BODY: [[f64; 2]; 6] = [
 /// Mesh vertices inside the cage in these tests: few, so a debug build solves in
 /// seconds.
 const DENSITY: usize = 300;
-
-/// The share of pixels that differ by more than 8 in some channel.
-fn changed(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
-    assert_eq!(a.dimensions(), b.dimensions());
-    let differ = a
-        .pixels()
-        .zip(b.pixels())
-        .filter(|(p, q)| p.0.iter().zip(q.0).any(|(x, y)| x.abs_diff(y) > 8))
-        .count();
-    differ as f64 / (a.width() * a.height()) as f64
-}
-
-/// The canvas as drawn.
-fn shot(h: &mut Harness<'_, EditorApp>) -> image::RgbaImage {
-    h.run();
-    let frame = h.render().expect("a frame drawn on the software adapter");
-    let scale = h.ctx.pixels_per_point();
-    let canvas = h.state().viewport.canvas;
-    let [x, y] = [canvas.min.x * scale, canvas.min.y * scale].map(|v| v.max(0.0) as u32);
-    let w = ((canvas.width() * scale) as u32).min(frame.width() - x);
-    let h = ((canvas.height() * scale) as u32).min(frame.height() - y);
-    image::imageops::crop_imm(&frame, x, y, w, h).to_image()
-}
 
 /// The canvas pixel that shows image point `p`.
 fn pixel(h: &Harness<'_, EditorApp>, shot: &image::RgbaImage, p: DVec2) -> image::Rgba<u8> {
@@ -361,13 +338,7 @@ fn an_lbc_export_is_what_the_pipeline_draws_for_the_saved_project() {
     let from = at(&h, BODY[3][0], BODY[3][1]);
     drag(&mut h, from, from + Vec2::new(-20.0, 25.0), Modifiers::NONE);
     assert!(pose(&h).is_some());
-    h.get_by_label("File").click();
-    h.run();
-    click_label(&mut h, "Export PNG…");
-    settle(&mut h);
-    let exported = image::open(dir.path().join("warped.png"))
-        .expect("an exported PNG")
-        .to_rgba8();
+    let exported = support::export_png(&mut h, dir.path());
     // What `c2warp render` does with the saved project: mesh the cage's inside to the
     // project's count, solve, warp.
     let doc = h.state().document().expect("doc");

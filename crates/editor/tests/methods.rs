@@ -12,30 +12,7 @@ use pipeline::{ArapRig, Deformer};
 use project::Method;
 
 use editor::{EditorApp, Tool};
-use support::{at, click_label, drag, editor};
-
-/// The share of pixels that differ by more than 8 in some channel.
-fn changed(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
-    assert_eq!(a.dimensions(), b.dimensions());
-    let differ = a
-        .pixels()
-        .zip(b.pixels())
-        .filter(|(p, q)| p.0.iter().zip(q.0).any(|(x, y)| x.abs_diff(y) > 8))
-        .count();
-    differ as f64 / (a.width() * a.height()) as f64
-}
-
-/// The canvas as drawn (the panels around it show times and messages that differ).
-fn shot(h: &mut Harness<'_, EditorApp>) -> image::RgbaImage {
-    h.run();
-    let frame = h.render().expect("a frame drawn on the software adapter");
-    let scale = h.ctx.pixels_per_point();
-    let canvas = h.state().viewport.canvas;
-    let [x, y] = [canvas.min.x * scale, canvas.min.y * scale].map(|v| v.max(0.0) as u32);
-    let w = ((canvas.width() * scale) as u32).min(frame.width() - x);
-    let h = ((canvas.height() * scale) as u32).min(frame.height() - y);
-    image::imageops::crop_imm(&frame, x, y, w, h).to_image()
-}
+use support::{at, changed, click_label, drag, editor, shot};
 
 fn method(h: &Harness<'_, EditorApp>) -> Method {
     h.state().document().expect("a document").method()
@@ -299,13 +276,7 @@ fn an_arap_export_is_what_the_pipeline_draws_for_the_saved_project() {
     let dir = tempfile::tempdir().expect("temp dir");
     let mut h = editor(dir.path());
     click_label(&mut h, "ARAP");
-    h.get_by_label("File").click();
-    h.run();
-    click_label(&mut h, "Export PNG…");
-    support::settle(&mut h);
-    let exported = image::open(dir.path().join("warped.png"))
-        .expect("an exported PNG")
-        .to_rgba8();
+    let exported = support::export_png(&mut h, dir.path());
     let doc = h.state().document().expect("doc");
     let project = doc.project_for_saving(None);
     assert_eq!(project.method, Method::Arap);

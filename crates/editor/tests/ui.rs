@@ -138,13 +138,7 @@ fn an_editing_session() {
     assert_eq!(saved.image.as_deref(), Some(Path::new("lizard.png")));
     assert_eq!(saved.handles, handles(&h));
 
-    h.get_by_label("File").click();
-    h.run();
-    click_label(&mut h, "Export PNG…");
-    settle(&mut h);
-    let exported = image::open(dir.path().join("warped.png"))
-        .expect("an exported PNG")
-        .to_rgba8();
+    let exported = support::export_png(&mut h, dir.path());
     // `c2warp render lizard.png --rig project.json` runs exactly this.
     let picture = pipeline::load_image(&lizard).expect("picture");
     let project = pipeline::load_project(&dir.path().join("project.json")).expect("project");

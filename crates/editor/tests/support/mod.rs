@@ -181,3 +181,38 @@ impl egui::DroppedFile for Dropped {
         std::fs::read(&self.0).map_err(|e| e.to_string())
     }
 }
+
+/// The share of pixels that differ by more than 8 in some channel.
+pub fn changed(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
+    assert_eq!(a.dimensions(), b.dimensions());
+    let differ = a
+        .pixels()
+        .zip(b.pixels())
+        .filter(|(p, q)| p.0.iter().zip(q.0).any(|(x, y)| x.abs_diff(y) > 8))
+        .count();
+    differ as f64 / (a.width() * a.height()) as f64
+}
+
+/// The canvas as drawn (the panels around it show times and messages that differ).
+pub fn shot(h: &mut Harness<'_, EditorApp>) -> image::RgbaImage {
+    h.run();
+    let frame = h.render().expect("a frame drawn on the software adapter");
+    let scale = h.ctx.pixels_per_point();
+    let canvas = h.state().viewport.canvas;
+    let [x, y] = [canvas.min.x * scale, canvas.min.y * scale].map(|v| v.max(0.0) as u32);
+    let w = ((canvas.width() * scale) as u32).min(frame.width() - x);
+    let h = ((canvas.height() * scale) as u32).min(frame.height() - y);
+    image::imageops::crop_imm(&frame, x, y, w, h).to_image()
+}
+
+/// File > Export PNG… (the scripted dialog answers `dir/warped.png`), waited for, and
+/// the exported picture read back.
+pub fn export_png(h: &mut Harness<'_, EditorApp>, dir: &Path) -> image::RgbaImage {
+    h.get_by_label("File").click();
+    h.run();
+    click_label(h, "Export PNG…");
+    settle(h);
+    image::open(dir.join("warped.png"))
+        .expect("an exported PNG")
+        .to_rgba8()
+}
