@@ -545,7 +545,7 @@ impl Problem {
             .enumerate()
             .map(|(part, ((next1, t1), gt))| {
                 gt.fill(0.0);
-                let mut r = Lanes::default();
+                let mut r = Residuals::default();
                 for (k, (out, ts)) in next1
                     .chunks_exact_mut(2 * n)
                     .zip(t1.chunks_exact(2 * n))
@@ -577,7 +577,7 @@ impl Problem {
                         }
                     }
                 }
-                r.sum()
+                r
             })
             .reduce(Residuals::default, Residuals::add);
         {
@@ -606,16 +606,15 @@ impl Problem {
                 let v = self.interior[j] as usize;
                 let zj = &z[v * n..(v + 1) * n];
                 let (root, m) = (self.root[j], self.split[j]);
-                let mut r = Lanes::default();
-                let mut one = |i: usize, lane: usize| {
+                let mut r = Residuals::default();
+                for i in 0..n {
                     let u = tj[i] / root - zj[i];
                     let w = (zj[i] - u).max(0.0);
                     wj[i] = w;
                     out[i] = root * (alpha * w + (1.0 - alpha) * zj[i] + u);
-                    r.add(lane, [(w - zj[i]).powi(2), w * w, zj[i] * zj[i], u * u]);
-                };
-                for_lanes(n, &mut one);
-                r.sum().scaled(m)
+                    r.add_terms([(w - zj[i]).powi(2), w * w, zj[i] * zj[i], u * u]);
+                }
+                r.scaled(m)
             })
             .reduce(Residuals::default, Residuals::add);
         let mut r = gradients.add(values);
@@ -637,7 +636,7 @@ impl Problem {
         out: &mut [f64],
         inverse_penalty: f64,
         alpha: f64,
-        r: &mut Lanes,
+        r: &mut Residuals,
     ) {
         let n = self.n;
         let [a, b, c] = self.triangles[s].map(|v| v as usize * n);
@@ -659,19 +658,16 @@ impl Problem {
             )
         };
         if MEASURE {
-            for_lanes(n, &mut |i, lane| {
+            for i in 0..n {
                 let (next, x, p, u) = step(i);
                 (ox[i], oy[i]) = (next.x, next.y);
-                r.add(
-                    lane,
-                    [
-                        (x - p).length_squared(),
-                        x.length_squared(),
-                        p.length_squared(),
-                        u.length_squared(),
-                    ],
-                );
-            });
+                r.add_terms([
+                    (x - p).length_squared(),
+                    x.length_squared(),
+                    p.length_squared(),
+                    u.length_squared(),
+                ]);
+            }
         } else {
             for i in 0..n {
                 let (next, ..) = step(i);
@@ -948,6 +944,14 @@ struct Residuals {
 }
 
 impl Residuals {
+    /// Adds one entry's primal, split, unknown and multiplier terms.
+    fn add_terms(&mut self, [primal, split, unknown, multiplier]: [f64; 4]) {
+        self.primal += primal;
+        self.split += split;
+        self.unknown += unknown;
+        self.multiplier += multiplier;
+    }
+
     fn scaled(self, m: f64) -> Self {
         Self {
             primal: m * self.primal,
@@ -969,35 +973,6 @@ impl Residuals {
     }
 }
 
-/// How many independent running sums [`Lanes`] keeps per term, so that a loop adding
-/// to them can run in SIMD lanes (floating-point sums in one accumulator cannot be
-/// reordered, which keeps a loop scalar).
-const LANES: usize = 8;
-
-/// Running sums of [`Residuals`]' terms but the dual one, [`LANES`] partial sums each.
-#[derive(Default)]
-struct Lanes([[f64; LANES]; 4]);
-
-impl Lanes {
-    #[inline(always)]
-    fn add(&mut self, lane: usize, terms: [f64; 4]) {
-        for (a, t) in self.0.iter_mut().zip(terms) {
-            a[lane] += t;
-        }
-    }
-
-    fn sum(&self) -> Residuals {
-        let [primal, split, unknown, multiplier] = self.0.map(|a| a.iter().sum());
-        Residuals {
-            primal,
-            dual: 0.0,
-            split,
-            unknown,
-            multiplier,
-        }
-    }
-}
-
 /// One entry of the X-update: from the gradient `p` and the state `t`, the
 /// multiplier `u = t − p`, `x` = `p − u` group soft-thresholded by `threshold`, and
 /// the next state `αx + (1 − α)p + u`. Returns `(next, x, p, u)`.
@@ -1008,22 +983,6 @@ fn shrink(p: DVec2, t: DVec2, threshold: f64, alpha: f64) -> (DVec2, DVec2, DVec
     let keep = (1.0 - threshold / a.length().max(f64::MIN_POSITIVE)).max(0.0);
     let x = keep * a;
     (alpha * x + (1.0 - alpha) * p + u, x, p, u)
-}
-
-/// Calls `f(i, lane)` for `i` in `0..n`, in blocks of [`LANES`] with `lane` the
-/// position in the block (a fixed-length inner loop the compiler vectorises), the
-/// remainder in lane 0.
-#[inline(always)]
-fn for_lanes(n: usize, f: &mut impl FnMut(usize, usize)) {
-    let blocks = n / LANES;
-    for b in 0..blocks {
-        for lane in 0..LANES {
-            f(b * LANES + lane, lane);
-        }
-    }
-    for i in blocks * LANES..n {
-        f(i, 0);
-    }
 }
 
 /// `β`: the `W = W̃` split enters the augmented Lagrangian as `β‖W − W̃‖²_M`, the
