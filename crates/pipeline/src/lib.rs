@@ -18,7 +18,8 @@ use render::Picture;
 pub use method::{ArapRig, ArapTimes, Deformer, Method, Output, deformer};
 pub use order::draw_order;
 use weights_core::{
-    Basis, Domain, Handle, Metric, MiddleControls, Rig, RigOptions, Similarity, VirtualHandle,
+    Basis, Domain, Handle, Metric, MiddleControls, Placement, Rig, RigOptions, Similarity,
+    VirtualHandle,
 };
 
 /// The picture the editor opens with and the demo warps (public domain, see
@@ -183,6 +184,10 @@ pub fn rig_options(project: &Project) -> Result<RigOptions> {
         alpha: project.alpha,
         basis,
         fixed_boundary: project.fixed_boundary,
+        placement: match project.placement {
+            project::Placement::AsWritten => Placement::AsWritten,
+            project::Placement::Symmetric => Placement::Symmetric,
+        },
     })
 }
 

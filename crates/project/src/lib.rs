@@ -171,6 +171,22 @@ pub enum Middle {
     Linear,
 }
 
+/// How Algorithm 1 places virtual handles.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Placement {
+    /// The paper's loop: one virtual handle at a time, in the worst cell.
+    #[default]
+    AsWritten,
+    /// Tied worst cells together, close candidates merged: mirror-symmetric rigs get
+    /// mirror-symmetric virtual handles.
+    Symmetric,
+}
+
+fn is_as_written(placement: &Placement) -> bool {
+    *placement == Placement::AsWritten
+}
+
 /// One handle as stored.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
@@ -262,6 +278,9 @@ pub struct Project {
     /// Distance choice.
     #[serde(default)]
     pub metric: MetricChoice,
+    /// How virtual handles are placed (omitted for the paper's rule).
+    #[serde(default, skip_serializing_if = "is_as_written")]
+    pub placement: Placement,
     /// Target number of mesh vertices (default: the tool's default density).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub density: Option<usize>,
@@ -306,6 +325,7 @@ impl Default for Project {
             middle: Middle::Half,
             fixed_boundary: false,
             metric: MetricChoice::Auto,
+            placement: Placement::AsWritten,
             density: None,
             handles: Vec::new(),
             virtual_handles: Vec::new(),
@@ -591,6 +611,7 @@ mod tests {
             middle: Middle::Linear,
             fixed_boundary: true,
             metric: MetricChoice::Intrinsic,
+            placement: Placement::Symmetric,
             density: Some(5000),
             handles: vec![
                 HandleSpec::Point {
@@ -696,6 +717,10 @@ mod tests {
                 "malformed",
             ),
             (r#"{"version":1,"alpha":2,"handles":[]}"#, "alpha"),
+            (
+                r#"{"version":1,"placement":"greedy","handles":[]}"#,
+                "unknown variant",
+            ),
             (r#"{"version":1,"degree":3,"handles":[]}"#, "degree"),
             (
                 r#"{"version":1,"handles":[{"type":"bar","rest":[[1,1],[1,1]]}]}"#,

@@ -43,3 +43,4 @@ pub use rig::{
     bar_samples, bar_spacing,
 };
 pub use transform::Similarity;
+pub use virtual_handles::Placement;

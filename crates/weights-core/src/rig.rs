@@ -13,7 +13,7 @@ use crate::error::RigError;
 use crate::harmonic::{Coefficients, Solved, dual_edges, harmonic_coordinates};
 use crate::nearest::segment_distance;
 use crate::transform::Similarity;
-use crate::virtual_handles::insert_virtual_handles;
+use crate::virtual_handles::{Placement, insert_virtual_handles};
 use crate::voronoi::{CellStats, NONE, Partition};
 use crate::weights::{Ball, Change, Weights, ball};
 
@@ -133,6 +133,8 @@ pub struct RigOptions {
     pub basis: Basis,
     /// Pin the domain's border in place (the paper's fixed boundary). Default off.
     pub fixed_boundary: bool,
+    /// How Algorithm 1 places virtual handles. Default: as the paper writes it.
+    pub placement: Placement,
 }
 
 impl Default for RigOptions {
@@ -141,6 +143,7 @@ impl Default for RigOptions {
             alpha: 1.0,
             basis: Basis::default(),
             fixed_boundary: false,
+            placement: Placement::AsWritten,
         }
     }
 }
@@ -529,7 +532,7 @@ impl Rig {
         report(Phase::VirtualHandles, 0, None);
         let clock = Instant::now();
         let mut placed = 0;
-        let added = insert_virtual_handles(&domain, &mut partition, |_, _| {
+        let added = insert_virtual_handles(&domain, &mut partition, options.placement, |_, _| {
             placed += 1;
             if placed % PROGRESS_STEP == 0 {
                 report(Phase::VirtualHandles, placed, None);
@@ -836,6 +839,7 @@ impl Rig {
             ..
         } = &mut *self;
         let (domain, weights, alpha) = (&*domain, &*weights, options.alpha);
+        let placement = options.placement;
         // Distance fields are searched on the other cores while the partition changes:
         // once the removals and the real nodes are in, Algorithm 1 only adds nodes, so
         // radii only shrink, and a field searched to a node's radius at that point
@@ -914,7 +918,7 @@ impl Rig {
             let clock = Instant::now();
             // A new virtual node's cell holds its field out to half its r_h already:
             // the search goes on from there.
-            let added = insert_virtual_handles(domain, partition, |partition, k| {
+            let added = insert_virtual_handles(domain, partition, placement, |partition, k| {
                 let v = partition.node_vertex[k];
                 let radius = support_radius(&partition.stats[k], alpha);
                 let inner = partition.inner_field(domain, k);

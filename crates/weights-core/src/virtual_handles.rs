@@ -3,14 +3,37 @@
 //!
 //! We insert while r_d ≥ r_h (the paper writes r_d > r_h): with a strict r_d < r_h
 //! every sample lies strictly inside its own node's support when α = 1, so the sum of
-//! basis values never vanishes. Each insertion puts a node on a sample that carried
-//! none (the farthest sample of a cell with r_d > 0), so the loop ends after at most as
-//! many insertions as there are samples.
+//! basis values never vanishes. (With r_d = r_h allowed, a node at 0 with its nearest
+//! neighbour at 2 on a segment from −2 to 3 keeps its cell's end −2 exactly on the rim
+//! of its support, and no other support reaches it.) Each insertion puts a node on a
+//! sample that carried none (the farthest sample of a cell with r_d > 0), so the loop
+//! ends after at most as many insertions as there are samples.
+//!
+//! [`Placement::AsWritten`] (the default) is the paper's loop: one virtual handle a
+//! round, at the farthest sample of the worst cell. [`Placement::Symmetric`] fixes
+//! tied worst cells together and merges their close candidates (see below), so that
+//! a mirror-symmetric rig gets mirror-symmetric virtual handles.
 
 use std::collections::{BinaryHeap, HashMap, HashSet};
 
 use crate::domain::{Domain, Metric};
 use crate::voronoi::Partition;
+
+/// How Algorithm 1 chooses the virtual handles of a round.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Placement {
+    /// The paper's Algorithm 1 as written: each round, one virtual handle, at the
+    /// farthest sample of the cell with the largest (r_d − r_h)/r_d (ties: the node
+    /// on the lower sample; its farthest sample of lowest index).
+    #[default]
+    AsWritten,
+    /// Each round, every cell within a relative 10⁻⁹ of the worst ratio, each at all
+    /// its tied farthest samples (up to four); candidates closer together than their
+    /// cell's r_h merge into one at the sample nearest their centroid, placed only if
+    /// it keeps that distance from every node. A mirror-symmetric rig keeps
+    /// mirror-symmetric virtual handles (the paper's loop breaks the tie to one side).
+    Symmetric,
+}
 
 /// Relative tolerance under which two violation ratios count as tied. Tied violators
 /// (and tied farthest samples of one cell) are fixed together, so that a
@@ -96,8 +119,10 @@ impl Ord for Violator {
 pub(crate) fn insert_virtual_handles(
     domain: &Domain,
     partition: &mut Partition,
+    placement: Placement,
     mut inserted: impl FnMut(&Partition, usize),
 ) -> Vec<u32> {
+    let as_written = placement == Placement::AsWritten;
     let mut added = Vec::new();
     if partition.len() == 0 {
         // No handles: nothing moves, nothing to weigh.
@@ -153,6 +178,9 @@ pub(crate) fn insert_virtual_handles(
             }
             taken[top.node] = true;
             violators.push((top.ratio, top.node));
+            if as_written {
+                break;
+            }
         }
         if violators.is_empty() {
             break;
@@ -193,7 +221,7 @@ pub(crate) fn insert_virtual_handles(
             let r_h = partition.stats[k].r_h;
             let samples = farthest[k].get_or_insert_with(|| {
                 let mut all = partition.farthest_samples(domain, k);
-                all.truncate(MAX_TIED_PER_CELL);
+                all.truncate(if as_written { 1 } else { MAX_TIED_PER_CELL });
                 all
             });
             for &far in samples.iter() {
@@ -293,11 +321,14 @@ mod tests {
 
     #[test]
     fn two_handles_one_sample_apart_terminate() {
-        for metric in [Metric::Intrinsic, Metric::Euclidean] {
+        for (metric, placement) in [Metric::Intrinsic, Metric::Euclidean]
+            .into_iter()
+            .flat_map(|m| [(m, Placement::AsWritten), (m, Placement::Symmetric)])
+        {
             let (p, t) = grid_mesh(40, 30, 1.0);
             let d = Domain::new(p, t, metric).expect("valid");
             let mut part = Partition::new(&d, vec![41 * 10 + 20, 41 * 10 + 21]);
-            let added = insert_virtual_handles(&d, &mut part, |_, _| {});
+            let added = insert_virtual_handles(&d, &mut part, placement, |_, _| {});
             assert!(!added.is_empty());
             for s in &part.stats {
                 assert!(s.r_d < s.r_h, "{s:?}");
@@ -311,7 +342,10 @@ mod tests {
         // A line of nodes two edges apart (a finely sampled bar) with a node two edges
         // beside it: no node may end up nearer another than that (in the metric), and
         // the refinement must stay far from one node per sample.
-        for metric in [Metric::Intrinsic, Metric::Euclidean] {
+        for (metric, placement) in [Metric::Intrinsic, Metric::Euclidean]
+            .into_iter()
+            .flat_map(|m| [(m, Placement::AsWritten), (m, Placement::Symmetric)])
+        {
             let (p, t) = grid_mesh(80, 60, 1.0);
             let samples = p.len();
             let d = Domain::new(p, t, metric).expect("valid");
@@ -319,15 +353,77 @@ mod tests {
             let mut nodes: Vec<u32> = (10..=70).step_by(2).map(|i| id(i, 30)).collect();
             nodes.push(id(40, 32));
             let mut part = Partition::new(&d, nodes);
-            let added = insert_virtual_handles(&d, &mut part, |_, _| {});
+            let added = insert_virtual_handles(&d, &mut part, placement, |_, _| {});
             assert!(
                 added.len() < samples / 4,
-                "{metric:?}: {} of {samples}",
+                "{metric:?} {placement:?}: {} of {samples}",
                 added.len()
             );
             for s in &part.stats {
-                assert!(s.r_h >= 2.0 - 1e-9, "{metric:?}: nodes {} apart", s.r_h);
+                assert!(
+                    s.r_h >= 2.0 - 1e-9,
+                    "{metric:?} {placement:?}: nodes {} apart",
+                    s.r_h
+                );
                 assert!(s.r_d < s.r_h, "{s:?}");
+            }
+        }
+    }
+
+    /// The paper's loop, written plainly: the partition rebuilt from scratch after each
+    /// insertion, every cell's ratio compared. The incremental, heap-driven version
+    /// must place the same virtual handles in the same order.
+    fn algorithm_1_from_scratch(d: &Domain, nodes: Vec<u32>) -> Vec<u32> {
+        let mut nodes = nodes;
+        let first = nodes.len();
+        loop {
+            let part = Partition::new(d, nodes.clone());
+            let worst = (0..nodes.len())
+                .filter_map(|k| {
+                    let s = &part.stats[k];
+                    (s.r_d > 0.0 && s.r_d >= s.r_h).then(|| ((s.r_d - s.r_h) / s.r_d, k))
+                })
+                .max_by(|a, b| a.0.total_cmp(&b.0).then(nodes[b.1].cmp(&nodes[a.1])));
+            let Some((_, k)) = worst else {
+                return nodes.split_off(first);
+            };
+            nodes.push(part.farthest_samples(d, k)[0]);
+        }
+    }
+
+    #[test]
+    fn as_written_is_the_papers_loop() {
+        // Close pairs and a line of close nodes on a jittered (tie-free) grid and on a
+        // regular one (many ties, broken by sample).
+        for (jitter, metric) in [
+            (0.3, Metric::Intrinsic),
+            (0.3, Metric::Euclidean),
+            (0.0, Metric::Intrinsic),
+        ] {
+            let (mut p, t) = grid_mesh(30, 24, 1.0);
+            let mut seed = 7u64;
+            for q in &mut p {
+                seed = seed
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                let a = (seed >> 11) as f64 / (1u64 << 53) as f64 * std::f64::consts::TAU;
+                *q += DVec2::new(a.cos(), a.sin()) * jitter * 0.5;
+            }
+            let d = Domain::new(p, t, metric).expect("valid");
+            let id = |i: u32, j: u32| j * 31 + i;
+            for nodes in [
+                vec![id(10, 10), id(12, 10)],
+                vec![id(4, 4), id(5, 6), id(25, 20)],
+                (8..=20).step_by(3).map(|i| id(i, 12)).collect(),
+            ] {
+                let mut part = Partition::new(&d, nodes.clone());
+                let added = insert_virtual_handles(&d, &mut part, Placement::AsWritten, |_, _| {});
+                assert_eq!(
+                    added,
+                    algorithm_1_from_scratch(&d, nodes.clone()),
+                    "{metric:?}, jitter {jitter}, nodes {nodes:?}"
+                );
+                assert!(!added.is_empty());
             }
         }
     }
@@ -337,7 +433,7 @@ mod tests {
         let (p, t) = grid_mesh(10, 10, 1.0);
         let d = Domain::new(p, t, Metric::Intrinsic).expect("valid");
         let mut part = Partition::new(&d, vec![0]);
-        assert!(insert_virtual_handles(&d, &mut part, |_, _| {}).is_empty());
+        assert!(insert_virtual_handles(&d, &mut part, Placement::AsWritten, |_, _| {}).is_empty());
     }
 
     #[test]
@@ -350,7 +446,7 @@ mod tests {
         t.extend(t2.iter().map(|tri| tri.map(|v| v + n)));
         let d = Domain::new(p, t, Metric::Intrinsic).expect("valid");
         let mut part = Partition::new(&d, vec![5]);
-        let added = insert_virtual_handles(&d, &mut part, |_, _| {});
+        let added = insert_virtual_handles(&d, &mut part, Placement::AsWritten, |_, _| {});
         assert!(added.contains(&n));
         assert!(part.unreached().is_empty());
     }

@@ -7,8 +7,8 @@ use glam::DVec2;
 use proptest::prelude::*;
 use support::{Rng, Shape, grid_domain};
 use weights_core::{
-    Domain, Handle, MAX_BAR_PIECES, Metric, NodeKind, Rig, RigError, RigOptions, Similarity,
-    bar_spacing,
+    Domain, Handle, MAX_BAR_PIECES, Metric, NodeKind, Placement, Rig, RigError, RigOptions,
+    Similarity, bar_spacing,
 };
 
 /// Checks every invariant the weights promise; returns a description of the first
@@ -142,6 +142,7 @@ proptest! {
             alpha,
             basis: weights_core::Basis::new(degree, weights_core::MiddleControls::Linear).expect("valid"),
             fixed_boundary: seed % 3 == 0,
+            placement: if seed % 2 == 0 { Placement::AsWritten } else { Placement::Symmetric },
         };
         let rig = Rig::new(domain, handles, options).expect("valid rig");
         if let Err(e) = check_invariants(&rig) {
@@ -300,7 +301,13 @@ fn mirror_symmetric_rigs_give_mirror_symmetric_weights_and_warps() {
             rest: bar.map(mirror),
             pose: pose.map(mirror),
         });
-        let rig = Rig::new(domain.clone(), handles, RigOptions::default()).expect("valid");
+        // Tied cells are fixed together: the paper's one-at-a-time loop would break
+        // each tie to one side.
+        let options = RigOptions {
+            placement: Placement::Symmetric,
+            ..RigOptions::default()
+        };
+        let rig = Rig::new(domain.clone(), handles, options).expect("valid");
         check_invariants(&rig).expect("invariants");
         let node_at: std::collections::HashMap<u32, usize> = rig
             .nodes()
