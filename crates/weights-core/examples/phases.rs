@@ -112,10 +112,14 @@ fn main() {
             totals.push(best);
         }
     }
+    if totals.is_empty() {
+        return;
+    }
     totals.sort_by(f64::total_cmp);
     let mean = totals.iter().sum::<f64>() / totals.len() as f64;
+    let p90 = totals[(totals.len() * 9).div_ceil(10) - 1];
     println!(
-        "insert over {} positions (best of {repeat}): median {:.2} ms, mean {mean:.2} ms",
+        "insert over {} positions (best of {repeat}): median {:.2} ms, p90 {p90:.2} ms, mean {mean:.2} ms",
         totals.len(),
         totals[totals.len() / 2]
     );
