@@ -323,6 +323,7 @@ impl Partition {
                     } else {
                         self.owner[w] = k;
                     }
+                    graph.prefetch(e.to);
                     queue.push(Entry::new(nd, key, e.to));
                 }
             }

@@ -131,6 +131,7 @@ fn search(
                     let w = e.to as usize;
                     if nd < dist[w] && nd < radius {
                         dist[w] = nd;
+                        graph.prefetch(e.to);
                         queue.push(Entry::new(nd, 0, e.to));
                     }
                 }
