@@ -25,7 +25,11 @@ const MAX_BUCKETS: usize = 1 << 12;
 pub(crate) struct Queue {
     /// One over the bucket width (0: the heap alone).
     inv_width: f64,
+    /// The buckets, a power of two of them, so that a bucket's slot is a mask away
+    /// (no division per push and pop).
     ring: Vec<Vec<Entry>>,
+    /// `ring.len() - 1`.
+    mask: u64,
     /// The absolute index of the current bucket.
     base: u64,
     /// Entries in the ring.
@@ -44,6 +48,7 @@ impl Queue {
         Self {
             inv_width: 0.0,
             ring: Vec::new(),
+            mask: 0,
             base: 0,
             in_ring: 0,
             overflow: BinaryHeap::new(),
@@ -63,10 +68,13 @@ impl Queue {
         let buckets = (max / width).ceil() + 3.0;
         if width > 0.0 && buckets <= MAX_BUCKETS as f64 {
             self.inv_width = 1.0 / width;
-            self.ring = vec![Vec::new(); buckets as usize];
+            let buckets = (buckets as usize).next_power_of_two();
+            self.ring = vec![Vec::new(); buckets];
+            self.mask = buckets as u64 - 1;
         } else {
             self.inv_width = 0.0;
             self.ring = Vec::new();
+            self.mask = 0;
         }
     }
 
@@ -91,9 +99,8 @@ impl Queue {
             // (Never below the current bucket but for rounding; the current one is as
             // good then.)
             let b = self.bucket(entry.d()).max(self.base);
-            if b < self.base + self.ring.len() as u64 {
-                let slot = (b % self.ring.len() as u64) as usize;
-                self.ring[slot].push(entry);
+            if b <= self.base + self.mask {
+                self.ring[(b & self.mask) as usize].push(entry);
                 self.in_ring += 1;
                 return;
             }
@@ -111,9 +118,8 @@ impl Queue {
             self.started = true;
             self.refill();
         }
-        let len = self.ring.len() as u64;
         loop {
-            if let Some(entry) = self.ring[(self.base % len) as usize].pop() {
+            if let Some(entry) = self.ring[(self.base & self.mask) as usize].pop() {
                 self.in_ring -= 1;
                 return Some(entry);
             }
@@ -133,14 +139,13 @@ impl Queue {
 
     /// Moves the waiting entries that now fall inside the ring into it.
     fn refill(&mut self) {
-        let len = self.ring.len() as u64;
         while let Some(next) = self.overflow.peek() {
             let b = self.bucket(next.d()).max(self.base);
-            if b >= self.base + len {
+            if b > self.base + self.mask {
                 break;
             }
             let entry = self.overflow.pop().expect("peeked");
-            self.ring[(b % len) as usize].push(entry);
+            self.ring[(b & self.mask) as usize].push(entry);
             self.in_ring += 1;
         }
     }

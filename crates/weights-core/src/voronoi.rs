@@ -371,7 +371,10 @@ impl Partition {
         let graph = domain.graph();
         let mut seeds = Vec::new();
         // Samples next to the freed ones offer their (unchanged) distances to them.
-        for &v in &freed {
+        for (i, &v) in freed.iter().enumerate() {
+            if let Some(&ahead) = freed.get(i + 8) {
+                graph.prefetch(ahead);
+            }
             for e in graph.neighbors(v) {
                 let o = self.owner[e.to as usize];
                 if o != NONE {
@@ -757,7 +760,12 @@ impl Partition {
                 cells.push(o as usize);
             }
         };
-        for &(v, old) in changed {
+        /// How far ahead of a visit the edges are fetched.
+        const AHEAD: usize = 8;
+        for (i, &(v, old)) in changed.iter().enumerate() {
+            if let Some(&(ahead, _)) = changed.get(i + AHEAD) {
+                graph.prefetch(ahead);
+            }
             let o = self.owner[v as usize];
             note(old, &mut cells);
             note(o, &mut cells);
