@@ -532,11 +532,47 @@ impl Rig {
         report(Phase::VirtualHandles, 0, None);
         let clock = Instant::now();
         let mut placed = 0;
-        let added = insert_virtual_handles(&domain, &mut partition, options.placement, |_, _| {
-            placed += 1;
-            if placed % PROGRESS_STEP == 0 {
-                report(Phase::VirtualHandles, placed, None);
+        // While Algorithm 1 runs on this core, the other cores search the distance
+        // fields of the nodes it is done with: each new virtual node from the inner
+        // part of its own cell, as in an insertion, and every cell that meets
+        // r_d < r_h already (a violator is about to be crowded by a virtual node, its
+        // support to shrink). Radii only shrink from there on, so a field searched
+        // now covers the final support; `Weights::build` searches again any
+        // that falls short.
+        let searched = std::sync::Mutex::new(Vec::new());
+        let (domain_ref, alpha) = (&domain, options.alpha);
+        let added = rayon::scope(|scope| {
+            let searched = &searched;
+            let search = |partition: &Partition, k: usize| {
+                let v = partition.node_vertex[k];
+                let radius = support_radius(&partition.stats[k], alpha);
+                let inner = partition.inner_field(domain_ref, k);
+                search_aside(scope, searched, v, move || {
+                    Some(Ball::compute_from(domain_ref, v, radius, inner))
+                });
+            };
+            if domain_ref.metric() == Metric::Intrinsic {
+                for k in 0..partition.len() {
+                    let s = &partition.stats[k];
+                    if s.r_d < s.r_h {
+                        search(&partition, k);
+                    }
+                }
             }
+            insert_virtual_handles(
+                domain_ref,
+                &mut partition,
+                options.placement,
+                |partition, k| {
+                    placed += 1;
+                    if placed % PROGRESS_STEP == 0 {
+                        report(Phase::VirtualHandles, placed, None);
+                    }
+                    if domain_ref.metric() == Metric::Intrinsic {
+                        search(partition, k);
+                    }
+                },
+            )
         });
         report(Phase::VirtualHandles, added.len(), Some(added.len()));
         nodes.extend(added.into_iter().map(|v| Node {
@@ -547,7 +583,13 @@ impl Rig {
         report(Phase::Weights, 0, Some(1));
         let clock = Instant::now();
         let radii = support_radii(&partition, options.alpha);
-        let weights = Weights::build(&domain, &partition, &radii, &options.basis);
+        let weights = Weights::build(
+            &domain,
+            &partition,
+            &radii,
+            &options.basis,
+            searched.into_inner().expect("not poisoned"),
+        );
         report(Phase::Weights, 1, Some(1));
         let mut rig = Self {
             domain,

@@ -412,17 +412,36 @@ pub(crate) struct Change {
 }
 
 impl Weights {
-    /// Weights from scratch.
-    pub fn build(domain: &Domain, partition: &Partition, radii: &[f64], basis: &Basis) -> Self {
+    /// Weights from scratch, with the distance fields already searched (by node
+    /// sample; a node without one, or whose field does not reach its support radius,
+    /// is searched here).
+    pub fn build(
+        domain: &Domain,
+        partition: &Partition,
+        radii: &[f64],
+        basis: &Basis,
+        searched: Vec<(u32, Ball)>,
+    ) -> Self {
         if domain.metric() == Metric::Euclidean {
             return Self::build_euclidean(domain, partition, radii, basis);
         }
         let n = domain.len();
-        let balls: Vec<Ball> = (0..partition.len())
-            .into_par_iter()
+        let mut found: std::collections::HashMap<u32, Ball> = searched.into_iter().collect();
+        let found: Vec<Option<Ball>> = (0..partition.len())
             .map(|k| {
-                let inner = partition.inner_field(domain, k);
-                Ball::compute_from(domain, partition.node_vertex[k], radii[k], inner)
+                found
+                    .remove(&partition.node_vertex[k])
+                    .filter(|b| b.covers(radii[k]))
+            })
+            .collect();
+        let balls: Vec<Ball> = found
+            .into_par_iter()
+            .enumerate()
+            .map(|(k, ball)| {
+                ball.unwrap_or_else(|| {
+                    let inner = partition.inner_field(domain, k);
+                    Ball::compute_from(domain, partition.node_vertex[k], radii[k], inner)
+                })
             })
             .collect();
         let supports: Vec<Vec<(u32, f32)>> = balls
