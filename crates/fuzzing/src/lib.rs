@@ -11,7 +11,7 @@ use std::sync::OnceLock;
 
 use arbitrary::Unstructured;
 use glam::DVec2;
-use weights_core::{Domain, Handle, Metric, Rig, RigOptions, Similarity};
+use weights_core::{Domain, Handle, Metric, Placement, Rig, RigOptions, Similarity};
 
 /// The rig-file parser: any text either parses into a project that validates and
 /// round-trips through its JSON exactly, or is refused with an error.
@@ -220,6 +220,11 @@ pub fn rig_handles(data: &[u8]) {
     let options = RigOptions {
         alpha: u.int_in_range(0..=4u8).map_or(1.0, |a| f64::from(a) / 4.0),
         fixed_boundary: u.arbitrary().unwrap_or(false),
+        placement: if u.arbitrary().unwrap_or(false) {
+            Placement::Symmetric
+        } else {
+            Placement::AsWritten
+        },
         ..RigOptions::default()
     };
     let domain = small_domain().clone();
