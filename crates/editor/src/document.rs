@@ -19,7 +19,8 @@ use image::RgbaImage;
 use pipeline::cage::{CageCoordinates, CageMesh};
 use pipeline::{ArapRig, ArapTimes, Deformer, Method};
 use project::{
-    CageSpec, HandleSpec, LbcSettings, MetricChoice, Middle, Project, RigidityStroke, Tau,
+    CageSpec, HandleSpec, LbcSettings, MetricChoice, Middle, Placement, Project, RigidityStroke,
+    Tau,
 };
 use weights_core::{Domain, NodeKind, Rig, VirtualHandle};
 
@@ -38,6 +39,8 @@ pub struct Settings {
     pub metric: MetricChoice,
     /// Target number of mesh vertices.
     pub density: usize,
+    /// How Algorithm 1 places virtual handles.
+    pub placement: Placement,
 }
 
 impl Settings {
@@ -50,6 +53,7 @@ impl Settings {
             fixed_boundary: project.fixed_boundary,
             metric: project.metric,
             density: project.density.unwrap_or(pipeline::DEFAULT_DENSITY),
+            placement: project.placement,
         }
     }
 
@@ -61,6 +65,7 @@ impl Settings {
         project.fixed_boundary = self.fixed_boundary;
         project.metric = self.metric;
         project.density = Some(self.density);
+        project.placement = self.placement;
     }
 }
 
@@ -1219,6 +1224,13 @@ mod tests {
         settings.metric = MetricChoice::Intrinsic;
         doc.apply(Edit::Settings(settings)).expect("rebuild");
         assert_eq!(doc.rig().options().alpha, 0.5);
+        settings.placement = Placement::Symmetric;
+        doc.apply(Edit::Settings(settings)).expect("rebuild");
+        assert_eq!(
+            doc.rig().options().placement,
+            weights_core::Placement::Symmetric
+        );
+        assert_eq!(doc.project().placement, Placement::Symmetric);
         settings.density = 1000;
         doc.apply(Edit::Settings(settings)).expect("re-mesh");
         assert!(doc.rig().domain().len() < 1500);

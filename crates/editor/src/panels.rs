@@ -4,7 +4,7 @@
 use std::time::Instant;
 
 use egui::{Key, KeyboardShortcut, Modifiers, Ui};
-use project::{Method, MetricChoice, Middle};
+use project::{Method, MetricChoice, Middle, Placement};
 
 use crate::app::{EditorApp, Pending, Tool};
 use crate::dialogs::FileAction;
@@ -588,6 +588,18 @@ impl EditorApp {
         commit |= released(&r);
         let before = draft;
         ui.checkbox(&mut draft.fixed_boundary, "Fixed boundary");
+        let mut symmetric = draft.placement == Placement::Symmetric;
+        ui.checkbox(&mut symmetric, "Symmetric virtual handles")
+            .on_hover_text(
+                "Place tied virtual handles together, so that a mirror-symmetric rig gets \
+                 mirror-symmetric virtual handles; off, Algorithm 1 places one at a time, \
+                 as the paper writes it",
+            );
+        draft.placement = if symmetric {
+            Placement::Symmetric
+        } else {
+            Placement::AsWritten
+        };
         egui::ComboBox::from_label("Distance")
             .selected_text(metric_name(draft.metric))
             .show_ui(ui, |ui| {
