@@ -1,7 +1,7 @@
 //! Times the three phases on a cut-out mesh (as the benchmarks build it) with four
 //! point handles, and with four turning handles (each pinning its one-ring), and
 //! prints the median and the fastest of several runs:
-//! `cargo run --release -p arap --example phases [VERTICES]`.
+//! `cargo run --release -p arap --example arap_phases [VERTICES]`.
 //!
 //! On a busy machine the fastest run says more about the code than the median.
 
