@@ -11,15 +11,29 @@ as a boundary condition with the identity as values, and solves to libigl's defa
 convergence. The C² time is the median full build reported by `c2warp bench`
 (distances, Voronoi cells, virtual handles, weights).
 
+With `--check`, the BBW result is also checked, so that a time is never compared
+against a solve that stopped early: the raw weights must interpolate the handles
+(identity rows at the handle vertices) and stay within [0, 1] up to `--tolerance`;
+every row must have a positive sum, so that the normalised weights (libigl's solve
+leaves out the partition-of-unity constraint, as the BBW paper suggests, and the raw
+rows sum to one only approximately: their largest deviation is reported) are finite
+and sum to one; and a second solve allowed ten times the active-set iterations must
+agree with the first (a solve that converged within `--max-iter` repeats itself; one
+cut off by the limit goes on and moves). libigl reports an
+unconverged active set only on stderr, and the pip wheel compiles that message out,
+so this re-solve is the only sign of one. The report gets a `bbw_check` entry and the
+script exits with status 1 if any check fails.
+
     pip install libigl pillow
     python3 scripts/bbw_compare.py --c2warp target/release/c2warp \
-        --image assets/lizard.png --density 31000 --handles 10
+        --image assets/lizard.png --density 31000 --handles 10 --check
 """
 
 import argparse
 import json
 import statistics
 import subprocess
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -70,7 +84,48 @@ def read_obj(path: Path) -> tuple[np.ndarray, np.ndarray]:
 
 
 def run(command: list[str]) -> str:
-    return subprocess.run(command, check=True, capture_output=True, text=True).stdout
+    """The command's stdout; its stderr passes through to ours."""
+    return subprocess.run(command, check=True, stdout=subprocess.PIPE, text=True).stdout
+
+
+def check_bbw(vertices: np.ndarray, faces: np.ndarray, b: np.ndarray, bc: np.ndarray,
+              w: np.ndarray, tolerance: float, max_iter: int) -> dict:
+    """Checks raw BBW weights `w` (before any normalisation) and re-solves to confirm
+    the active set had converged."""
+    at_handles = float(np.abs(w[b] - bc).max())
+    low, high = float(w.min()), float(w.max())
+    sums = w.sum(axis=1)
+    unity = float(np.abs(sums - 1.0).max())
+    normalised = w / sums[:, None] if sums.min() > 0.0 else None
+    normalised_unity = (float(np.abs(normalised.sum(axis=1) - 1.0).max())
+                        if normalised is not None and np.isfinite(normalised).all()
+                        else float("inf"))
+
+    clock = time.perf_counter()
+    longer = igl.bbw(vertices, faces, b, bc, max_iter=10 * max_iter)
+    resolve_s = time.perf_counter() - clock
+    resolve_diff = float(np.abs(longer - w).max())
+
+    checks = {
+        "interpolates_handles": at_handles <= tolerance,
+        "bounded": low >= -tolerance and high <= 1.0 + tolerance,
+        "partition_of_unity_normalised": normalised_unity <= tolerance,
+        "converged": resolve_diff <= tolerance,
+    }
+    return {
+        "tolerance": tolerance,
+        "max_error_at_handles": at_handles,
+        "min_weight": low,
+        "max_weight": high,
+        "max_unity_error_raw": unity,
+        "min_row_sum_raw": float(sums.min()),
+        "max_unity_error_normalised": normalised_unity,
+        "resolve_max_iter": 10 * max_iter,
+        "resolve_s": round(resolve_s, 3),
+        "resolve_max_difference": resolve_diff,
+        "checks": checks,
+        "passed": all(checks.values()),
+    }
 
 
 def main() -> None:
@@ -83,6 +138,12 @@ def main() -> None:
                         help="handles over the extremities, or 12 px apart near the middle")
     parser.add_argument("--runs", type=int, default=5, help="c2warp bench runs")
     parser.add_argument("--bbw-runs", type=int, default=3)
+    parser.add_argument("--max-iter", type=int, default=100,
+                        help="BBW active-set iterations (libigl's default: 100)")
+    parser.add_argument("--check", action="store_true",
+                        help="check BBW's weights and re-solve to confirm convergence")
+    parser.add_argument("--tolerance", type=float, default=1e-6,
+                        help="tolerance of the --check tests")
     args = parser.parse_args()
 
     with tempfile.TemporaryDirectory() as tmp:
@@ -111,13 +172,15 @@ def main() -> None:
         bbw_s = []
         for _ in range(args.bbw_runs):
             clock = time.perf_counter()
-            w = igl.bbw(vertices, faces, b, bc)
+            raw = igl.bbw(vertices, faces, b, bc, max_iter=args.max_iter)
             bbw_s.append(time.perf_counter() - clock)
-        w = w / w.sum(axis=1, keepdims=True)
+        check = (check_bbw(vertices, faces, b, bc, raw, args.tolerance, args.max_iter)
+                 if args.check else None)
+        w = raw / raw.sum(axis=1, keepdims=True)
 
         c2 = statistics.median(build_ms) / 1e3
         bbw = statistics.median(bbw_s)
-        print(json.dumps({
+        report = {
             "mesh": {"vertices": len(vertices), "triangles": len(faces)},
             "handles": len(b),
             "virtual_handles": builds[0].get("virtual_handles"),
@@ -126,7 +189,12 @@ def main() -> None:
             "bbw_at_handles": float(np.min(w[b, np.arange(len(b))])),
             "bbw_min_weight": float(w.min()),
             "ratio": round(bbw / c2),
-        }, indent=1))
+        }
+        if check is not None:
+            report["bbw_check"] = check
+        print(json.dumps(report, indent=1))
+        if check is not None and not check["passed"]:
+            sys.exit(1)
 
 
 if __name__ == "__main__":
