@@ -533,8 +533,8 @@ impl Rig {
         let clock = Instant::now();
         let mut placed = 0;
         // While Algorithm 1 runs on this core, the other cores search the distance
-        // fields of the nodes it is done with: each new virtual node from the inner
-        // part of its own cell, as in an insertion, and every cell that meets
+        // fields of the nodes it is done with: each from the frontier of its own
+        // cell, as in an insertion, for each new virtual node and every cell that meets
         // r_d < r_h already (a violator is about to be crowded by a virtual node, its
         // support to shrink). Radii only shrink from there on, so a field searched
         // now covers the final support; `Weights::build` searches again any
@@ -546,9 +546,9 @@ impl Rig {
             let search = |partition: &Partition, k: usize| {
                 let v = partition.node_vertex[k];
                 let radius = support_radius(&partition.stats[k], alpha);
-                let inner = partition.inner_field(domain_ref, k);
+                let cell = partition.cell_field(domain_ref, k);
                 search_aside(scope, searched, v, move || {
-                    Some(Ball::compute_from(domain_ref, v, radius, inner))
+                    Some(Ball::compute_from(domain_ref, v, radius, cell))
                 });
             };
             if domain_ref.metric() == Metric::Intrinsic {
@@ -958,14 +958,14 @@ impl Rig {
             }
             update_timings.partition_ms = ms(clock);
             let clock = Instant::now();
-            // A new virtual node's cell holds its field out to half its r_h already:
-            // the search goes on from there.
+            // A new virtual node's cell holds its field already: the search goes on
+            // from the cell's frontier.
             let added = insert_virtual_handles(domain, partition, placement, |partition, k| {
                 let v = partition.node_vertex[k];
                 let radius = support_radius(&partition.stats[k], alpha);
-                let inner = partition.inner_field(domain, k);
+                let cell = partition.cell_field(domain, k);
                 search_aside(scope, searched, v, move || {
-                    Some(Ball::compute_from(domain, v, radius, inner))
+                    Some(Ball::compute_from(domain, v, radius, cell))
                 });
             });
             if let Some(first) = first_arrival {

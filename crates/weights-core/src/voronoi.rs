@@ -155,6 +155,14 @@ pub(crate) struct CellStats {
     pub r_h: f64,
 }
 
+/// A cell's samples with their distances to its node, and its frontier samples: the
+/// head start of a search of the node's distance field.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct CellField {
+    pub entries: Vec<(u32, f64)>,
+    pub seeds: Vec<u32>,
+}
+
 /// The partition of samples into cells, one per node.
 #[derive(Clone, Debug)]
 pub(crate) struct Partition {
@@ -911,24 +919,22 @@ impl Partition {
         out
     }
 
-    /// The samples of cell `k` closer to its node than just under half its r_h, with
-    /// their distances, and that radius (`None` with straight-line distances, whose
-    /// searches need no head start, or when r_h is infinite). Any sample that close to the node is at least r_h − d > d from every
-    /// other node, so it lies in this cell, at the distance a search from the node alone
-    /// finds: the list is a complete distance field of that radius, for free. (The
-    /// radius is shortened by 10⁻⁹ of itself, far more than the rounding of any path
-    /// length, so that rounding cannot turn the strict inequality into a tie.)
-    pub fn inner_field(&self, domain: &Domain, k: usize) -> Option<(f64, Vec<(u32, f64)>)> {
-        let radius = self.stats[k].r_h / 2.0 * (1.0 - 1e-9);
-        if domain.metric() != Metric::Intrinsic || !radius.is_finite() {
+    /// The samples of cell `k` with their distances (each a complete shortest-path
+    /// distance from the cell's node: every sample on a shortest path to a member is
+    /// a member), and the cell's frontier, from which a search from the node goes on
+    /// beyond the cell (see `weights::Known::Cell`). `None` with straight-line
+    /// distances, whose searches need no head start.
+    pub fn cell_field(&self, domain: &Domain, k: usize) -> Option<CellField> {
+        if domain.metric() != Metric::Intrinsic {
             return None;
         }
-        let entries = self.members[k]
-            .iter()
-            .map(|&v| (v, self.dist[v as usize]))
-            .filter(|&(_, d)| d < radius)
-            .collect();
-        Some((radius, entries))
+        Some(CellField {
+            entries: self.members[k]
+                .iter()
+                .map(|&v| (v, self.dist[v as usize]))
+                .collect(),
+            seeds: self.frontier[k].to_vec(),
+        })
     }
 
     /// Samples no node reaches (other components of the graph), lowest first.

@@ -16,7 +16,7 @@ use std::sync::atomic::Ordering::Relaxed;
 use crate::basis::Basis;
 use crate::domain::{Domain, Metric};
 use crate::queue::Queue;
-use crate::voronoi::{Entry, NONE, Partition};
+use crate::voronoi::{CellField, Entry, NONE, Partition};
 
 /// Reusable buffers for bounded Dijkstra searches, one set per thread. `dist` is all
 /// infinite between searches (each search resets what it set: the samples it returns,
@@ -39,14 +39,34 @@ thread_local! {
 /// their distances (for the intrinsic metric in order of distance to within a bucket of
 /// the search queue: half the shortest edge).
 pub(crate) fn ball(domain: &Domain, source: u32, radius: f64) -> Vec<(u32, f64)> {
-    search(domain, source, radius, None, None).0
+    search(domain, source, radius, Known::Nothing, None).0
 }
 
-/// [`ball`], continuing from `known`: every sample closer than `known_radius`, with its
-/// exact distance. Along the graph only the samples near the known ball's rim are put
-/// back on the queue (the others have no neighbour outside it), and the distances found
-/// beyond are the ones a search from scratch finds: each is the same minimum over the
-/// same neighbours.
+/// What a search already knows of the source's distance field.
+#[derive(Clone, Copy)]
+enum Known<'a> {
+    /// Nothing: the search starts at the source.
+    Nothing,
+    /// Every sample closer than `radius`, with its exact distance. Along the graph only
+    /// the samples near the ball's rim are put back on the queue (the others have no
+    /// neighbour outside it).
+    Ball {
+        entries: &'a [(u32, f64)],
+        radius: f64,
+    },
+    /// Every sample of the source's Voronoi cell, with its exact distance (its distance
+    /// to the cell's node), and `seeds`, the cell's samples with a neighbour in another
+    /// cell. A shortest path from the node to a sample outside the cell leaves it for
+    /// good at some sample; that sample is a seed (its next one lies in another cell),
+    /// so the search goes on from the seeds only.
+    Cell {
+        entries: &'a [(u32, f64)],
+        seeds: &'a [u32],
+    },
+}
+
+/// [`ball`], continuing from what is `known`. The distances found beyond are the ones a
+/// search from scratch finds: each is the same minimum over the same neighbours.
 ///
 /// With `nearest`, the search stops at the nearest sample it accepts (other than the
 /// source) instead: at its distance times 1 + 10⁻⁶, beyond any f32 rounding of that
@@ -56,7 +76,7 @@ fn search(
     domain: &Domain,
     source: u32,
     mut radius: f64,
-    known: Option<(&[(u32, f64)], f64)>,
+    known: Known<'_>,
     nearest: Option<&dyn Fn(u32) -> bool>,
 ) -> (Vec<(u32, f64)>, f64) {
     let mut out = Vec::new();
@@ -69,11 +89,10 @@ fn search(
             }
             let graph = domain.graph();
             queue.prepare(graph.min_edge_length(), graph.max_edge_length());
-            // Samples closer than this are known and final.
-            let mut known_radius = f64::NEG_INFINITY;
+            // Entries put back on the queue carry key 1: they are in `out` already.
+            const KNOWN: u32 = 1;
             match known {
-                Some((entries, r)) => {
-                    known_radius = r;
+                Known::Ball { entries, radius: r } => {
                     if let Some(accept) = nearest {
                         // The nearest accepted sample may lie inside the known ball.
                         let inside = entries
@@ -93,12 +112,25 @@ fn search(
                     for &(v, d) in entries {
                         dist[v as usize] = d;
                         if d >= rim {
-                            queue.push(Entry::new(d, 0, v));
+                            queue.push(Entry::new(d, KNOWN, v));
                         }
                     }
                     out.extend_from_slice(entries);
                 }
-                None => {
+                Known::Cell { entries, seeds } => {
+                    debug_assert!(nearest.is_none(), "a cell's search goes to a radius");
+                    for &(v, d) in entries {
+                        dist[v as usize] = d;
+                    }
+                    for &v in seeds {
+                        let d = dist[v as usize];
+                        if d < radius {
+                            queue.push(Entry::new(d, KNOWN, v));
+                        }
+                    }
+                    out.extend(entries.iter().copied().filter(|&(_, d)| d < radius));
+                }
+                Known::Nothing => {
                     dist[source as usize] = 0.0;
                     queue.push(Entry::new(0.0, 0, source));
                 }
@@ -123,7 +155,7 @@ fn search(
                     // out are dropped below.)
                     radius = d * (1.0 + 1e-6);
                 }
-                if d >= known_radius && v != source || known.is_none() {
+                if entry.key() != KNOWN {
                     out.push((v, d));
                 }
                 for e in graph.neighbors(v) {
@@ -139,6 +171,12 @@ fn search(
             queue.clear();
             for &(v, _) in &out {
                 dist[v as usize] = f64::INFINITY;
+            }
+            if let Known::Cell { entries, .. } = known {
+                // Cell samples beyond the radius were set but not returned.
+                for &(v, _) in entries {
+                    dist[v as usize] = f64::INFINITY;
+                }
             }
             if nearest.is_some() {
                 out.retain(|&(v, d)| d < radius || v == source);
@@ -190,22 +228,23 @@ impl Ball {
         }
     }
 
-    /// The field of a node on `source` to `radius`, searched on from `inner`: the
-    /// complete field of some smaller radius, with its entries (see
-    /// [`Partition::inner_field`]), or nothing.
+    /// The field of a node on `source` to `radius`, searched on from its Voronoi cell
+    /// (see [`Partition::cell_field`]) if there is one.
     pub fn compute_from(
         domain: &Domain,
         source: u32,
         radius: f64,
-        inner: Option<(f64, Vec<(u32, f64)>)>,
+        cell: Option<CellField>,
     ) -> Self {
-        match inner {
-            Some((r, entries)) if !entries.is_empty() => {
-                let known = Self { radius: r, entries };
-                if r >= radius {
-                    known
-                } else {
-                    known.extend(domain, source, radius)
+        match cell {
+            Some(cell) if !cell.entries.is_empty() => {
+                let known = Known::Cell {
+                    entries: &cell.entries,
+                    seeds: &cell.seeds,
+                };
+                Self {
+                    radius,
+                    entries: search(domain, source, radius, known, None).0,
                 }
             }
             _ => Self::compute(domain, source, radius),
@@ -219,7 +258,8 @@ impl Ball {
         if domain.metric() != Metric::Intrinsic {
             return None;
         }
-        let (entries, radius) = search(domain, source, f64::INFINITY, None, Some(is_node));
+        let (entries, radius) =
+            search(domain, source, f64::INFINITY, Known::Nothing, Some(is_node));
         Some(Self { radius, entries })
     }
 
@@ -235,7 +275,10 @@ impl Ball {
         if domain.metric() != Metric::Intrinsic || self.radius < 0.0 || self.entries.is_empty() {
             return None;
         }
-        let known = Some((self.entries.as_slice(), self.radius));
+        let known = Known::Ball {
+            entries: &self.entries,
+            radius: self.radius,
+        };
         let (entries, radius) = search(domain, source, f64::INFINITY, known, Some(is_node));
         (radius > self.radius).then_some(Self { radius, entries })
     }
@@ -251,7 +294,10 @@ impl Ball {
                 domain,
                 source,
                 radius,
-                Some((&self.entries, self.radius)),
+                Known::Ball {
+                    entries: &self.entries,
+                    radius: self.radius,
+                },
                 None,
             )
             .0,
@@ -439,8 +485,8 @@ impl Weights {
             .enumerate()
             .map(|(k, ball)| {
                 ball.unwrap_or_else(|| {
-                    let inner = partition.inner_field(domain, k);
-                    Ball::compute_from(domain, partition.node_vertex[k], radii[k], inner)
+                    let cell = partition.cell_field(domain, k);
+                    Ball::compute_from(domain, partition.node_vertex[k], radii[k], cell)
                 })
             })
             .collect();
@@ -962,7 +1008,7 @@ mod tests {
     }
 
     #[test]
-    fn a_cell_holds_its_nodes_field_out_to_half_its_r_h() {
+    fn a_field_searched_on_from_its_cell_equals_one_searched_at_once() {
         // A regular grid (distances tie everywhere) and a jittered one, with nodes in
         // clusters and apart; some at exactly even spacing.
         let (p, t) = grid_mesh(40, 30, 1.0);
@@ -982,24 +1028,24 @@ mod tests {
             .collect();
         let jittered = Domain::new(jittered, t, Metric::Intrinsic).expect("valid");
         for d in [&regular, &jittered] {
-            let part = Partition::new(d, vec![0, 2, 4, 300, 345, 606, 1000, 1234]);
+            let mut part = Partition::new(d, vec![0, 2, 4, 300, 345, 606, 1000, 1234]);
+            // Cells made by the incremental paths too: nodes added one by one (as
+            // Algorithm 1 does) and one removed (its samples handed to its neighbours).
+            part.add_node(d, 700);
+            part.add_node(d, 20);
+            part.remove_node(d, 4);
             for k in 0..part.len() {
-                let (r, inner) = part.inner_field(d, k).expect("finite r_h");
-                assert!(r > 0.0 && r < part.stats[k].r_h / 2.0);
                 let source = part.node_vertex[k];
-                let mut a = inner;
-                let mut b = ball(d, source, r);
-                a.sort_by_key(|e| e.0);
-                b.sort_by_key(|e| e.0);
-                assert_eq!(a, b, "node {k}");
-                // And searched on from there, the field a search from scratch finds.
-                let radius = part.stats[k].r_h * 1.5;
-                let from = Ball::compute_from(d, source, radius, part.inner_field(d, k));
-                let mut a = from.entries.clone();
-                let mut b = ball(d, source, radius);
-                a.sort_by_key(|e| e.0);
-                b.sort_by_key(|e| e.0);
-                assert_eq!(a, b, "node {k}");
+                let r_h = part.stats[k].r_h;
+                // Radii inside the cell, across its rim, and well beyond it.
+                for radius in [r_h * 0.3, r_h, r_h * 1.5, f64::INFINITY] {
+                    let from = Ball::compute_from(d, source, radius, part.cell_field(d, k));
+                    let mut a = from.entries.clone();
+                    let mut b = ball(d, source, radius);
+                    a.sort_by_key(|e| e.0);
+                    b.sort_by_key(|e| e.0);
+                    assert_eq!(a, b, "node {k}, radius {radius}");
+                }
             }
         }
     }
