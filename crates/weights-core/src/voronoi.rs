@@ -273,7 +273,7 @@ impl Partition {
     }
 
     /// Whether sample `v` carries a node.
-    #[inline]
+    #[cfg(test)]
     pub fn is_node(&self, v: u32) -> bool {
         let o = self.owner[v as usize];
         o != NONE && self.node_vertex[o as usize] == v

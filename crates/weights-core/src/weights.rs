@@ -314,19 +314,32 @@ impl Ball {
     }
 
     /// Support entries from the cached field.
-    fn support(
-        &self,
-        basis: &Basis,
-        radius: f64,
-        partition: &Partition,
-        source: u32,
-    ) -> Vec<(u32, f32)> {
+    fn support(&self, basis: &Basis, radius: f64, nodes: &NodeSet, source: u32) -> Vec<(u32, f32)> {
         self.entries
             .iter()
             .filter_map(|&(v, d)| {
-                support_entry(basis, partition, source, v, d as f32, radius).map(|f| (v, f))
+                support_entry(basis, nodes, source, v, d as f32, radius).map(|f| (v, f))
             })
             .collect()
+    }
+}
+
+/// The samples that carry a node, a bit each (the partition answers the same from two
+/// tables; [`support_entry`] asks for every sample a support reaches).
+pub(crate) struct NodeSet(Vec<u64>);
+
+impl NodeSet {
+    pub fn new(samples: usize, partition: &Partition) -> Self {
+        let mut bits = vec![0u64; samples.div_ceil(64)];
+        for &v in &partition.node_vertex {
+            bits[v as usize / 64] |= 1 << (v % 64);
+        }
+        Self(bits)
+    }
+
+    #[inline]
+    fn contains(&self, v: u32) -> bool {
+        self.0[v as usize / 64] >> (v % 64) & 1 == 1
     }
 }
 
@@ -337,7 +350,7 @@ impl Ball {
 #[inline]
 fn support_entry(
     basis: &Basis,
-    partition: &Partition,
+    nodes: &NodeSet,
     source: u32,
     v: u32,
     d: f32,
@@ -347,7 +360,7 @@ fn support_entry(
         return Some(1.0);
     }
     let d = f64::from(d);
-    if d >= radius || partition.is_node(v) {
+    if d >= radius || nodes.contains(v) {
         return None;
     }
     let phi = basis.eval(d / radius) as f32;
@@ -490,10 +503,11 @@ impl Weights {
                 })
             })
             .collect();
+        let nodes = NodeSet::new(n, partition);
         let supports: Vec<Vec<(u32, f32)>> = balls
             .par_iter()
             .enumerate()
-            .map(|(k, b)| b.support(basis, radii[k], partition, partition.node_vertex[k]))
+            .map(|(k, b)| b.support(basis, radii[k], &nodes, partition.node_vertex[k]))
             .collect();
         let mut order: Vec<usize> = (0..partition.len()).collect();
         order.sort_unstable_by_key(|&k| partition.node_vertex[k]);
@@ -541,6 +555,7 @@ impl Weights {
         basis: &Basis,
     ) -> Self {
         let n = domain.len();
+        let nodes = NodeSet::new(n, partition);
         let grid = domain.vertex_grid();
         let positions = domain.positions();
         // Per cell, the nodes whose support disc meets it (or whose sample is in it), in
@@ -599,7 +614,7 @@ impl Weights {
                         let source = partition.node_vertex[k as usize];
                         let d = (positions[source as usize] - p).length() as f32;
                         if let Some(f) =
-                            support_entry(basis, partition, source, v as u32, d, radii[k as usize])
+                            support_entry(basis, &nodes, source, v as u32, d, radii[k as usize])
                         {
                             rows.nodes.push(k);
                             rows.phi.push(f);
@@ -738,6 +753,7 @@ impl Weights {
         /// support entries `(sample, node, φ)` bucketed by chunk.
         type Reach = (usize, Option<Ball>, Vec<Vec<(u32, u32, f32)>>);
         let chunk_count = n.div_ceil(CHUNK);
+        let nodes = NodeSet::new(n, partition);
         let balls = &self.balls;
         let results: Vec<Reach> = changes
             .par_iter()
@@ -753,10 +769,12 @@ impl Weights {
                 let mut by_chunk = vec![Vec::new(); chunk_count];
                 for &(v, d) in &ball.entries {
                     let d = d as f32;
-                    if f64::from(d) < reach {
-                        mark(v);
+                    if f64::from(d) >= reach && v != source {
+                        // Beyond the support now and before: no row changes.
+                        continue;
                     }
-                    if let Some(f) = support_entry(basis, partition, source, v, d, r) {
+                    mark(v);
+                    if let Some(f) = support_entry(basis, &nodes, source, v, d, r) {
                         by_chunk[v as usize / CHUNK].push((v, c.node as u32, f));
                     }
                 }
@@ -790,11 +808,11 @@ impl Weights {
                 let fresh = results.iter().map(|r| &r.2[c][..]);
                 let (start, by_row) = bucket_rows(lo, hi, fresh);
                 let mut rebuilt = Chunk::new();
-                rebuilt
-                    .nodes
-                    .reserve(chunk.nodes.len() + chunk.nodes.len() / 8);
-                rebuilt.phi.reserve(rebuilt.nodes.capacity());
-                let mut row: Vec<(u32, f32)> = Vec::new();
+                // At most every old entry and every new one.
+                let most = chunk.nodes.len() + by_row.len();
+                rebuilt.nodes.reserve(most);
+                rebuilt.phi.reserve(most);
+                rebuilt.offsets.reserve(hi - lo);
                 let mut v = lo;
                 while v < hi {
                     if !is_dirty(v) {
@@ -822,20 +840,35 @@ impl Weights {
                             .extend_from_slice(&chunk.phi[a as usize..b as usize]);
                         continue;
                     }
+                    // A dirty row: its entries of unchanged nodes (in sample order
+                    // already), then each changed node's new entry put in its place.
                     let i = v - lo;
-                    let (nodes, phi) = chunk.row(i);
-                    row.clear();
-                    row.extend(
-                        nodes
-                            .iter()
-                            .map(|&k| map[k as usize])
-                            .zip(phi.iter().copied())
-                            .filter(|&(k, _)| k != NONE && !changed_node[k as usize]),
-                    );
-                    row.extend_from_slice(&by_row[start[i] as usize..start[i + 1] as usize]);
-                    row.sort_unstable_by_key(|&(k, _)| partition.node_vertex[k as usize]);
-                    sums[i] = row.iter().map(|&(_, f)| f64::from(f)).sum();
-                    rebuilt.push(row.iter().copied());
+                    let (a, b) = (chunk.offsets[i] as usize, chunk.offsets[i + 1] as usize);
+                    let base = rebuilt.nodes.len();
+                    for (&k, &f) in chunk.nodes[a..b].iter().zip(&chunk.phi[a..b]) {
+                        let k = map[k as usize];
+                        if k != NONE && !changed_node[k as usize] {
+                            rebuilt.nodes.push(k);
+                            rebuilt.phi.push(f);
+                        }
+                    }
+                    for &(k, f) in &by_row[start[i] as usize..start[i + 1] as usize] {
+                        let key = partition.node_vertex[k as usize];
+                        let mut at = rebuilt.nodes.len();
+                        rebuilt.nodes.push(k);
+                        rebuilt.phi.push(f);
+                        while at > base
+                            && partition.node_vertex[rebuilt.nodes[at - 1] as usize] > key
+                        {
+                            rebuilt.nodes[at] = rebuilt.nodes[at - 1];
+                            rebuilt.phi[at] = rebuilt.phi[at - 1];
+                            at -= 1;
+                        }
+                        rebuilt.nodes[at] = k;
+                        rebuilt.phi[at] = f;
+                    }
+                    sums[i] = rebuilt.phi[base..].iter().map(|&f| f64::from(f)).sum();
+                    rebuilt.offsets.push(rebuilt.nodes.len() as u32);
                     v += 1;
                 }
                 *chunk = rebuilt;
