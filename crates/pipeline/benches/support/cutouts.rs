@@ -113,6 +113,16 @@ pub fn quantile(mut v: Vec<f64>, q: f64) -> f64 {
     v[rank - 1]
 }
 
+/// How many passes over the positions the insertion benchmark makes: `INSERTION_PASSES`,
+/// else 3 (at least 1).
+pub fn passes() -> usize {
+    std::env::var("INSERTION_PASSES")
+        .ok()
+        .and_then(|s| s.trim().parse().ok())
+        .unwrap_or(3)
+        .max(1)
+}
+
 /// The densities measured: `INSERTION_SIZES` (comma-separated), else 20k and 100k.
 pub fn sizes() -> Vec<usize> {
     std::env::var("INSERTION_SIZES")
