@@ -44,9 +44,10 @@ fn insertion(c: &mut Criterion) {
                 // Every position once, in order, for the median and the 90th percentile;
                 // then more passes, keeping each position's fastest time (what the
                 // insertion costs when nothing else on the machine gets in its way).
+                let passes = cutouts::passes();
                 let mut first = Vec::new();
                 let mut best = vec![f64::INFINITY; positions.len()];
-                for pass in 0..cutouts::passes() {
+                for pass in 0..passes {
                     for (i, &at) in positions.iter().enumerate() {
                         let clock = Instant::now();
                         let inserted = rig.insert_handle(Handle::point(at));
@@ -68,7 +69,7 @@ fn insertion(c: &mut Criterion) {
                     first.len(),
                     cutouts::quantile(first.clone(), 0.5),
                     cutouts::quantile(first, 0.9),
-                    cutouts::passes(),
+                    passes,
                     cutouts::quantile(best.clone(), 0.5),
                     cutouts::quantile(best, 0.9)
                 );

@@ -15,7 +15,7 @@ use crate::nearest::segment_distance;
 use crate::transform::Similarity;
 use crate::virtual_handles::{Placement, insert_virtual_handles};
 use crate::voronoi::{CellStats, NONE, Partition};
-use crate::weights::{Ball, Change, Weights, ball};
+use crate::weights::{Ball, Change, SampleSet, Weights, ball};
 
 /// A handle the user places.
 #[derive(Clone, Debug, PartialEq)]
@@ -832,15 +832,15 @@ impl Rig {
         // The node samples once the removals and the real nodes are in (a bit per
         // sample: searches ask for every sample they reach), and the new real nodes
         // among them.
-        let mut settled = vec![0u64; self.domain.len().div_ceil(64)];
+        let mut settled = SampleSet::new(self.domain.len());
         for v in (0..self.nodes.len())
             .filter(|k| doomed.binary_search(k).is_err())
             .map(|k| self.nodes[k].vertex)
             .chain(target_vertices.iter().copied())
         {
-            settled[v as usize / 64] |= 1 << (v % 64);
+            settled.insert(v);
         }
-        let is_settled = |v: u32| settled[v as usize / 64] >> (v % 64) & 1 == 1;
+        let is_settled = |v: u32| settled.contains(v);
         let arriving: Vec<u32> = target
             .iter()
             .map(|n| n.vertex)

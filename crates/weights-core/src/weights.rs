@@ -91,6 +91,8 @@ fn search(
             queue.prepare(graph.min_edge_length(), graph.max_edge_length());
             // Entries put back on the queue carry key 1: they are in `out` already.
             const KNOWN: u32 = 1;
+            // How many of `out`'s entries came from a known cell.
+            let mut known_out = 0;
             match known {
                 Known::Ball { entries, radius: r } => {
                     if let Some(accept) = nearest {
@@ -129,6 +131,7 @@ fn search(
                         }
                     }
                     out.extend(entries.iter().copied().filter(|&(_, d)| d < radius));
+                    known_out = out.len();
                 }
                 Known::Nothing => {
                     dist[source as usize] = 0.0;
@@ -169,14 +172,19 @@ fn search(
                 }
             }
             queue.clear();
-            for &(v, _) in &out {
-                dist[v as usize] = f64::INFINITY;
-            }
-            if let Known::Cell { entries, .. } = known {
-                // Cell samples beyond the radius were set but not returned.
-                for &(v, _) in entries {
-                    dist[v as usize] = f64::INFINITY;
+            // Reset what was set: the cell's samples (those beyond the radius were set
+            // but not returned) and what the search found, or everything returned.
+            let found = match known {
+                Known::Cell { entries, .. } => {
+                    for &(v, _) in entries {
+                        dist[v as usize] = f64::INFINITY;
+                    }
+                    &out[known_out..]
                 }
+                _ => &out[..],
+            };
+            for &(v, _) in found {
+                dist[v as usize] = f64::INFINITY;
             }
             if nearest.is_some() {
                 out.retain(|&(v, d)| d < radius || v == source);
@@ -314,7 +322,13 @@ impl Ball {
     }
 
     /// Support entries from the cached field.
-    fn support(&self, basis: &Basis, radius: f64, nodes: &NodeSet, source: u32) -> Vec<(u32, f32)> {
+    fn support(
+        &self,
+        basis: &Basis,
+        radius: f64,
+        nodes: &SampleSet,
+        source: u32,
+    ) -> Vec<(u32, f32)> {
         self.entries
             .iter()
             .filter_map(|&(v, d)| {
@@ -324,21 +338,32 @@ impl Ball {
     }
 }
 
-/// The samples that carry a node, a bit each (the partition answers the same from two
-/// tables; [`support_entry`] asks for every sample a support reaches).
-pub(crate) struct NodeSet(Vec<u64>);
+/// A set of samples, a bit each: one load to ask (the partition answers whether a
+/// sample carries a node from two tables; [`support_entry`] asks for every sample a
+/// support reaches).
+pub(crate) struct SampleSet(Vec<u64>);
 
-impl NodeSet {
-    pub fn new(samples: usize, partition: &Partition) -> Self {
-        let mut bits = vec![0u64; samples.div_ceil(64)];
+impl SampleSet {
+    /// The empty set of a domain of `samples` samples.
+    pub fn new(samples: usize) -> Self {
+        Self(vec![0; samples.div_ceil(64)])
+    }
+
+    /// The samples that carry a node of `partition`.
+    pub fn nodes_of(samples: usize, partition: &Partition) -> Self {
+        let mut set = Self::new(samples);
         for &v in &partition.node_vertex {
-            bits[v as usize / 64] |= 1 << (v % 64);
+            set.insert(v);
         }
-        Self(bits)
+        set
+    }
+
+    pub fn insert(&mut self, v: u32) {
+        self.0[v as usize / 64] |= 1 << (v % 64);
     }
 
     #[inline]
-    fn contains(&self, v: u32) -> bool {
+    pub fn contains(&self, v: u32) -> bool {
         self.0[v as usize / 64] >> (v % 64) & 1 == 1
     }
 }
@@ -350,7 +375,7 @@ impl NodeSet {
 #[inline]
 fn support_entry(
     basis: &Basis,
-    nodes: &NodeSet,
+    nodes: &SampleSet,
     source: u32,
     v: u32,
     d: f32,
@@ -503,7 +528,7 @@ impl Weights {
                 })
             })
             .collect();
-        let nodes = NodeSet::new(n, partition);
+        let nodes = SampleSet::nodes_of(n, partition);
         let supports: Vec<Vec<(u32, f32)>> = balls
             .par_iter()
             .enumerate()
@@ -555,7 +580,7 @@ impl Weights {
         basis: &Basis,
     ) -> Self {
         let n = domain.len();
-        let nodes = NodeSet::new(n, partition);
+        let nodes = SampleSet::nodes_of(n, partition);
         let grid = domain.vertex_grid();
         let positions = domain.positions();
         // Per cell, the nodes whose support disc meets it (or whose sample is in it), in
@@ -753,7 +778,7 @@ impl Weights {
         /// support entries `(sample, node, φ)` bucketed by chunk.
         type Reach = (usize, Option<Ball>, Vec<Vec<(u32, u32, f32)>>);
         let chunk_count = n.div_ceil(CHUNK);
-        let nodes = NodeSet::new(n, partition);
+        let nodes = SampleSet::nodes_of(n, partition);
         let balls = &self.balls;
         let results: Vec<Reach> = changes
             .par_iter()
