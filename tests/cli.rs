@@ -862,3 +862,45 @@ fn webp_tiff_bmp_and_gif_pictures_render() {
         assert_eq!(load(&out), expected, "{name}");
     }
 }
+
+#[test]
+fn a_directory_where_a_file_belongs_is_refused_once() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let folder = dir.path().join("folder.png");
+    fs::create_dir(&folder).expect("mkdir");
+    let rig = data("dino-rig.json");
+    let line = fails(&render_args(&data("dino.png"), &rig, &folder, &[]));
+    assert!(line.contains("Is a directory"), "{line}");
+    let line = fails(&render_args(
+        &data("dino.png"),
+        &folder,
+        &dir.path().join("o.png"),
+        &[],
+    ));
+    assert!(line.contains("not a regular file"), "{line}");
+    let line = fails(&render_args(&folder, &rig, &dir.path().join("o.png"), &[]));
+    assert!(line.contains("not a regular file"), "{line}");
+}
+
+#[test]
+fn a_rig_file_that_is_not_an_object_says_what_it_is() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    for (text, expected) in [
+        ("null", "a rig file is one JSON object"),
+        ("[]", "not a list"),
+        ("7", "not a number"),
+    ] {
+        let rig = dir.path().join("rig.json");
+        fs::write(&rig, text).expect("write");
+        let line = fails(&render_args(
+            &data("dino.png"),
+            &rig,
+            &dir.path().join("o.png"),
+            &[],
+        ));
+        assert!(
+            line.contains(expected) && !line.contains("Probe"),
+            "{text}: {line}"
+        );
+    }
+}

@@ -213,7 +213,14 @@ fn bad_method_fields_give_one_clear_line_and_keep_the_old_output() {
     fs::write(&out, b"precious").expect("write");
     let handles = r#""handles":[{"type":"point","rest":[60,60]}]"#;
     let cases = [
-        (r#""method":"lbc3""#, "unknown variant `lbc3`"),
+        (
+            r#""method":"lbc3""#,
+            r#"method: invalid value: string "lbc3", expected a method: "c2", "arap" or "lbc""#,
+        ),
+        (
+            r#""method":2"#,
+            r#"method: invalid type: integer `2`, expected a method"#,
+        ),
         (
             r#""rigidity":[{"stroke":[[1,NaN]],"radius":2,"weight":3}]"#,
             "malformed",
@@ -390,14 +397,23 @@ fn lbc_deform_follows_the_cage() {
     let dir = tempfile::tempdir().expect("temp dir");
     let mesh = data("strip.obj");
     let rest = strip_rest();
-    let cases: [(&str, CageMap, f64); 2] = [
-        // A translation is reproduced exactly: the rows sum to one.
+    // Every affine motion of the cage is reproduced to rounding, rest included: the
+    // compact rows keep partition of unity and linear precision.
+    let cases: [(&str, CageMap, f64); 4] = [
+        ("rest.json", |p| p, 1e-9),
         ("shift.json", |p| [p[0] + 7.0, p[1] - 3.0], 1e-9),
-        // Another affine map to within the weights dropped by compaction.
         (
             "shear.json",
             |p| [1.2 * p[0] + 0.3 * p[1], 0.9 * p[1] + 5.0],
-            0.5,
+            1e-9,
+        ),
+        (
+            "turn.json",
+            |p| {
+                let (s, c) = 0.5f64.sin_cos();
+                [c * p[0] - s * p[1] + 40.0, s * p[0] + c * p[1] - 10.0]
+            },
+            1e-9,
         ),
     ];
     for (name, map, tolerance) in cases {
@@ -442,6 +458,10 @@ fn bad_cages_give_one_clear_line() {
         (
             r#"{"version":1,"method":"lbc","handles":[],"cage":{"rest":[[0,0],[121,0],[121,30],[0,30]]}}"#,
             "not a vertex of the mesh",
+        ),
+        (
+            r#"{"version":1,"method":"lbc","handles":[],"cage":{"rest":[[0,0],[60,0],[60,30],[0,30]]}}"#,
+            "lies outside the cage",
         ),
     ];
     for (i, (text, expected)) in cases.into_iter().enumerate() {
@@ -612,4 +632,77 @@ fn the_editors_cage_export_is_what_render_draws_for_its_saved_project() {
     );
     let (_, warped) = difference(&load(&rendered), &load(&picture), 8);
     assert!(warped > 0.001, "the cage moved the picture ({warped})");
+}
+
+#[test]
+fn cage_writes_a_rig_whose_cage_encloses_the_picture_and_renders_it_unchanged_at_rest() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let rig = dir.path().join("cage.json");
+    let picture = data("dino.png");
+    ok(&[
+        os("cage"),
+        picture.as_os_str(),
+        os("--vertices"),
+        os("12"),
+        os("-o"),
+        rig.as_os_str(),
+    ]);
+    let project =
+        project::Project::from_json(&fs::read_to_string(&rig).expect("read")).expect("a valid rig");
+    assert_eq!(project.method, project::Method::Lbc);
+    let cage = project.cage.expect("a cage");
+    assert_eq!(cage.rest.len(), 12);
+    assert!(cage.pose.is_none());
+    // The picture, named so that the rig finds it from its own folder.
+    let named = rig
+        .parent()
+        .expect("a folder")
+        .join(project.image.expect("an image"));
+    assert_eq!(
+        named.canonicalize().expect("exists"),
+        picture.canonicalize().expect("exists")
+    );
+    // Every visible pixel lies inside the cage (its centre at least).
+    let image = load(&picture);
+    let ring: Vec<glam::DVec2> = cage.rest.iter().map(|&p| glam::DVec2::from(p)).collect();
+    let polygon = lbc::Cage::new(ring).expect("a simple polygon");
+    for (x, y, p) in image.enumerate_pixels() {
+        if p[3] > 0 {
+            let c = glam::DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            assert!(polygon.contains(c), "({x}, {y}) is outside the cage");
+        }
+    }
+    // At rest the cage gives the picture back exactly.
+    let out = dir.path().join("rest.png");
+    ok(&render_args(&picture, &rig, &out, &["--density", "800"]));
+    assert_eq!(load(&out), image);
+    // A rig to start from keeps its handles; the cage and the method are new.
+    let with = dir.path().join("with.json");
+    let original = data("dino-rig.json");
+    ok(&[
+        os("cage"),
+        picture.as_os_str(),
+        os("--rig"),
+        original.as_os_str(),
+        os("-o"),
+        with.as_os_str(),
+    ]);
+    let kept = project::Project::from_json(&fs::read_to_string(&with).expect("read"))
+        .expect("a valid rig");
+    let before = project::Project::from_json(&fs::read_to_string(&original).expect("read"))
+        .expect("a valid rig");
+    assert_eq!(kept.handles, before.handles);
+    assert_eq!(kept.cage.expect("a cage").rest.len(), 16);
+    // Bad requests: one line, nothing written.
+    let refused = dir.path().join("refused.json");
+    let line = fails(&[
+        os("cage"),
+        picture.as_os_str(),
+        os("--vertices"),
+        os("2"),
+        os("-o"),
+        refused.as_os_str(),
+    ]);
+    assert!(line.contains("3 to 1000 vertices"), "{line}");
+    assert!(!refused.exists());
 }

@@ -44,6 +44,14 @@ pub fn fails(args: &[&std::ffi::OsStr]) -> String {
     let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
     assert_eq!(lines.len(), 1, "one line of error expected, got: {stderr}");
     assert!(lines[0].starts_with("error: "), "{stderr}");
+    // Each reason once: no part of the line between ": " says again what another says.
+    let parts: Vec<&str> = lines[0].split(": ").filter(|p| p.len() >= 8).collect();
+    for (i, part) in parts.iter().enumerate() {
+        assert!(
+            !parts[..i].contains(part),
+            "the line says {part:?} twice: {stderr}"
+        );
+    }
     lines[0].to_string()
 }
 
@@ -138,6 +146,14 @@ pub fn fails_within(args: &[&std::ffi::OsStr], limit: std::time::Duration) -> St
     let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
     assert_eq!(lines.len(), 1, "one line of error expected, got: {stderr}");
     assert!(lines[0].starts_with("error: "), "{stderr}");
+    // Each reason once: no part of the line between ": " says again what another says.
+    let parts: Vec<&str> = lines[0].split(": ").filter(|p| p.len() >= 8).collect();
+    for (i, part) in parts.iter().enumerate() {
+        assert!(
+            !parts[..i].contains(part),
+            "the line says {part:?} twice: {stderr}"
+        );
+    }
     lines[0].to_string()
 }
 

@@ -47,6 +47,21 @@ pub fn solve_on(project: &Project, mesh: CageMesh) -> Result<CageCoordinates> {
         true
     })?;
     progress.finish();
+    let report = &solved.report;
+    if !report.converged {
+        let residuals = report.last.map_or(String::new(), |p| {
+            format!(
+                " (relative residuals {:.1e} and {:.1e} of their thresholds)",
+                p.primal_residual / p.primal_threshold,
+                p.dual_residual / p.dual_threshold
+            )
+        });
+        eprintln!(
+            "warning: the cage's coordinates did not converge in {} ADMM iterations{residuals}; \
+             the warp may be off",
+            report.iterations
+        );
+    }
     Ok(solved)
 }
 

@@ -61,7 +61,7 @@ enum Command {
         /// bits per channel: a 16-bit source gives an 8-bit PNG.
         #[arg(long)]
         gpu: bool,
-        /// The warping method: c2 or arap (overrides the rig's `method`).
+        /// The warping method: c2, arap or lbc (overrides the rig's `method`).
         #[arg(long)]
         method: Option<Method>,
     },
@@ -73,7 +73,7 @@ enum Command {
         /// The rig file (RIG.json).
         #[arg(long)]
         rig: PathBuf,
-        /// The warping method: c2 or arap (overrides the rig's `method`).
+        /// The warping method: c2, arap or lbc (overrides the rig's `method`).
         #[arg(long)]
         method: Option<Method>,
         /// Where to write the OBJ (`-`: standard output).
@@ -102,9 +102,30 @@ enum Command {
         /// Random positions to insert and remove a handle at.
         #[arg(long, default_value_t = 31)]
         positions: usize,
-        /// The method to time: c2 or arap (overrides the rig's `method`).
+        /// The method to time: c2, arap or lbc (overrides the rig's `method`).
         #[arg(long)]
         method: Option<Method>,
+    },
+    /// Write a rig whose cage (LBC) encloses every visible pixel of a picture: the
+    /// picture's outline a few pixels out, brought down to `--vertices` vertices
+    /// without crossing itself (more where that few cannot enclose it, with a note).
+    Cage {
+        /// The picture (PNG, JPEG, WebP, TIFF, BMP, or a GIF's first frame).
+        image: PathBuf,
+        /// Vertices of the cage.
+        #[arg(long, default_value_t = 16)]
+        vertices: usize,
+        /// How far outside the visible pixels the cage runs at least, in pixels
+        /// (default: 1% of the picture's diagonal, 3 to 20).
+        #[arg(long)]
+        offset: Option<f64>,
+        /// A rig to start from: its handles and settings are kept, its cage replaced.
+        #[arg(long)]
+        rig: Option<PathBuf>,
+        /// Where to write the rig (`-`: standard output); `"method"` is `"lbc"`, the
+        /// cage at rest, `"image"` the picture relative to the rig's folder.
+        #[arg(short, long)]
+        output: PathBuf,
     },
     /// Render the sample rig on the built-in image and say where the PNG went.
     Demo {
@@ -146,7 +167,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", pipeline::error_line(&e));
             ExitCode::FAILURE
         }
     }
@@ -180,8 +201,48 @@ fn run(command: Command) -> Result<()> {
             positions,
             method,
         } => bench::run(&source, &rig, positions, method),
+        Command::Cage {
+            image,
+            vertices,
+            offset,
+            rig,
+            output,
+        } => cage(&image, vertices, offset, rig.as_deref(), &output),
         Command::Demo { output } => demo(&output),
     }
+}
+
+fn cage(
+    image: &Path,
+    vertices: usize,
+    offset: Option<f64>,
+    rig: Option<&Path>,
+    output: &Path,
+) -> Result<()> {
+    let mut project = match rig {
+        Some(rig) => load_project(rig)?,
+        None => Project::default(),
+    };
+    let picture = pipeline::load_image(image)?;
+    let (w, h) = picture.dimensions();
+    let offset = offset.unwrap_or_else(|| pipeline::cage::outline_offset(w, h));
+    let ring = pipeline::cage::cage_from_outline(&picture, vertices, offset)?;
+    if let Some(note) = pipeline::cage::outline_note(vertices, ring.len()) {
+        eprintln!("note: {note}");
+    }
+    project.cage = Some(project::CageSpec {
+        rest: ring.iter().map(|p| p.to_array()).collect(),
+        pose: None,
+    });
+    project.method = Method::Lbc;
+    let folder = if is_stdout(output) {
+        Path::new("")
+    } else {
+        output.parent().unwrap_or(Path::new(""))
+    };
+    project.image = Some(pipeline::relative_path(image, folder));
+    project.validate(Some((w, h)))?;
+    write_text(output, project.to_json().as_bytes())
 }
 
 fn render(

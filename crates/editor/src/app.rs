@@ -453,7 +453,7 @@ impl EditorApp {
 
     pub(crate) fn error(&mut self, error: &anyhow::Error) {
         self.say(Message {
-            text: format!("{error:#}"),
+            text: pipeline::error_line(error),
             is_error: true,
         });
     }
@@ -1353,10 +1353,7 @@ impl EditorApp {
             });
             if gpu.backdrop.is_none() || !same {
                 let backdrop = match &cage {
-                    Some(solution) => Arc::new(crate::cage::outside_of(
-                        &doc.image,
-                        solution.domain.cage().vertices(),
-                    )),
+                    Some(solution) => Arc::new(crate::cage::outside_of(&doc.image, solution)),
                     None => doc.image.clone(),
                 };
                 gpu.backdrop = Some(Versioned {

@@ -185,9 +185,9 @@ pub(crate) fn mesh_data(solution: &CageCoordinates, source_size: [u32; 2]) -> Me
 
 /// The picture as LBC leaves it outside the cage: pixels inside the rest cage cleared
 /// (the warped inside is drawn over it), as the export draws it.
-pub(crate) fn outside_of(image: &image::RgbaImage, cage: &[DVec2]) -> image::RgbaImage {
+pub(crate) fn outside_of(image: &image::RgbaImage, solution: &CageCoordinates) -> image::RgbaImage {
     let mut out = image.clone();
-    pipeline::cage::clear_inside(&mut out, cage);
+    pipeline::cage::clear_inside(&mut out, &solution.domain);
     out
 }
 
@@ -619,16 +619,19 @@ impl EditorApp {
     pub fn cage_from_outline(&mut self) {
         let Some(doc) = &self.doc else { return };
         let (w, h) = doc.image.dimensions();
-        let offset = (0.01 * f64::from(w).hypot(f64::from(h))).clamp(3.0, 20.0);
+        let offset = pipeline::cage::outline_offset(w, h);
         let vertices = self.cage.outline_vertices;
         match pipeline::cage::cage_from_outline(&doc.image, vertices, offset) {
             Ok(ring) => {
                 self.cage.draft = None;
+                let note = pipeline::cage::outline_note(vertices, ring.len())
+                    .map_or(String::new(), |n| format!(" ({n})"));
+                let count = ring.len();
                 if self.set_cage_rest(ring) {
                     self.cage.selected.clear();
                     self.cage.edit_rest = false;
                     self.info(format!(
-                        "a cage of {vertices} vertices around the picture's outline: adjust \
+                        "a cage of {count} vertices around everything visible{note}: adjust \
                          it, then Solve (Enter)"
                     ));
                 }

@@ -577,7 +577,7 @@ impl Document {
         let mut project = self.snapshot();
         project.image = self.image_path.as_ref().map(|image| {
             let folder = path.and_then(Path::parent).unwrap_or(Path::new(""));
-            relative_to(image, folder)
+            pipeline::relative_path(image, folder)
         });
         project
     }
@@ -1092,15 +1092,6 @@ pub fn posed(h: &HandleSpec) -> [DVec2; 2] {
 }
 
 /// `path` relative to `folder` when it lies inside it, else `path` made absolute.
-fn relative_to(path: &Path, folder: &Path) -> PathBuf {
-    let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
-    let (path, folder) = (absolute(path), absolute(folder));
-    match path.strip_prefix(&folder) {
-        Ok(relative) => relative.to_path_buf(),
-        Err(_) => path,
-    }
-}
-
 fn ms(clock: Instant) -> f64 {
     clock.elapsed().as_secs_f64() * 1e3
 }

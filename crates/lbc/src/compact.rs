@@ -1,10 +1,10 @@
 //! The coordinates as computed (dense) and in the paper's compact form (sparse rows).
 
-use glam::DVec2;
+use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use crate::error::LbcError;
-use crate::solve::Report;
+use crate::solve::{Report, project_row};
 
 /// Dense coordinates: `n` weights per mesh vertex, vertex-major.
 #[derive(Clone, Debug, PartialEq)]
@@ -13,6 +13,10 @@ pub struct Coordinates {
     weights: Vec<f64>,
     /// How the solve went.
     pub report: Report,
+    /// `(x, y, 1)` of each cage vertex in the solver's frame (centred, unit size), and
+    /// each mesh vertex's position in that frame: what a compact row must reproduce.
+    cage: Vec<DVec3>,
+    positions: Vec<DVec2>,
 }
 
 fn check_pose(pose: &[DVec2], n: usize) -> Result<(), LbcError> {
@@ -26,8 +30,20 @@ fn check_pose(pose: &[DVec2], n: usize) -> Result<(), LbcError> {
 }
 
 impl Coordinates {
-    pub(crate) fn new(n: usize, weights: Vec<f64>, report: Report) -> Self {
-        Self { n, weights, report }
+    pub(crate) fn new(
+        n: usize,
+        weights: Vec<f64>,
+        report: Report,
+        cage: Vec<DVec3>,
+        positions: Vec<DVec2>,
+    ) -> Self {
+        Self {
+            n,
+            weights,
+            report,
+            cage,
+            positions,
+        }
     }
 
     /// Number of cage vertices.
@@ -58,29 +74,33 @@ impl Coordinates {
             .collect())
     }
 
-    /// The paper's compact form: weights below `10⁻³/n` dropped, each row divided by
-    /// its remaining sum. Partition of unity stays exact; reproduction then holds to
-    /// within the dropped weight times the cage's size (at most `n · 10⁻³/n = 10⁻³`
-    /// of the distance to the farthest cage vertex, in practice far less).
+    /// The paper's compact form: weights below `10⁻³/n` dropped, the rest corrected
+    /// so that each row still reproduces its vertex exactly.
+    ///
+    /// Dropping weights alone (and dividing by what remains, as the paper's Table 1
+    /// implies) keeps partition of unity but not linear precision: a vertex moves by
+    /// up to the dropped weight times the cage's size, so the cage at rest would not
+    /// be the identity. Here each row is instead the projection of its kept weights
+    /// onto `{w ≥ 0, Σ wᵢ = 1, Σ wᵢ cᵢ = x}` with the dropped ones held at zero (the
+    /// least-norm correction, kept non-negative): rest is the identity and every
+    /// affine motion of the cage is reproduced, to rounding. Where no such row exists
+    /// on the kept support (fewer than three kept weights off the cage, say, or a
+    /// vertex on a cage edge next to a cage vertex), the row keeps every non-zero
+    /// weight, as solved.
     pub fn compact(&self) -> CompactWeights {
         let n = self.n;
         let threshold = 1e-3 / n as f64;
-        let mut offsets = Vec::with_capacity(self.vertices() + 1);
-        let mut entries = Vec::new();
+        let rows: Vec<Vec<(u32, f64)>> = self
+            .weights
+            .par_chunks(n.max(1))
+            .zip(&self.positions)
+            .map(|(row, &x)| compact_row(row, &self.cage, x, threshold))
+            .collect();
+        let mut offsets = Vec::with_capacity(rows.len() + 1);
+        let mut entries = Vec::with_capacity(rows.iter().map(Vec::len).sum());
         offsets.push(0u32);
-        for row in self.weights.chunks(n) {
-            let start = entries.len();
-            entries.extend(
-                row.iter()
-                    .enumerate()
-                    .filter(|(_, w)| **w >= threshold)
-                    .map(|(i, w)| (i as u32, *w)),
-            );
-            let kept = &mut entries[start..];
-            let sum: f64 = kept.iter().map(|e| e.1).sum();
-            if sum > 0.0 {
-                kept.iter_mut().for_each(|e| e.1 /= sum);
-            }
+        for row in rows {
+            entries.extend(row);
             offsets.push(entries.len() as u32);
         }
         CompactWeights {
@@ -88,6 +108,32 @@ impl Coordinates {
             offsets,
             entries,
         }
+    }
+}
+
+/// One compact row (see [`Coordinates::compact`]): the weights of `row` at least
+/// `threshold`, corrected to reproduce `x` (solver frame) with the cage rows `cage`.
+fn compact_row(row: &[f64], cage: &[DVec3], x: DVec2, threshold: f64) -> Vec<(u32, f64)> {
+    let nonzero = |w: &[f64]| -> Vec<(u32, f64)> {
+        w.iter()
+            .enumerate()
+            .filter(|(_, w)| **w > 0.0)
+            .map(|(i, w)| (i as u32, *w))
+            .collect()
+    };
+    let support: Vec<bool> = row.iter().map(|&w| w >= threshold).collect();
+    if support.iter().zip(row).all(|(&kept, &w)| kept || w == 0.0) {
+        // Nothing to drop: the row is as solved.
+        return nonzero(row);
+    }
+    let kept: Vec<f64> = row
+        .iter()
+        .zip(&support)
+        .map(|(&w, &s)| if s { w } else { 0.0 })
+        .collect();
+    match project_row(&kept, cage, x.extend(1.0), Some(&support)) {
+        Ok(projected) => nonzero(&projected),
+        Err(_) => nonzero(row),
     }
 }
 

@@ -116,6 +116,8 @@ impl Domain {
     /// # Errors
     /// [`LbcError::InvalidMesh`] for an out-of-range index, a non-finite position, a
     /// zero-area triangle or a vertex in no triangle;
+    /// [`LbcError::OutsideCage`] for a vertex outside the cage (or a triangle whose
+    /// centroid is: one that spans a notch of the cage);
     /// [`LbcError::CageVertexNotInMesh`] if a cage vertex has no mesh vertex.
     pub fn from_mesh(
         cage: &Cage,
@@ -151,6 +153,28 @@ impl Domain {
             return Err(LbcError::InvalidMesh(format!(
                 "vertex {v} is in no triangle"
             )));
+        }
+        let (lo, hi) = cage.bounds();
+        let tol = 1e-9 * (hi - lo).length();
+        let c = cage.vertices();
+        let inside = |p: DVec2| {
+            cage.contains(p)
+                || (0..c.len()).any(|e| segment_distance(p, c[e], c[(e + 1) % c.len()]).0 <= tol)
+        };
+        let outside = |v: usize, p: DVec2| LbcError::OutsideCage {
+            vertex: v,
+            x: p.x,
+            y: p.y,
+        };
+        if let Some(v) = positions.iter().position(|&p| !inside(p)) {
+            return Err(outside(v, positions[v]));
+        }
+        for t in &oriented {
+            let p = t.map(|v| positions[v as usize]);
+            if !cage.contains((p[0] + p[1] + p[2]) / 3.0) {
+                let v = t[0] as usize;
+                return Err(outside(v, positions[v]));
+            }
         }
         Self::assemble(cage.clone(), positions, oriented, None)
     }

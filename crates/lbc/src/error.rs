@@ -38,6 +38,20 @@ pub enum LbcError {
     /// non-finite vertex).
     #[error("invalid mesh: {0}")]
     InvalidMesh(String),
+    /// A given mesh reaches beyond the cage: coordinates are defined inside it only.
+    #[error(
+        "mesh vertex {vertex} at ({x}, {y}) lies outside the cage: local barycentric \
+         coordinates are defined inside the cage only (mesh just the cage's inside, or \
+         keep the outside at rest as `c2warp render` does)"
+    )]
+    OutsideCage {
+        /// Index of the mesh vertex.
+        vertex: usize,
+        /// Its position.
+        x: f64,
+        /// Its position.
+        y: f64,
+    },
     /// A cage vertex is not among the given mesh's vertices.
     #[error("cage vertex {vertex} is not a vertex of the mesh")]
     CageVertexNotInMesh {

@@ -189,7 +189,7 @@ pub fn solve_with_distances(
     problem.project(&mut z, clamped.as_deref());
     report.projection = t.elapsed();
     report.objective = problem.objective(&z);
-    Ok(Coordinates::new(n, z, report))
+    Ok(Coordinates::new(n, z, report, problem.k, problem.q))
 }
 
 /// Everything fixed during the iterations, in the solver's frame.

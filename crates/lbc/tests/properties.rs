@@ -223,30 +223,96 @@ fn progress_can_cancel() {
 }
 
 #[test]
-fn compact_rows_drop_small_weights_and_renormalise() {
-    let cage = star(10, false);
-    let (domain, c) = solved(&cage, 400);
-    let compact = c.compact();
-    let n = cage.len();
-    let (lo, hi) = cage.bounds();
-    let size = (hi - lo).length();
-    assert!(compact.len() < domain.positions().len() * n / 2);
-    for v in 0..compact.vertices() {
-        let row = compact.row(v);
-        let sum: f64 = row.iter().map(|e| e.1).sum();
-        assert!((sum - 1.0).abs() < 1e-12);
-        assert!(row.iter().all(|e| e.1 >= 1e-3 / n as f64));
+fn compact_rows_drop_small_weights_and_still_reproduce_exactly() {
+    for (cage, target) in [
+        (star(10, false), 400),
+        (u_shape(), 600),
+        (star(16, true), 900),
+    ] {
+        let (domain, c) = solved(&cage, target);
+        let compact = c.compact();
+        let n = cage.len();
+        let (lo, hi) = cage.bounds();
+        let size = (hi - lo).length();
+        let dense = (0..domain.positions().len())
+            .map(|v| c.row(v).iter().filter(|w| **w > 0.0).count())
+            .sum::<usize>();
+        assert!(compact.len() < dense, "{} of {dense} kept", compact.len());
+        let threshold = 1e-3 / n as f64;
+        let mut small = 0;
+        for v in 0..compact.vertices() {
+            let row = compact.row(v);
+            let sum: f64 = row.iter().map(|e| e.1).sum();
+            assert!((sum - 1.0).abs() < 1e-12, "row {v} sums to {sum}");
+            assert!(row.iter().all(|e| e.1 >= 0.0));
+            // Only weights the solve had are kept.
+            assert!(row.iter().all(|&(i, _)| c.row(v)[i as usize] > 0.0));
+            small += row.iter().filter(|e| e.1 < threshold).count();
+        }
+        // The correction keeps the dropped weights out (a handful of rows where it
+        // cannot keep every weight as solved).
+        assert!(small * 50 < compact.len(), "{small} small weights kept");
+        // Rest is the identity, and affine motions of the cage are reproduced, to
+        // rounding (dropping alone moved vertices by up to 10⁻³ of the cage's size).
+        let affine =
+            |p: DVec2| DVec2::new(1.3 * p.x - 0.4 * p.y + 17.0, 0.2 * p.x + 0.9 * p.y - 3.0);
+        let rotate = |p: DVec2| glam::DMat2::from_angle(0.52) * (p - lo) + DVec2::new(40.0, -7.0);
+        for (name, motion) in [
+            ("rest", &(|p: DVec2| p) as &dyn Fn(DVec2) -> DVec2),
+            ("affine", &affine),
+            ("rotation", &rotate),
+        ] {
+            let pose: Vec<DVec2> = cage.vertices().iter().map(|&p| motion(p)).collect();
+            let moved = compact.deform(&pose).expect("pose fits");
+            let worst = domain
+                .positions()
+                .iter()
+                .zip(&moved)
+                .map(|(p, q)| motion(*p).distance(*q))
+                .fold(0.0, f64::max);
+            assert!(worst < 1e-9 * size, "{name}: off by {worst}");
+        }
+        let pose = cage.vertices().to_vec();
+        assert!(matches!(
+            compact.deform(&pose[1..]),
+            Err(LbcError::BadPose { .. })
+        ));
     }
-    let pose: Vec<DVec2> = cage.vertices().iter().map(|p| *p * 2.0).collect();
-    let moved = compact.deform(&pose).expect("pose fits");
-    for (p, q) in domain.positions().iter().zip(&moved) {
-        // Within the dropped weight (≤ 10⁻³ in all) times the pose's size.
-        assert!((*p * 2.0).distance(*q) < 2e-3 * 2.0 * size);
+}
+
+#[test]
+fn a_mesh_that_reaches_beyond_the_cage_is_refused() {
+    // A grid over [−1, 4] × [0, 2]: a column of vertices on each side of the square.
+    let mut positions = Vec::new();
+    for y in 0..3 {
+        for x in -1..5 {
+            positions.push(DVec2::new(x as f64, y as f64));
+        }
     }
-    assert!(matches!(
-        compact.deform(&pose[1..]),
-        Err(LbcError::BadPose { .. })
-    ));
+    let mut triangles = Vec::new();
+    for y in 0..2u32 {
+        for x in 0..5u32 {
+            let a = y * 6 + x;
+            triangles.push([a, a + 1, a + 7]);
+            triangles.push([a, a + 7, a + 6]);
+        }
+    }
+    let err = Domain::from_mesh(&square(), positions, triangles).expect_err("outside");
+    assert!(
+        matches!(err, LbcError::OutsideCage { vertex: 0, .. }),
+        "{err}"
+    );
+    assert!(err.to_string().contains("outside the cage"), "{err}");
+    // A triangle across the notch of a U whose corners all lie on the cage.
+    let u = u_shape();
+    let positions = vec![
+        DVec2::new(3.0, 3.0),
+        DVec2::new(7.0, 3.0),
+        DVec2::new(7.0, 10.0),
+        DVec2::new(3.0, 10.0),
+    ];
+    let err = Domain::from_mesh(&u, positions, vec![[0, 1, 2], [0, 2, 3]]).expect_err("notch");
+    assert!(matches!(err, LbcError::OutsideCage { .. }), "{err}");
 }
 
 #[test]

@@ -432,7 +432,7 @@ impl Outline {
 ///
 /// Works on runs of equal pixels along rows, joined with a union-find where they touch
 /// a run of the row above.
-fn label_components(
+pub(crate) fn label_components(
     mask: &[bool],
     w: usize,
     h: usize,
@@ -517,7 +517,7 @@ fn label_components(
 }
 
 /// Dilates the mask with a `(2r+1)²` square, clipped to the image.
-fn dilate(mask: &mut [bool], w: usize, h: usize, r: usize) {
+pub(crate) fn dilate(mask: &mut [bool], w: usize, h: usize, r: usize) {
     // Rows: a sliding count of inside pixels in [x - r, x + r].
     let mut tmp = vec![false; w];
     for row in mask.chunks_exact_mut(w) {
@@ -569,7 +569,7 @@ fn dilate(mask: &mut [bool], w: usize, h: usize, r: usize) {
 /// Blocks are visited from the last (bottom right) to the first, and the blocks around
 /// every pixel a fix sets are checked again before going on; the order matters (a fix
 /// can turn a later diagonal block into a three-pixel one), so it is kept fixed.
-fn make_well_composed(mask: &mut [bool], w: usize, h: usize) {
+pub(crate) fn make_well_composed(mask: &mut [bool], w: usize, h: usize) {
     if w < 2 || h < 2 {
         return;
     }

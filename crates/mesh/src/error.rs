@@ -72,6 +72,10 @@ pub enum MeshError {
         y: f64,
     },
 
+    /// An option out of its range (the message says which and why).
+    #[error("{0}")]
+    InvalidOption(String),
+
     /// A hand-made [`Domain`](crate::Domain) is unusable (too few ring vertices,
     /// intersecting rings, ...).
     #[error("invalid domain: {0}")]

@@ -48,6 +48,7 @@
 
 mod cover;
 mod domain;
+mod enclose;
 mod error;
 mod geometry;
 mod mesh;
@@ -57,6 +58,7 @@ mod trace;
 mod triangulate;
 
 pub use domain::{Domain, DomainOptions, Polygon, domain_for_density, domain_from_image};
+pub use enclose::{Enclosure, enclosing_ring};
 pub use error::MeshError;
 pub use mesh::Mesh;
 pub use triangulate::{

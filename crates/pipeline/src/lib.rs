@@ -131,6 +131,44 @@ pub fn load_obj(path: &Path) -> Result<Mesh> {
     Ok(mesh)
 }
 
+/// An error with its causes on one line, as a user reads it: `message: cause: …`, each
+/// cause once. A cause whose text the line already holds is left out (an error that
+/// prints its source, such as an I/O error naming the file, would otherwise say it
+/// twice: "Is a directory (os error 21): Is a directory (os error 21)").
+///
+/// ```
+/// let io = std::io::Error::other("disk full");
+/// let e = anyhow::Error::new(io).context("cannot write out.png: disk full");
+/// assert_eq!(pipeline::error_line(&e), "cannot write out.png: disk full");
+/// let e = anyhow::anyhow!("bad value").context("rig file a.json");
+/// assert_eq!(pipeline::error_line(&e), "rig file a.json: bad value");
+/// ```
+pub fn error_line(error: &anyhow::Error) -> String {
+    let mut line = String::new();
+    for cause in error.chain() {
+        let text = cause.to_string();
+        if text.is_empty() || line.contains(&text) {
+            continue;
+        }
+        if !line.is_empty() {
+            line.push_str(": ");
+        }
+        line.push_str(&text);
+    }
+    line
+}
+
+/// `path` relative to `folder` when it lies inside it, else absolute: how a rig file
+/// names its picture, relative to the rig's own folder.
+pub fn relative_path(path: &Path, folder: &Path) -> std::path::PathBuf {
+    let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+    let (path, folder) = (absolute(path), absolute(folder));
+    match path.strip_prefix(&folder) {
+        Ok(relative) => relative.to_path_buf(),
+        Err(_) => path,
+    }
+}
+
 /// Target vertex count of the mesh when neither the project nor the command says.
 pub const DEFAULT_DENSITY: usize = 20_000;
 

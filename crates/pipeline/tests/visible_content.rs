@@ -308,3 +308,68 @@ fn a_thin_tail_and_a_dot_survive_an_identity_render() {
 fn a_checkerboard_survives_an_identity_render() {
     identity_keeps_every_visible_pixel("checkerboard", &checkerboard());
 }
+
+/// Whether the pixel square of `(x, y)` lies inside the cage or on it (every corner).
+fn enclosed(cage: &lbc::Cage, ring: &[DVec2], x: u32, y: u32) -> bool {
+    let n = ring.len();
+    let on_edge = |p: DVec2| {
+        (0..n).any(|i| {
+            let (a, b) = (ring[i], ring[(i + 1) % n]);
+            let ab = b - a;
+            let t = ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0);
+            (a + t * ab).distance(p) < 1e-9
+        })
+    };
+    [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)]
+        .into_iter()
+        .map(|(dx, dy)| DVec2::new(f64::from(x) + dx, f64::from(y) + dy))
+        .all(|p| cage.contains(p) || on_edge(p))
+}
+
+/// A cage from the outline encloses every visible pixel whole, as a simple polygon of
+/// the vertices asked for, for every count from 8 to 64 (`step` apart).
+fn outline_cage_encloses(name: &str, img: &RgbaImage, step: usize) {
+    let visible: Vec<(u32, u32)> = img
+        .enumerate_pixels()
+        .filter(|(_, _, p)| p.0[3] > 0)
+        .map(|(x, y, _)| (x, y))
+        .collect();
+    let (w, h) = img.dimensions();
+    let offset = (0.01 * f64::from(w).hypot(f64::from(h))).clamp(3.0, 20.0);
+    for n in (8..=64).step_by(step) {
+        let ring = pipeline::cage::cage_from_outline(img, n, offset)
+            .unwrap_or_else(|e| panic!("{name}, {n} vertices: {e:#}"));
+        assert_eq!(ring.len(), n, "{name}: {n} vertices asked for");
+        let cage =
+            lbc::Cage::new(ring.clone()).unwrap_or_else(|e| panic!("{name}, {n} vertices: {e}"));
+        let left_out: Vec<_> = visible
+            .iter()
+            .filter(|&&(x, y)| !enclosed(&cage, &ring, x, y))
+            .collect();
+        assert!(
+            left_out.is_empty(),
+            "{name}, {n} vertices: {} visible pixels outside the cage, first {:?}",
+            left_out.len(),
+            left_out[0]
+        );
+    }
+}
+
+#[test]
+fn an_outline_cage_encloses_every_visible_pixel() {
+    outline_cage_encloses("800 specks", &specks(300, 220, 800, 7), 1);
+    outline_cage_encloses("hair", &hair(320, 240, 12, 5), 1);
+    outline_cage_encloses("tail and dot", &tail_and_dot(), 1);
+    outline_cage_encloses("text", &text(400, 260, 3), 3);
+    outline_cage_encloses("single pixel", &single_pixel(), 7);
+    outline_cage_encloses("faint pixels", &faint(13), 3);
+}
+
+#[test]
+fn an_outline_cage_encloses_every_cut_out_in_assets() {
+    let assets = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets");
+    for name in ["lizard.png", "giraffe.png", "spider.png"] {
+        let img = image::open(assets.join(name)).unwrap().to_rgba8();
+        outline_cage_encloses(name, &img, 4);
+    }
+}

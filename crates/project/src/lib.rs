@@ -35,7 +35,7 @@ pub const VERSION: u32 = 1;
 pub const MAX_HANDLES: usize = 10_000;
 
 /// Which distance the weights use.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Default)]
 #[serde(rename_all = "lowercase")]
 pub enum MetricChoice {
     /// Euclidean for an opaque (rectangular) image, intrinsic for a cut-out.
@@ -48,7 +48,7 @@ pub enum MetricChoice {
 }
 
 /// Which published method warps the picture.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Default)]
 #[serde(rename_all = "lowercase")]
 pub enum Method {
     /// The closed-form C² weights of Xian, Jin and Wang, with virtual handles.
@@ -121,7 +121,7 @@ pub struct CageSpec {
 }
 
 /// The locality weighting `τ` of local barycentric coordinates (the paper's eq. 12).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Default)]
 #[serde(rename_all = "lowercase")]
 pub enum Tau {
     /// `τ(x) = x²`, the paper's choice.
@@ -161,7 +161,7 @@ pub const MAX_RIGIDITY: f64 = 1e8;
 pub const MAX_STROKE_POINTS: usize = 100_000;
 
 /// Placement of the basis's middle Bézier controls (degrees above 5).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Default)]
 #[serde(rename_all = "lowercase")]
 pub enum Middle {
     /// All 0.5.
@@ -172,7 +172,7 @@ pub enum Middle {
 }
 
 /// How Algorithm 1 places virtual handles.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum Placement {
     /// The paper's loop: one virtual handle at a time, in the worst cell.
@@ -182,6 +182,62 @@ pub enum Placement {
     /// mirror-symmetric virtual handles.
     Symmetric,
 }
+
+/// Reads a unit enum from its name in a rig file; any other value is answered with
+/// the names that would do (`expected a method: "c2", "arap" or "lbc"`).
+macro_rules! deserialize_by_name {
+    ($ty:ident, $what:literal, [$($name:literal => $value:expr),+ $(,)?]) => {
+        impl<'de> Deserialize<'de> for $ty {
+            fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+                struct Names;
+                impl serde::de::Visitor<'_> for Names {
+                    type Value = $ty;
+                    fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                        let names = [$(concat!("\"", $name, "\"")),+];
+                        let (last, rest) = names.split_last().unwrap_or((&"", &[]));
+                        if rest.is_empty() {
+                            write!(f, "{} {last}", $what)
+                        } else {
+                            write!(f, "{}: {} or {last}", $what, rest.join(", "))
+                        }
+                    }
+                    fn visit_str<E: serde::de::Error>(self, s: &str) -> Result<$ty, E> {
+                        match s {
+                            $($name => Ok($value),)+
+                            _ => Err(E::invalid_value(serde::de::Unexpected::Str(s), &self)),
+                        }
+                    }
+                }
+                d.deserialize_str(Names)
+            }
+        }
+    };
+}
+
+deserialize_by_name!(MetricChoice, "a metric", [
+    "auto" => MetricChoice::Auto,
+    "euclidean" => MetricChoice::Euclidean,
+    "intrinsic" => MetricChoice::Intrinsic,
+]);
+deserialize_by_name!(Method, "a method", [
+    "c2" => Method::C2,
+    "arap" => Method::Arap,
+    "lbc" => Method::Lbc,
+]);
+deserialize_by_name!(Tau, "a locality weighting τ", [
+    "square" => Tau::Square,
+    "linear" => Tau::Linear,
+    "constant" => Tau::Constant,
+    "sqrt" => Tau::Sqrt,
+]);
+deserialize_by_name!(Middle, "middle controls", [
+    "half" => Middle::Half,
+    "linear" => Middle::Linear,
+]);
+deserialize_by_name!(Placement, "a placement", [
+    "as_written" => Placement::AsWritten,
+    "symmetric" => Placement::Symmetric,
+]);
 
 fn is_as_written(placement: &Placement) -> bool {
     *placement == Placement::AsWritten
@@ -367,9 +423,18 @@ pub enum ProjectError {
     /// Not JSON, or not the expected fields.
     #[error("malformed rig file: {0}")]
     Json(#[from] serde_json::Error),
+    /// A field of the wrong type or with an unknown value (`path`: where, as
+    /// `handles[2].rest`).
+    #[error("malformed rig file: {}{source}", field_prefix(path))]
+    Field {
+        /// Where in the file.
+        path: String,
+        /// What is wrong there.
+        source: serde_json::Error,
+    },
     /// A version this build does not read.
     #[error("unsupported rig file version {0} (this build reads version {VERSION})")]
-    Version(u32),
+    Version(u64),
     /// A value out of range.
     #[error("invalid rig: {0}")]
     Invalid(String),
@@ -380,6 +445,15 @@ pub enum ProjectError {
         max = DENSITY_RANGE.end()
     )]
     Density(usize),
+}
+
+/// `"path: "` for a field's path, nothing for the whole file.
+fn field_prefix(path: &str) -> String {
+    if path.is_empty() || path == "." {
+        String::new()
+    } else {
+        format!("{path}: ")
+    }
 }
 
 impl Project {
@@ -393,17 +467,43 @@ impl Project {
         // use for it.
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         // Read the version first so a future file gets a clear message.
-        #[derive(Deserialize)]
-        struct Probe {
-            version: Option<u32>,
-        }
-        let probe: Probe = serde_json::from_str(text)?;
-        match probe.version {
-            Some(VERSION) => {}
-            Some(v) => return Err(ProjectError::Version(v)),
+        let value: serde_json::Value = serde_json::from_str(text)?;
+        let Some(object) = value.as_object() else {
+            let kind = match value {
+                serde_json::Value::Null => "null",
+                serde_json::Value::Bool(_) => "true or false",
+                serde_json::Value::Number(_) => "a number",
+                serde_json::Value::String(_) => "a string",
+                serde_json::Value::Array(_) => "a list",
+                serde_json::Value::Object(_) => "an object",
+            };
+            return Err(ProjectError::Invalid(format!(
+                "a rig file is one JSON object ({{\"version\": {VERSION}, \"handles\": [\u{2026}], \
+                 \u{2026}}}), not {kind}"
+            )));
+        };
+        match object.get("version") {
             None => return Err(ProjectError::Invalid("missing \"version\"".into())),
+            Some(v) => match v.as_u64() {
+                Some(v) if v == u64::from(VERSION) => {}
+                Some(v) => return Err(ProjectError::Version(v)),
+                None => {
+                    return Err(ProjectError::Invalid(format!(
+                        "\"version\" must be a whole number ({VERSION}), not {v}"
+                    )));
+                }
+            },
         }
-        let project: Self = serde_json::from_str(text)?;
+        // Deserialised from the text (not the value) so that errors keep their line
+        // and column, and with the path of the field at fault.
+        let mut deserializer = serde_json::Deserializer::from_str(text);
+        let project: Self = serde_path_to_error::deserialize(&mut deserializer).map_err(|e| {
+            let path = e.path().to_string();
+            ProjectError::Field {
+                path,
+                source: e.into_inner(),
+            }
+        })?;
         project.validate(None)?;
         Ok(project)
     }
@@ -719,7 +819,21 @@ mod tests {
             (r#"{"version":1,"alpha":2,"handles":[]}"#, "alpha"),
             (
                 r#"{"version":1,"placement":"greedy","handles":[]}"#,
-                "unknown variant",
+                r#"placement: invalid value: string "greedy", expected a placement: "as_written" or "symmetric""#,
+            ),
+            ("null", "a rig file is one JSON object"),
+            ("[1, 2]", "not a list"),
+            (
+                r#"{"version":"1","handles":[]}"#,
+                "\"version\" must be a whole number",
+            ),
+            (
+                r#"{"version":1,"handles":[],"method":2}"#,
+                r#"method: invalid type: integer `2`, expected a method: "c2", "arap" or "lbc""#,
+            ),
+            (
+                r#"{"version":1,"handles":[{"type":"point","rest":[1,"x"]}]}"#,
+                "handles[0]: invalid type: string \"x\", expected f64",
             ),
             (r#"{"version":1,"degree":3,"handles":[]}"#, "degree"),
             (
@@ -763,7 +877,7 @@ mod tests {
             ),
             (
                 r#"{"version":1,"method":"c3","handles":[]}"#,
-                "unknown variant `c3`",
+                r#"invalid value: string "c3", expected a method"#,
             ),
             (
                 r#"{"version":1,"handles":[],"rigidity":[{"stroke":[[1,NaN]],"radius":2,"weight":3}]}"#,
@@ -807,7 +921,7 @@ mod tests {
             ),
             (
                 r#"{"version":1,"handles":[],"lbc":{"tau":"cubic"}}"#,
-                "unknown variant `cubic`",
+                r#"lbc.tau: invalid value: string "cubic", expected a locality weighting τ: "square", "linear", "constant" or "sqrt""#,
             ),
             (
                 r#"{"version":1,"handles":[],"lbc":{"density":3}}"#,

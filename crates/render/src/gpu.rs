@@ -302,7 +302,8 @@ impl GpuContext {
 
     /// Draws `mesh` textured with `texture` into a `width × height` image, like
     /// [`crate::warp_cpu`]: premultiplied bilinear sampling clamped to the edge, later
-    /// triangles drawn over earlier ones, uncovered pixels transparent.
+    /// triangles composited over earlier ones ("over" in premultiplied alpha),
+    /// uncovered pixels transparent.
     ///
     /// # Errors
     /// An invalid mesh, an empty texture, or a size the device cannot hold.
@@ -557,8 +558,9 @@ impl GpuContext {
     }
 }
 
-/// A render pipeline drawing into an RGBA8 target with no blending, vertex attributes
-/// `attributes` in one interleaved buffer.
+/// A render pipeline drawing into an RGBA8 target, each (premultiplied) fragment
+/// composited over what is there, vertex attributes `attributes` in one interleaved
+/// buffer.
 fn make_pipeline(
     device: &wgpu::Device,
     module: &wgpu::ShaderModule,
@@ -606,7 +608,7 @@ fn make_pipeline(
             compilation_options: Default::default(),
             targets: &[Some(wgpu::ColorTargetState {
                 format: FORMAT,
-                blend: None,
+                blend: Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
                 write_mask: wgpu::ColorWrites::ALL,
             })],
         }),

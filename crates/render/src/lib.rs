@@ -25,6 +25,7 @@
 #![warn(missing_docs)]
 
 mod atomic;
+mod composite;
 mod error;
 mod files;
 mod gpu;
@@ -38,6 +39,7 @@ mod view;
 mod warp;
 
 pub use atomic::{PngPixels, save_png_atomic, write_atomic, write_png};
+pub use composite::{over, over16};
 pub use error::RenderError;
 pub use files::{open_regular_file, read_regular_file};
 pub use gpu::{Affine, GpuContext, SkinnedMesh};
@@ -45,4 +47,4 @@ pub use image_io::{ImageLimits, decode_image, decode_picture, load_image, load_p
 pub use mesh::WarpMesh;
 pub use picture::{Picture, Rgba16Image};
 pub use view::{MeshView, Overlay, ViewParams};
-pub use warp::{RasterOptions, coverage_counts, warp_cpu, warp_picture};
+pub use warp::{RasterOptions, coverage_counts, warp_cpu, warp_over, warp_picture};

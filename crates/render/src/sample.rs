@@ -48,6 +48,9 @@ pub(crate) trait Texel: Copy + Default + PartialEq + Send + Sync + 'static {
     /// Weighted premultiplied average of four texels whose weights sum to
     /// `WEIGHT_ONE²`.
     fn blend(taps: &[([Self; 4], u64); 4]) -> [Self; 4];
+
+    /// `top` composited over `base` (straight alpha; see [`crate::over`]).
+    fn over(top: [Self; 4], base: [Self; 4]) -> [Self; 4];
 }
 
 impl Texel for u8 {
@@ -55,12 +58,22 @@ impl Texel for u8 {
     fn blend(taps: &[([u8; 4], u64); 4]) -> [u8; 4] {
         blend(taps)
     }
+
+    #[inline]
+    fn over(top: [u8; 4], base: [u8; 4]) -> [u8; 4] {
+        crate::composite::over(top, base)
+    }
 }
 
 impl Texel for u16 {
     #[inline]
     fn blend(taps: &[([u16; 4], u64); 4]) -> [u16; 4] {
         blend16(taps)
+    }
+
+    #[inline]
+    fn over(top: [u16; 4], base: [u16; 4]) -> [u16; 4] {
+        crate::composite::over16(top, base)
     }
 }
 

@@ -54,10 +54,15 @@ fn alloc<T: Clone + Default + Send>(
 ///
 /// * Fold-overs (triangles whose deformed winding is flipped) are drawn like
 ///   any other triangle.
-/// * Where triangles overlap, **the later triangle in `mesh.triangles` wins**.
+/// * Where triangles overlap, **the later triangle in `mesh.triangles` is in
+///   front**: its sample is composited over what is there ([`crate::over`],
+///   straight alpha), so a half-transparent edge of the part in front shows the part
+///   behind through it rather than a crack. A pixel drawn once gets its sample
+///   exactly.
 /// * Triangles of zero area after snapping are skipped, as are (absurd)
 ///   triangles whose texture mapping overflows `f64`.
-/// * Pixels no triangle covers get `opts.background`.
+/// * Pixels no triangle covers get `opts.background` (the background is not under
+///   the drawn pixels: it fills what nothing covers).
 ///
 /// Work is split into bands of rows drawn in parallel on the rayon pool.
 ///
@@ -128,6 +133,39 @@ pub fn warp_picture(
     }
 }
 
+/// Draws `mesh` textured with `texture` over `target` (8 bits per channel, any size),
+/// as [`warp_cpu`] draws it over transparent pixels: each covered pixel takes the
+/// sample composited over what `target` holds ([`crate::over`]), so where `target` is
+/// transparent it takes the sample exactly, and pixels no triangle covers keep their
+/// value. Used to put a warped layer over a picture without losing what lies under
+/// its transparent parts.
+///
+/// # Errors
+/// As [`warp_cpu`] (without the allocation).
+pub fn warp_over(
+    texture: &RgbaImage,
+    mesh: &WarpMesh,
+    target: &mut RgbaImage,
+) -> Result<(), RenderError> {
+    let (tw, th) = texture.dimensions();
+    check(mesh, tw, th)?;
+    let (width, height) = target.dimensions();
+    draw_texels(texture.as_raw(), tw, th, mesh, target, width, height);
+    Ok(())
+}
+
+/// Refuses an invalid mesh or an empty texture.
+fn check(mesh: &WarpMesh, tw: u32, th: u32) -> Result<(), RenderError> {
+    mesh.validate()?;
+    if tw == 0 || th == 0 {
+        return Err(RenderError::EmptyTexture {
+            width: tw,
+            height: th,
+        });
+    }
+    Ok(())
+}
+
 /// The work of [`warp_cpu`] on row-major RGBA texels of either depth.
 fn warp_texels<C: Texel>(
     texels: &[C],
@@ -138,27 +176,51 @@ fn warp_texels<C: Texel>(
     height: u32,
     background: [C; 4],
 ) -> Result<Vec<C>, RenderError> {
-    mesh.validate()?;
-    if tw == 0 || th == 0 {
-        return Err(RenderError::EmptyTexture {
-            width: tw,
-            height: th,
-        });
-    }
+    check(mesh, tw, th)?;
     let mut pixels = alloc::<C>(width, height, 4)?;
+    draw_texels(texels, tw, th, mesh, &mut pixels, width, height);
+    if background != [C::default(); 4] {
+        // What no triangle covers takes the background (a second scan, for coverage
+        // alone: a background other than transparent is rare).
+        let mut covered = alloc::<u8>(width, height, 1)?;
+        Raster::new(mesh, width, height).scan(
+            &mut covered,
+            1,
+            |_| {},
+            |_, _, columns, row| row[columns.start as usize..columns.end as usize].fill(1),
+        );
+        for (px, &drawn) in pixels.chunks_exact_mut(4).zip(&covered) {
+            if drawn == 0 {
+                px.copy_from_slice(&background);
+            }
+        }
+    }
+    Ok(pixels)
+}
+
+/// Draws a checked `mesh` over `pixels` (row-major RGBA, `width × height`), each
+/// sample composited over what the pixel holds.
+fn draw_texels<C: Texel>(
+    texels: &[C],
+    tw: u32,
+    th: u32,
+    mesh: &WarpMesh,
+    pixels: &mut [C],
+    width: u32,
+    height: u32,
+) {
     let raster = Raster::new(mesh, width, height);
     let texture = Texture::new(texels, tw, th);
-    let clear = background == [C::default(); 4];
+    // Each sample goes over what the pixel holds: a pixel drawn once over a
+    // transparent one takes its sample exactly.
+    let put = |px: &mut [C], sample: [C; 4]| {
+        let base = [px[0], px[1], px[2], px[3]];
+        px.copy_from_slice(&C::over(sample, base));
+    };
     raster.scan(
-        &mut pixels,
+        pixels,
         4,
-        |band| {
-            if !clear {
-                for px in band.chunks_exact_mut(4) {
-                    px.copy_from_slice(&background);
-                }
-            }
-        },
+        |_| {},
         |setup, y, columns, row| {
             let map = &setup.map;
             let [u0, v0] = map.row_start(f64::from(y) + 0.5);
@@ -178,19 +240,18 @@ fn warp_texels<C: Texel>(
                 let (mut u, mut v) = (to_fixed(first.0), to_fixed(first.1));
                 let (du, dv) = (step_to_fixed(du_dx), step_to_fixed(dv_dx));
                 for px in out.chunks_exact_mut(4) {
-                    px.copy_from_slice(&texture.sample_fixed(u, v));
+                    put(px, texture.sample_fixed(u, v));
                     u = u.wrapping_add(du);
                     v = v.wrapping_add(dv);
                 }
             } else {
                 for (px, x) in out.chunks_exact_mut(4).zip(columns) {
                     let (u, v) = at(x);
-                    px.copy_from_slice(&texture.sample_fixed(to_fixed(u), to_fixed(v)));
+                    put(px, texture.sample_fixed(to_fixed(u), to_fixed(v)));
                 }
             }
         },
     );
-    Ok(pixels)
 }
 
 /// How many triangles of `mesh` cover each pixel of a `width × height`

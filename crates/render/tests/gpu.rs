@@ -77,6 +77,33 @@ fn gpu_identity_of_an_opaque_image_is_exact() {
 }
 
 #[test]
+fn gpu_composites_overlapping_parts_as_the_cpu_does() {
+    let gpu = GpuContext::new().expect("a wgpu adapter (run scripts/setup.sh for lavapipe)");
+    let (s, shift) = (48, 40.0);
+    let (texture, rest, deformed, triangles) = support::overlapping_parts(s, shift);
+    let mesh = WarpMesh {
+        rest: &rest,
+        deformed: &deformed,
+        triangles: &triangles,
+    };
+    let out = gpu.warp(&texture, &mesh, 2 * s, s).expect("gpu");
+    let cracks = support::cracks(&out, s, shift);
+    assert!(
+        cracks.is_empty(),
+        "{} pixels lost alpha: {:?}",
+        cracks.len(),
+        &cracks[..cracks.len().min(8)]
+    );
+    let cpu = warp_cpu(&texture, &mesh, 2 * s, s, &RasterOptions::default()).expect("cpu");
+    let (share, worst) = compare(&cpu, &out, 3);
+    assert!(
+        share < 0.01,
+        "{:.3}% of channels differ by more than 3 (largest {worst})",
+        share * 100.0
+    );
+}
+
+#[test]
 fn gpu_refuses_bad_input() {
     let gpu = GpuContext::new().expect("a wgpu adapter (run scripts/setup.sh for lavapipe)");
     let texture = gradient_texture(16);

@@ -584,3 +584,81 @@ fn sixteen_bit_pictures_warp_in_sixteen_bits() {
         }
     }
 }
+
+#[test]
+fn overlapping_opaque_parts_keep_their_alpha() {
+    // The part in front has a transparent margin and an anti-aliased rim: drawn over
+    // the part behind, they must let it show through, not cut a crack into it.
+    let (s, shift) = (48, 40.0);
+    let (texture, rest, deformed, triangles) = support::overlapping_parts(s, shift);
+    let out = warp(&texture, &rest, &deformed, &triangles, (2 * s, s), [0; 4]);
+    let cracks = support::cracks(&out, s, shift);
+    assert!(
+        cracks.is_empty(),
+        "{} pixels lost alpha: {:?}",
+        cracks.len(),
+        &cracks[..cracks.len().min(8)]
+    );
+    // Where the front disc's rim lies over the back disc, both colours mix.
+    let rim = out
+        .enumerate_pixels()
+        .filter(|(_, _, p)| p[0] > 40 && p[2] > 60 && p[3] == 255)
+        .count();
+    assert!(
+        rim > 0,
+        "the front disc's rim shows the back disc through it"
+    );
+    // Where nothing overlaps, the picture is drawn as before: the left disc alone,
+    // away from the other, is exactly its texels.
+    assert_eq!(out.get_pixel(4, s / 2), texture.get_pixel(4, s / 2));
+    assert_eq!(out.get_pixel(s / 4, s / 2), texture.get_pixel(s / 4, s / 2));
+}
+
+#[test]
+fn a_background_fills_only_what_nothing_covers() {
+    let (s, shift) = (32, 20.0);
+    let (texture, rest, deformed, triangles) = support::overlapping_parts(s, shift);
+    let background = [9, 8, 7, 6];
+    let out = warp(
+        &texture,
+        &rest,
+        &deformed,
+        &triangles,
+        (2 * s, s),
+        background,
+    );
+    // The right part moved left: its old place at the right edge is uncovered.
+    assert_eq!(out.get_pixel(2 * s - 1, 0).0, background);
+    // A transparent texel of the mesh keeps its own value, not the background.
+    assert_eq!(out.get_pixel(0, 0), texture.get_pixel(0, 0));
+    assert!(support::cracks(&out, s, shift).is_empty());
+}
+
+#[test]
+fn warp_over_keeps_what_it_does_not_cover_and_composites_the_rest() {
+    let (s, shift) = (32, 20.0);
+    let (texture, rest, deformed, triangles) = support::overlapping_parts(s, shift);
+    let mesh = WarpMesh {
+        rest: &rest,
+        deformed: &deformed,
+        triangles: &triangles,
+    };
+    let alone = warp(&texture, &rest, &deformed, &triangles, (2 * s, s), [0; 4]);
+    // Over a transparent picture whose colours differ: the same as drawing alone where
+    // drawn, the picture's own pixels where not.
+    let mut target = RgbaImage::from_fn(2 * s, s, |x, y| Rgba([x as u8, y as u8, 7, 0]));
+    let before = target.clone();
+    render::warp_over(&texture, &mesh, &mut target).expect("warp");
+    let counts = coverage_counts(&mesh, 2 * s, s).expect("coverage");
+    for (i, (x, y, p)) in target.enumerate_pixels().enumerate() {
+        if counts[i] == 0 {
+            assert_eq!(p, before.get_pixel(x, y));
+        } else {
+            assert_eq!(p, alone.get_pixel(x, y));
+        }
+    }
+    // Over an opaque picture, everything stays opaque.
+    let mut opaque = RgbaImage::from_pixel(2 * s, s, Rgba([9, 9, 9, 255]));
+    render::warp_over(&texture, &mesh, &mut opaque).expect("warp");
+    assert!(opaque.pixels().all(|p| p[3] == 255));
+}

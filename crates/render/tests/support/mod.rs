@@ -173,3 +173,66 @@ pub fn gradient_texture(size: u32) -> RgbaImage {
         ])
     })
 }
+
+/// Two cut-out parts side by side, for overlap tests: a `2s × s` texture whose halves
+/// each hold an opaque disc of radius `0.35·s` with an anti-aliased rim (alpha falls
+/// from 255 to 0 over two pixels) on transparent ground, and a mesh of each half (a
+/// grid over it, as a picture's mesh covers a cut-out with some margin). The right
+/// half's mesh is drawn after the left's, shifted left by `shift` pixels so the two
+/// discs overlap: `(texture, rest, deformed, triangles)`.
+pub fn overlapping_parts(s: u32, shift: f32) -> (RgbaImage, Vec<Vec2>, Vec<Vec2>, Vec<[u32; 3]>) {
+    let r = 0.35 * s as f32;
+    let texture = RgbaImage::from_fn(2 * s, s, |x, y| {
+        let half = x / s;
+        let centre = Vec2::new(half as f32 * s as f32 + 0.5 * s as f32, 0.5 * s as f32);
+        let d = (Vec2::new(x as f32 + 0.5, y as f32 + 0.5) - centre).length();
+        let alpha = ((r - d) / 2.0 + 0.5).clamp(0.0, 1.0);
+        let colour = if half == 0 {
+            [200, 40, 30]
+        } else {
+            [30, 60, 210]
+        };
+        image::Rgba([
+            colour[0],
+            colour[1],
+            colour[2],
+            (alpha * 255.0).round() as u8,
+        ])
+    });
+    let mut rest = Vec::new();
+    let mut deformed = Vec::new();
+    let mut triangles = Vec::new();
+    for half in 0..2 {
+        let mut grid = Grid::new(s as f32, s as f32, 7, 7);
+        let first = rest.len() as u32;
+        let offset = Vec2::new(half as f32 * s as f32, 0.0);
+        let moved = if half == 1 { shift } else { 0.0 };
+        rest.extend(grid.positions.iter().map(|&p| p + offset));
+        deformed.extend(
+            grid.positions
+                .iter()
+                .map(|&p| p + offset - Vec2::new(moved, 0.0)),
+        );
+        triangles.extend(grid.triangles.drain(..).map(|t| t.map(|v| v + first)));
+    }
+    (texture, rest, deformed, triangles)
+}
+
+/// Pixels of `out` that lie well inside either disc of [`overlapping_parts`] where it
+/// was drawn (at least two pixels in from the rim, so its alpha was 255) and have lost
+/// alpha: the cracks a front part's transparent edge would cut into the part behind.
+pub fn cracks(out: &RgbaImage, s: u32, shift: f32) -> Vec<(u32, u32, u8)> {
+    let r = 0.35 * s as f32 - 2.0;
+    let centres = [
+        Vec2::new(0.5 * s as f32, 0.5 * s as f32),
+        Vec2::new(1.5 * s as f32 - shift, 0.5 * s as f32),
+    ];
+    let mut found = Vec::new();
+    for (x, y, p) in out.enumerate_pixels() {
+        let c = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+        if centres.iter().any(|&o| (c - o).length() < r) && p[3] < 255 {
+            found.push((x, y, p[3]));
+        }
+    }
+    found
+}
