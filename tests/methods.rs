@@ -231,7 +231,7 @@ fn bad_method_fields_give_one_clear_line_and_keep_the_old_output() {
         ),
         (
             r#""rigidity":[{"stroke":[[1,1]],"radius":2,"weight":0}]"#,
-            "weight must be positive",
+            "weight must be between 0.001 and 1e8",
         ),
     ];
     for (i, (field, expected)) in cases.into_iter().enumerate() {

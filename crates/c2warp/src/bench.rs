@@ -8,7 +8,7 @@ use serde::Serialize;
 use weights_core::Handle;
 
 use crate::{Source, export};
-use pipeline::{ArapRig, Deformer, Method, load_project};
+use pipeline::{ArapOptions, ArapRig, Deformer, Method, load_project};
 
 #[derive(Serialize)]
 struct Phases {
@@ -71,9 +71,14 @@ struct ArapReport {
     samples: usize,
     triangles: usize,
     real_handles: usize,
+    /// Vertices of the mesh ARAP solves on (its own mesh of the picture, or the given
+    /// mesh).
+    arap_vertices: usize,
+    /// What each handle holds, pixels (0: its nearest vertex).
+    pin_radius: f64,
     /// Vertices the handles pin.
     pinned_vertices: usize,
-    /// Registration (once per mesh), ms.
+    /// Registration (once per mesh; ARAP's meshing of the picture included), ms.
     registration_ms: f64,
     /// Median compilation (factorising both steps' systems), ms.
     compile_ms_median: f64,
@@ -99,16 +104,30 @@ pub fn run(
     }
     let built = export::build(source, &project, &|_| {})?;
     match method {
-        Method::Arap => arap(built.rig, &project, positions),
+        Method::Arap => arap(built.rig, built.picture.as_ref(), &project, positions),
         _ => c2(built.rig, positions),
     }
 }
 
-/// Times ARAP on the rig's mesh and handles: registration once, compilation by
-/// dropping and restoring the last handle, updates over `poses` random poses.
-fn arap(rig: weights_core::Rig, project: &project::Project, poses: usize) -> Result<()> {
+/// Times ARAP on the rig's handles (on its own mesh of `picture`, else on the rig's
+/// mesh): registration once, compilation by dropping and restoring the last handle,
+/// updates over `poses` random poses.
+fn arap(
+    rig: weights_core::Rig,
+    picture: Option<&image::RgbaImage>,
+    project: &project::Project,
+    poses: usize,
+) -> Result<()> {
     let handles = rig.handles().to_vec();
-    let mut arap = ArapRig::new(rig.domain().clone(), &handles, &project.rigidity)?;
+    let domain = rig.domain().clone();
+    let strokes = &project.rigidity;
+    let mut arap = match picture {
+        Some(p) => {
+            let options = ArapOptions::for_picture(project, p);
+            ArapRig::with_own_mesh(p, domain, &handles, strokes, options)?
+        }
+        None => ArapRig::new(domain, &handles, strokes, ArapOptions::of(project, None))?,
+    };
     let registration_ms = arap.times().registration_ms;
     let mut compile = vec![arap.times().compile_ms];
     if let Some((_, fewer)) = handles.split_last() {
@@ -158,6 +177,8 @@ fn arap(rig: weights_core::Rig, project: &project::Project, poses: usize) -> Res
         samples: rig.domain().len(),
         triangles: rig.domain().triangles().len(),
         real_handles: handles.len(),
+        arap_vertices: arap.arap_mesh().len(),
+        pin_radius: arap.options().pin_radius,
         pinned_vertices,
         registration_ms,
         compile_ms_median: median(compile),

@@ -15,8 +15,9 @@ use crate::export::{self, Built};
 /// full precision — the file's vertices in its order, then those the command inserted
 /// — and the triangles as `f a b c` (1-based).
 pub fn run(source: &Source, rig_path: &Path, method: Option<Method>, output: &Path) -> Result<()> {
-    let project = load_project(rig_path)?;
+    let mut project = load_project(rig_path)?;
     let method = method.unwrap_or(project.method);
+    project.method = method;
     if method == Method::Lbc {
         let solved = crate::lbc::solve(source, &project)?;
         let deformed = solved.deformed()?;
@@ -24,9 +25,10 @@ pub fn run(source: &Source, rig_path: &Path, method: Option<Method>, output: &Pa
     }
     let progress = crate::progress::Steps::new(3);
     progress.step("meshing and weighting");
-    let Built { rig, .. } = export::build(source, &project, &progress.weighting())?;
+    let Built { rig, picture, .. } = export::build(source, &project, &progress.weighting())?;
     progress.step("deforming");
-    let deformer = pipeline::deformer(method, rig, &project.rigidity)?;
+    // With --mesh, the given mesh is ARAP's own; with --image, ARAP meshes the picture.
+    let deformer = pipeline::deformer(&project, rig, picture.as_ref())?;
     let deformed = deformer.deformed();
     progress.step("writing");
     write_obj(output, method, &deformed, deformer.domain().triangles())?;

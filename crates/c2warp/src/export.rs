@@ -17,6 +17,8 @@ pub struct Built {
     pub rig: Rig,
     /// Vertices the mesh file had; later ones were inserted for handles.
     pub file_vertices: usize,
+    /// The picture meshed (`--image`), for a method that meshes it again its own way.
+    pub picture: Option<image::RgbaImage>,
 }
 
 /// Builds the rig of `project` on the source's samples.
@@ -43,6 +45,7 @@ pub fn build(
         return Ok(Built {
             rig: prepared.rig,
             file_vertices,
+            picture: Some(picture),
         });
     }
     let path = source.mesh.as_deref().context("give --mesh or --image")?;
@@ -104,7 +107,11 @@ pub fn build(
         pipeline::rig_options(project)?,
         progress,
     )?;
-    Ok(Built { rig, file_vertices })
+    Ok(Built {
+        rig,
+        file_vertices,
+        picture: None,
+    })
 }
 
 #[derive(Serialize)]
@@ -145,7 +152,9 @@ pub fn weights(source: &Source, rig_path: &Path, output: &Path) -> Result<()> {
     }
     let progress = crate::progress::Steps::new(2);
     progress.step("meshing and weighting");
-    let Built { rig, file_vertices } = build(source, &project, &progress.weighting())?;
+    let Built {
+        rig, file_vertices, ..
+    } = build(source, &project, &progress.weighting())?;
     progress.step("writing");
     let positions = rig.domain().positions();
     let nodes = rig

@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use egui::{Color32, Mesh, PointerButton, Pos2, Shape, Ui};
 use glam::DVec2;
-use pipeline::method::polyline_distance_squared;
+use pipeline::arap::polyline_distance_squared;
 use project::{Method, RigidityStroke};
 
 use crate::app::EditorApp;
@@ -185,7 +185,7 @@ impl EditorApp {
         if !fresh {
             let key = (mesh, strokes.clone());
             let domain = doc.rig().domain();
-            let weights = pipeline::method::rigidity_weights(domain, strokes);
+            let weights = pipeline::arap::rigidity_weights(domain, strokes);
             let painted = weights
                 .iter()
                 .zip(domain.triangles())

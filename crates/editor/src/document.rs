@@ -276,23 +276,26 @@ impl Document {
     }
 
     /// Brings the method's deformer in line with the rig file: for ARAP, set up (on a
-    /// new mesh, or when first chosen), repainted and posed with the rig's handles; for
-    /// C², none.
+    /// new mesh, when first chosen or with new settings), repainted and posed with the
+    /// rig's handles; for C², none.
     fn sync_method(&mut self) -> Result<()> {
         if self.project.method != Method::Arap {
             self.arap = None;
             return Ok(());
         }
+        let options = pipeline::ArapOptions::for_picture(&self.project, &self.image);
         match &mut self.arap {
-            Some((mesh, arap)) if *mesh == self.mesh_version => {
+            Some((mesh, arap)) if *mesh == self.mesh_version && arap.options() == options => {
                 arap.set_rigidity(&self.project.rigidity)?;
                 arap.set_handles(self.rig.handles())?;
             }
             _ => {
-                let arap = ArapRig::new(
+                let arap = ArapRig::with_own_mesh(
+                    &self.image,
                     self.rig.domain().clone(),
                     self.rig.handles(),
                     &self.project.rigidity,
+                    options,
                 )?;
                 self.arap = Some((self.mesh_version, arap));
             }

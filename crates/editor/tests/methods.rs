@@ -8,7 +8,6 @@ use egui::{Key, Modifiers};
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use glam::DVec2;
-use pipeline::{ArapRig, Deformer};
 use project::Method;
 
 use editor::{EditorApp, Tool};
@@ -41,7 +40,8 @@ fn switching_methods_keeps_the_pose_and_comes_back_and_undoes() {
     let times = doc.arap_times().expect("ARAP is set up");
     assert!(times.compile_ms > 0.0);
     // The editor's ARAP is the method's own answer for the rig's mesh and handles.
-    let own = ArapRig::new(doc.rig().domain().clone(), doc.rig().handles(), &[])
+    let project = doc.project();
+    let own = pipeline::deformer(project, doc.rig().clone(), Some(&doc.image))
         .expect("ARAP")
         .deformed();
     assert_eq!(positions(&h), own);
@@ -344,7 +344,7 @@ fn painted_rigidity_survives_a_new_density() {
     assert_eq!(doc.project().rigidity.len(), 1);
     // The overlay shows the triangles painted on the new mesh.
     let domain = doc.rig().domain();
-    let fresh: Vec<[u32; 3]> = pipeline::method::rigidity_weights(domain, &doc.project().rigidity)
+    let fresh: Vec<[u32; 3]> = pipeline::arap::rigidity_weights(domain, &doc.project().rigidity)
         .iter()
         .zip(domain.triangles())
         .filter(|(w, _)| **w != 1.0)

@@ -1,6 +1,7 @@
 //! Image + project → mesh → rig → warped image: the path the `c2warp` command line and
 //! the editor share, so an export from either gives the same pixels.
 
+pub mod arap;
 pub mod cage;
 pub mod method;
 pub mod order;
@@ -15,7 +16,8 @@ use mesh::{Constraints, DomainOptions, Mesh, MeshError, MeshOptions};
 use project::{HandleSpec, MetricChoice, Middle, Project};
 use render::Picture;
 
-pub use method::{ArapRig, ArapTimes, Deformer, Method, Output, deformer};
+pub use arap::{ArapOptions, ArapRig, ArapTimes};
+pub use method::{Deformer, Method, Output, deformer};
 pub use order::draw_order;
 use weights_core::{
     Basis, Domain, Handle, Metric, MiddleControls, Placement, Rig, RigOptions, Similarity,
@@ -358,15 +360,15 @@ pub struct Warper {
 }
 
 impl Warper {
-    /// Sets up `project`'s method (its rigidity included) on the rig `prepare` built,
-    /// with the overlap order of its handles' depths.
+    /// Sets up `project`'s method (its rigidity included) on the rig `prepare` built
+    /// from `picture`, with the overlap order of its handles' depths.
     ///
     /// # Errors
     /// What the method refuses.
-    pub fn new(rig: Rig, project: &Project) -> Result<Self> {
+    pub fn new(rig: Rig, project: &Project, picture: &RgbaImage) -> Result<Self> {
         let depths: Vec<i32> = project.handles.iter().map(HandleSpec::depth).collect();
         let triangles = draw_order(&rig, &depths);
-        let deformer = deformer(project.method, rig, &project.rigidity)?;
+        let deformer = deformer(project, rig, Some(picture))?;
         Ok(Self {
             deformer,
             triangles,
@@ -405,7 +407,7 @@ pub fn prepare_warper(
     progress: &(dyn Fn(weights_core::Progress) + Sync),
 ) -> Result<Warper> {
     let prepared = prepare_with_progress(image, project, density, progress)?;
-    Warper::new(prepared.rig, project)
+    Warper::new(prepared.rig, project, image)
 }
 
 /// The image warped by the current pose on the GPU (or a software adapter): for C²

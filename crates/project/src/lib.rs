@@ -150,6 +150,31 @@ pub struct LbcSettings {
     pub density: Option<usize>,
 }
 
+/// ARAP's settings: how far each handle holds and how fine ARAP's own mesh is.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct ArapSettings {
+    /// Radius in pixels of what a handle holds: the mesh vertices within it of a point
+    /// handle (within it of the segment, for a bar) move with the handle. 0 pins only
+    /// the handle's nearest vertex, as the paper does. Default: 2% of the picture's
+    /// diagonal.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pin_radius: Option<f64>,
+    /// Target vertex count of ARAP's own mesh of the picture, which the picture's mesh
+    /// follows (the paper solves on a few hundred vertices; a single vertex of a fine
+    /// mesh has too little hold). Default: 3,000.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density: Option<usize>,
+}
+
+/// The largest `arap.density`: ARAP factorises its mesh when handles change, which
+/// takes about a second at this size.
+pub const MAX_ARAP_DENSITY: usize = 200_000;
+
+/// The smallest rigidity weight accepted: far below, a painted triangle has no
+/// stiffness left and the systems lose precision.
+pub const MIN_RIGIDITY: f64 = 1e-3;
+
 /// The most vertices a cage may have.
 pub const MAX_CAGE_VERTICES: usize = 1000;
 
@@ -365,6 +390,9 @@ pub struct Project {
     /// LBC's settings.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lbc: Option<LbcSettings>,
+    /// ARAP's settings.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub arap: Option<ArapSettings>,
 }
 
 fn is_c2(method: &Method) -> bool {
@@ -390,6 +418,7 @@ impl Default for Project {
             rigidity: Vec::new(),
             cage: None,
             lbc: None,
+            arap: None,
         }
     }
 }
@@ -687,12 +716,30 @@ impl Project {
                     s.radius
                 ));
             }
-            if !(s.weight.is_finite() && s.weight > 0.0 && s.weight <= MAX_RIGIDITY) {
+            if !(s.weight.is_finite() && (MIN_RIGIDITY..=MAX_RIGIDITY).contains(&s.weight)) {
                 return bad(format!(
-                    "rigidity stroke {i}: weight must be positive and at most {MAX_RIGIDITY:e}, \
-                     got {}",
+                    "rigidity stroke {i}: weight must be between {MIN_RIGIDITY} and \
+                     {MAX_RIGIDITY:e} (1 is unpainted; the paper paints 10000), got {:?}",
                     s.weight
                 ));
+            }
+        }
+        if let Some(arap) = &self.arap {
+            if let Some(r) = arap.pin_radius
+                && !(r.is_finite() && (0.0..=MAX_POSE).contains(&r))
+            {
+                return bad(format!(
+                    "arap.pin_radius must be a number of pixels, 0 or more, got {r}"
+                ));
+            }
+            if let Some(density) = arap.density {
+                validate_density(density)?;
+                if density > MAX_ARAP_DENSITY {
+                    return bad(format!(
+                        "arap.density is at most {MAX_ARAP_DENSITY} vertices (ARAP \
+                         factorises its mesh), got {density}"
+                    ));
+                }
             }
         }
         Ok(())
@@ -893,7 +940,23 @@ mod tests {
             ),
             (
                 r#"{"version":1,"handles":[],"rigidity":[{"stroke":[[1,1]],"radius":2,"weight":0}]}"#,
-                "weight must be positive",
+                "weight must be between 0.001 and 1e8",
+            ),
+            (
+                r#"{"version":1,"handles":[],"rigidity":[{"stroke":[[1,1]],"radius":2,"weight":1e-20}]}"#,
+                "got 1e-20",
+            ),
+            (
+                r#"{"version":1,"handles":[],"arap":{"pin_radius":-1}}"#,
+                "arap.pin_radius must be a number of pixels",
+            ),
+            (
+                r#"{"version":1,"handles":[],"arap":{"density":300000}}"#,
+                "arap.density is at most 200000",
+            ),
+            (
+                r#"{"version":1,"handles":[],"arap":{"radius":3}}"#,
+                "unknown field `radius`",
             ),
             (
                 r#"{"version":1,"handles":[],"rigidity":[{"stroke":[],"radius":2,"weight":1}]}"#,

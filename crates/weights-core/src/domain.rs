@@ -474,6 +474,30 @@ impl Domain {
         best.map(|(_, v)| v)
     }
 
+    /// The samples within `r` of the segment from `a` to `b` (of the point `a` when
+    /// `a == b`), in index order; none for a non-finite segment or radius.
+    pub fn vertices_near_segment(&self, a: DVec2, b: DVec2, r: f64) -> Vec<u32> {
+        if !(a.is_finite() && b.is_finite() && r.is_finite() && r >= 0.0) {
+            return Vec::new();
+        }
+        let grid = self.vertex_grid();
+        let (x0, y0) = grid.cell_of(a.min(b) - DVec2::splat(r));
+        let (x1, y1) = grid.cell_of(a.max(b) + DVec2::splat(r));
+        let mut out = Vec::new();
+        for y in y0..=y1 {
+            for x in x0..=x1 {
+                for &v in grid.items(x, y) {
+                    let p = self.positions[v as usize];
+                    if crate::nearest::segment_distance([p, p], [a, b]) <= r {
+                        out.push(v);
+                    }
+                }
+            }
+        }
+        out.sort_unstable();
+        out
+    }
+
     /// Closed boundary loops (edges used by exactly one triangle), each as a vertex
     /// sequence without repeating the first vertex.
     pub fn boundary_loops(&self) -> &[Vec<u32>] {
