@@ -351,47 +351,110 @@ fn bad_input_gives_one_clear_line_and_keeps_the_old_output() {
 }
 
 #[test]
-/// The editor's export and `c2warp render` of the project it saved give the same pixels.
+/// What the editor shows, exports and saves is one picture: after insertions and
+/// removals in posed states, density changes and method switches, the export equals
+/// `c2warp render` of the saved project pixel for pixel, the view (the editor's own GPU
+/// frame drawn at full size) equals it up to filtering, and the saved project reopens
+/// with the same mesh, virtual handles and weights (`Document::check_reopens`).
 fn the_editor_exports_what_the_command_renders() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let picture = dir.path().join("dino.png");
-    fs::copy(data("dino.png"), &picture).expect("copy the picture");
+    let picture = dir.path().join("lizard.png");
+    fs::write(&picture, pipeline::DEFAULT_IMAGE).expect("write the picture");
+    let gpu = render::GpuContext::new().expect("a wgpu adapter (run scripts/setup.sh)");
     let mut app = editor::EditorApp::headless(false);
     app.open(&picture);
-    assert!(
-        app.message.as_ref().is_some_and(|m| !m.is_error),
-        "{:?}",
-        app.message
-    );
-    // A point, then a bar, inserted live, and the point posed: the rig the editor
-    // holds has live-inserted handles and virtual handles.
-    app.add_point(glam::DVec2::new(250.0, 120.0));
-    app.add_bar(
-        glam::DVec2::new(130.0, 100.0),
-        glam::DVec2::new(160.0, 160.0),
-    );
+    app.wait_for_job();
+    let fine = |app: &editor::EditorApp| {
+        assert!(
+            app.message.as_ref().is_some_and(|m| !m.is_error),
+            "{:?}",
+            app.message
+        );
+    };
+    fine(&app);
+    let set_density = |app: &mut editor::EditorApp, density: usize| {
+        let mut settings = app.document().expect("a document").settings();
+        settings.density = density;
+        assert!(
+            app.edit(editor::Edit::Settings(settings)),
+            "{:?}",
+            app.message
+        );
+        app.wait_for_job();
+    };
+    let mut round = 0;
+    let mut same = |app: &mut editor::EditorApp, what: &str| {
+        round += 1;
+        let doc = app.document().expect("a document");
+        doc.check_reopens()
+            .unwrap_or_else(|e| panic!("{what}: {e:#}"));
+        let project = dir.path().join(format!("lizard-{round}.json"));
+        let exported = dir.path().join(format!("exported-{round}.png"));
+        app.save_to(&project);
+        app.export_to(&exported);
+        fine(app);
+        let rendered = dir.path().join(format!("rendered-{round}.png"));
+        ok(&render_args(&picture, &project, &rendered, &[]));
+        let exported = load(&exported);
+        assert!(exported == load(&rendered), "{what}: identical pixels");
+        // The view, as the GPU draws it at full size, is the export up to filtering.
+        let view = app.view_offscreen(&gpu).expect("the view drawn offscreen");
+        let (worst, share) = difference(&view, &exported, 8);
+        assert!(
+            share < 0.01,
+            "{what}: the view differs from the export in {:.2}% of channels (largest {worst})",
+            share * 100.0
+        );
+    };
+    set_density(&mut app, 4000);
+    // A point on the hind leg, posed; a bar added in the posed state; a point added and
+    // removed again.
+    app.add_point(glam::DVec2::new(190.0, 470.0));
+    // Posed where it was put (its rest is the picture point under the click).
+    let handles = &app.document().expect("a document").project().handles;
+    let leg = handles.len() - 1;
+    let project::HandleSpec::Point { rest, .. } = handles[leg] else {
+        panic!("a point handle");
+    };
     let posed = project::HandleSpec::Point {
-        rest: [250.0, 120.0],
-        translate: [12.0, -25.0],
+        rest,
+        translate: [40.0, -35.0],
         rotate: 0.3,
         scale: 1.1,
         depth: 0,
     };
-    assert!(app.edit(editor::Edit::Pose(0, posed)), "{:?}", app.message);
-    let handles = app.document().map_or(0, |d| d.project().handles.len());
-    assert_eq!(handles, 2, "{:?}", app.message);
-    let project = dir.path().join("dino.json");
-    let exported = dir.path().join("exported.png");
-    app.save_to(&project);
-    app.export_to(&exported);
     assert!(
-        app.message.as_ref().is_some_and(|m| !m.is_error),
+        app.edit(editor::Edit::Pose(leg, posed)),
         "{:?}",
         app.message
     );
-    let rendered = dir.path().join("rendered.png");
-    ok(&render_args(&picture, &project, &rendered, &[]));
-    assert!(load(&exported) == load(&rendered), "identical pixels");
+    app.add_bar(
+        glam::DVec2::new(330.0, 230.0),
+        glam::DVec2::new(430.0, 330.0),
+    );
+    app.add_point(glam::DVec2::new(600.0, 520.0));
+    same(&mut app, "insertions in a posed state");
+    let last = app.document().expect("a document").project().handles.len() - 1;
+    assert!(app.edit(editor::Edit::Remove(last)), "{:?}", app.message);
+    same(&mut app, "a removal");
+    // Another density: the picture is meshed anew, and a handle inserted on it.
+    set_density(&mut app, 6000);
+    app.add_point(glam::DVec2::new(640.0, 560.0));
+    same(&mut app, "a new density");
+    // Method switches, and an insertion under ARAP.
+    assert!(
+        app.edit(editor::Edit::Method(pipeline::Method::Arap)),
+        "{:?}",
+        app.message
+    );
+    app.add_point(glam::DVec2::new(300.0, 150.0));
+    same(&mut app, "ARAP");
+    assert!(
+        app.edit(editor::Edit::Method(pipeline::Method::C2)),
+        "{:?}",
+        app.message
+    );
+    same(&mut app, "back to C²");
 }
 
 /// How long a refusal may take at most (a hang or a 2 GB read takes far longer).

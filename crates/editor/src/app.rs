@@ -1299,6 +1299,20 @@ impl EditorApp {
         }
     }
 
+    /// The canvas as the GPU draws it (no overlays), at the picture's full size, one
+    /// image pixel to one output pixel, on `gpu` (any adapter): to compare the view with
+    /// an export.
+    ///
+    /// # Errors
+    /// No picture open, or a GPU failure.
+    pub fn view_offscreen(&mut self, gpu: &render::GpuContext) -> Result<image::RgbaImage> {
+        if self.doc.is_none() {
+            anyhow::bail!("no picture is open");
+        }
+        self.update_gpu_frame();
+        Ok(self.gpu.draw_offscreen(gpu)?)
+    }
+
     /// Brings the GPU frame up to date with the document: weights after a structural
     /// change, transforms after a pose change, overlay values when asked for. This is
     /// the CPU side of what a frame uploads; the canvas calls it every frame.

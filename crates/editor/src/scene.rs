@@ -188,6 +188,51 @@ impl SceneResources {
     }
 }
 
+impl GpuFrame {
+    /// Draws this frame as the canvas does (backdrop, then the mesh; no overlays) at
+    /// the picture's full size, one image pixel to one output pixel, into an offscreen
+    /// target of `gpu`: the view at full resolution, to compare with an export.
+    ///
+    /// # Errors
+    /// Nothing to draw yet, or a GPU failure.
+    pub fn draw_offscreen(
+        &self,
+        gpu: &render::GpuContext,
+    ) -> Result<RgbaImage, render::RenderError> {
+        let [w, h] = self.mesh.value.source_size;
+        if w == 0 || h == 0 {
+            return Err(render::RenderError::OutputTooLarge {
+                width: w,
+                height: h,
+            });
+        }
+        let format = wgpu::TextureFormat::Rgba8Unorm;
+        let mut scene = SceneResources::new(gpu.device(), gpu.queue(), format);
+        scene.update(gpu.device(), gpu.queue(), self);
+        if let Some(e) = &scene.error {
+            return Err(render::RenderError::Gpu(e.clone()));
+        }
+        // Image pixels to clip space: x in [0, w] to [−1, 1], y down.
+        let params = ViewParams {
+            scale: [2.0 / w as f32, -2.0 / h as f32],
+            offset: [-1.0, 1.0],
+            overlay: render::Overlay::None,
+            show_folds: false,
+            wireframe: false,
+        };
+        scene.view.prepare(gpu.queue(), &params);
+        if self.backdrop.is_some() {
+            scene.backdrop.prepare(gpu.queue(), &params);
+        }
+        gpu.offscreen(w, h, |pass| {
+            if self.backdrop.is_some() {
+                scene.backdrop.paint(pass, false);
+            }
+            scene.view.paint(pass, false);
+        })
+    }
+}
+
 /// The canvas' paint callback.
 pub struct MeshCallback {
     /// What to draw.

@@ -6,7 +6,9 @@
 //! cancelled, vertices and boxes dragged at rest and posed) — in every state (no
 //! handles, one, many, after Clear, no cage, a cage drawn, solved, posed, during a
 //! background job). After every action the editor must not have panicked and
-//! [`EditorApp::sanity_check`] must hold.
+//! [`EditorApp::sanity_check`] must hold; at random points the project is saved and
+//! reopened ([`editor::Document::check_reopens`]) and must build the same mesh, virtual
+//! handles and weights, bit for bit, and put every vertex in the same place.
 //!
 //! CI runs a short walk. A long one:
 //! `MONKEY_ACTIONS=5000 MONKEY_SEEDS=1,2,3,4,5,6,7,8 cargo test --release -p editor
@@ -554,17 +556,28 @@ fn walk(seed: u64, actions: usize) {
     let mut slowest: Vec<(f64, String)> = Vec::new();
     // Actions taken in each state of the cage tool: drawing, at rest, posed.
     let mut cage_states = [0usize; 3];
+    // Times the project was saved and reopened to compare.
+    let mut reopened = 0usize;
     for step in 0..actions {
         let result = std::panic::catch_unwind(AssertUnwindSafe(|| {
             let started = Instant::now();
             let what = monkey.act();
             slowest.push((started.elapsed().as_secs_f64(), what.clone()));
             monkey.trail.push(what);
+            let reopen = monkey.rng.chance(0.08);
             let app = monkey.h.state();
             if app.tool == editor::Tool::Cage {
                 cage_states[app.cage_state() as usize] += 1;
             }
-            app.sanity_check()
+            app.sanity_check()?;
+            // Saved and reopened at random points, the project builds what is on screen.
+            match app.document() {
+                Some(doc) if reopen && !app.is_busy() => {
+                    reopened += 1;
+                    doc.check_reopens()
+                }
+                _ => Ok(()),
+            }
         }));
         let failure = match result {
             Ok(Ok(())) => None,
@@ -611,7 +624,8 @@ fn walk(seed: u64, actions: usize) {
         actions as f64 / seconds
     );
     println!(
-        "  with the cage tool: {} actions drawing, {} at rest, {} posed",
+        "  with the cage tool: {} actions drawing, {} at rest, {} posed; reopened {reopened} \
+         times",
         cage_states[0], cage_states[1], cage_states[2]
     );
     slowest.sort_by(|a, b| b.0.total_cmp(&a.0));

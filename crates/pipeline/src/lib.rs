@@ -242,28 +242,7 @@ pub fn metric(choice: MetricChoice, convex: bool) -> Metric {
     }
 }
 
-/// Points the mesh must have as vertices: point handles, then virtual handles; and one
-/// polyline of samples per bar.
-fn constraints(project: &Project, handles: &[Handle]) -> (Vec<DVec2>, Vec<Vec<DVec2>>) {
-    let mut points = Vec::new();
-    let mut bars = Vec::new();
-    for (i, h) in handles.iter().enumerate() {
-        match h {
-            Handle::Point { rest, .. } => points.push(*rest),
-            Handle::Bar { rest, .. } => bars.push(
-                weights_core::bar_samples(*rest, weights_core::bar_spacing(handles, i))
-                    .into_iter()
-                    .map(|(_, p)| p)
-                    .collect(),
-            ),
-        }
-    }
-    points.extend(project.virtual_handles.iter().map(|&p| DVec2::from(p)));
-    (points, bars)
-}
-
-/// A project's rig on an image: the image meshed with its handles as vertices, then
-/// weighted.
+/// A project's rig on an image: the image meshed, then weighted.
 pub struct Prepared {
     /// The weighted rig (its domain is the mesh).
     pub rig: Rig,
@@ -271,6 +250,16 @@ pub struct Prepared {
 
 /// Meshes `image` for `project` (at `density` vertices, else the project's, else the
 /// default) and builds the rig.
+///
+/// **One rule gives the mesh and the rig from what the rig file holds**, so that the
+/// editor's view, its export, a reopened project and `c2warp render` of the saved file
+/// are one picture: the picture is meshed at its density alone (the handles play no
+/// part in the mesh, so handles added, moved or removed in the editor leave it as it
+/// is); each handle takes the vertex nearest its rest position (each bar sample, the
+/// vertex nearest it), as the editor's insertions do; the saved virtual handles take
+/// the vertices at their positions (a saved position is a vertex of this very mesh), and
+/// Algorithm 1 adds only what they leave undone. A rig built so equals the editor's
+/// incrementally updated one bit for bit (the weights depend on the set of nodes alone).
 ///
 /// `density` follows the rule of a rig file's `density`
 /// ([`project::validate_density`]), with the same message.
@@ -311,7 +300,6 @@ pub fn prepare_with_progress(
         );
     }
     let handles = handles(project);
-    let (points, bars) = constraints(project, &handles);
     let options = MeshOptions {
         target_vertices,
         ..MeshOptions::default()
@@ -320,26 +308,25 @@ pub fn prepare_with_progress(
         image,
         &DomainOptions::default(),
         &options,
-        &Constraints {
-            points: &points,
-            polylines: &bars,
-        },
+        &Constraints::default(),
     )
     .context("cannot mesh the image")?;
-    let first_virtual = points.len() - project.virtual_handles.len();
-    let virtual_handles: Vec<VirtualHandle> = mesh.point_vertices[first_virtual..]
-        .iter()
-        .enumerate()
-        .map(|(i, &vertex)| VirtualHandle {
-            vertex,
-            placed_for: project.virtual_placed_for.get(i).copied().flatten(),
-        })
-        .collect();
     let domain = Domain::new(
-        mesh.mesh.vertices.clone(),
-        mesh.mesh.triangles.clone(),
+        mesh.mesh.vertices,
+        mesh.mesh.triangles,
         metric(project.metric, mesh.is_convex),
     )?;
+    let virtual_handles: Vec<VirtualHandle> = project
+        .virtual_handles
+        .iter()
+        .enumerate()
+        .filter_map(|(i, &p)| {
+            Some(VirtualHandle {
+                vertex: domain.nearest_vertex(DVec2::from(p))?,
+                placed_for: project.virtual_placed_for.get(i).copied().flatten(),
+            })
+        })
+        .collect();
     let rig = Rig::with_progress(
         domain,
         handles,
