@@ -565,24 +565,21 @@ impl EditorApp {
     }
 
     /// Adds a point handle under `at` (image pixels, current pose): its rest position is
-    /// the point of the picture shown there, and it starts with the pose's local
-    /// rotation and scale so the warp does not jump.
+    /// the point of the picture shown there, and it starts with the rotation and scale
+    /// the pose has around it ([`Document::local_pose`]), so the warp jumps as little as
+    /// the method allows.
     pub fn add_point(&mut self, at: DVec2) {
         let Some(doc) = &mut self.doc else { return };
-        let Some((rest, rotate, scale)) = doc.unwarp(at) else {
+        let Some((rest, _, _)) = doc.unwarp(at) else {
             self.error(&anyhow::anyhow!("click on the picture to add a handle"));
             return;
         };
-        // Round-off of an unposed neighbourhood is no rotation or scale.
+        let (rotate, scale) = doc.local_pose(rest, at);
         let handle = HandleSpec::Point {
             rest: rest.to_array(),
             translate: (at - rest).to_array(),
-            rotate: if rotate.abs() < 1e-9 { 0.0 } else { rotate },
-            scale: if (scale - 1.0).abs() < 1e-9 {
-                1.0
-            } else {
-                scale
-            },
+            rotate,
+            scale,
             depth: 0,
         };
         if self.edit(Edit::Add(handle))

@@ -1046,6 +1046,63 @@ impl Document {
         None
     }
 
+    /// The rotation and scale a new point handle at rest position `rest`, placed at
+    /// `at` in the current pose, should start with so that inserting it moves the
+    /// picture as little as it can: the similarity (about `rest`, taking `rest` to
+    /// `at`) that best fits where the current pose puts the vertices the new handle's
+    /// weight will reach. Its support will be about the distance to the nearest node
+    /// (the support radius r_h), so the vertices within that distance are fitted, each
+    /// weighted by the basis φ(d/r) as the weights will be. `(0, 1)` where nothing is
+    /// posed or nothing is there to fit.
+    pub fn local_pose(&mut self, rest: DVec2, at: DVec2) -> (f64, f64) {
+        self.deformed();
+        let deformed = self
+            .deformed
+            .as_ref()
+            .map_or(&[][..], |(_, d)| d.as_slice());
+        let rig = &self.rig;
+        let positions = rig.domain().positions();
+        let reach = rig
+            .nodes()
+            .iter()
+            .map(|n| positions[n.vertex as usize].distance(rest))
+            .fold(f64::INFINITY, f64::min);
+        let reach = if reach.is_finite() {
+            reach
+        } else {
+            // No node: the picture is at rest.
+            return (0.0, 1.0);
+        };
+        let near = rig.domain().vertices_near_segment(rest, rest, reach);
+        let basis = &rig.options().basis;
+        let (mut dot, mut cross, mut norm) = (0.0, 0.0, 0.0);
+        for v in near {
+            let Some(&q) = deformed.get(v as usize) else {
+                continue;
+            };
+            let d = positions[v as usize] - rest;
+            let e = q - at;
+            let w = basis.eval(d.length() / reach);
+            dot += w * d.dot(e);
+            cross += w * d.perp_dot(e);
+            norm += w * d.length_squared();
+        }
+        if !(norm > 0.0 && dot.is_finite() && cross.is_finite()) {
+            return (0.0, 1.0);
+        }
+        let (a, b) = (dot / norm, cross / norm);
+        let scale = a.hypot(b);
+        if !(scale > 1e-6 && scale.is_finite()) {
+            // Folded flat there: keep the handle's own frame.
+            return (0.0, 1.0);
+        }
+        let round = |x: f64, unit: f64| if (x - unit).abs() < 1e-9 { unit } else { x };
+        (
+            round(b.atan2(a), 0.0),
+            round(scale.clamp(project::MIN_SCALE, project::MAX_SCALE), 1.0),
+        )
+    }
+
     /// Where node `k` is in the current pose.
     pub fn node_position(&self, k: usize) -> DVec2 {
         let vertex = self.rig.nodes()[k].vertex as usize;
@@ -1252,6 +1309,96 @@ mod tests {
             0,
             "no virtual handles without handles"
         );
+    }
+
+    #[test]
+    fn a_handle_inserted_under_a_similarity_takes_it_and_nothing_moves() {
+        // Every handle moved by one similarity (a rigid motion for ARAP, which keeps
+        // sizes): the picture is that similarity, a new handle must start with it, and
+        // inserting it must move nothing.
+        for (method, scale) in [(Method::C2, 1.3), (Method::Arap, 1.0)] {
+            let mut doc = document();
+            doc.apply(Edit::Method(method)).expect("method");
+            let motion = weights_core::Similarity {
+                translation: DVec2::new(3.0, -2.0),
+                rotation: 0.4,
+                scale,
+            };
+            let centre = DVec2::new(30.0, 20.0);
+            for (i, rest) in [DVec2::new(10.0, 10.0), DVec2::new(50.0, 30.0)]
+                .into_iter()
+                .enumerate()
+            {
+                let at = motion.apply(centre, rest);
+                let pose = HandleSpec::Point {
+                    rest: rest.to_array(),
+                    translate: (at - rest).to_array(),
+                    rotate: 0.4,
+                    scale,
+                    depth: 0,
+                };
+                doc.apply(Edit::Pose(i, pose)).expect("pose");
+            }
+            let before = doc.deformed().to_vec();
+            let rest = DVec2::new(30.0, 38.0);
+            let at = motion.apply(centre, rest);
+            let (rotate, scale_found) = doc.local_pose(rest, at);
+            assert!((rotate - 0.4).abs() < 1e-9, "{method:?}: {rotate}");
+            assert!(
+                (scale_found - scale).abs() < 1e-9,
+                "{method:?}: {scale_found}"
+            );
+            let new = HandleSpec::Point {
+                rest: rest.to_array(),
+                translate: (at - rest).to_array(),
+                rotate,
+                scale: scale_found,
+                depth: 0,
+            };
+            doc.apply(Edit::Add(new)).expect("insert");
+            let jump = before
+                .iter()
+                .zip(doc.deformed())
+                .map(|(a, b)| a.distance(*b))
+                .fold(0.0, f64::max);
+            assert!(jump < 1e-6, "{method:?}: the picture jumped by {jump}");
+        }
+    }
+
+    #[test]
+    fn a_new_handle_fits_the_pose_around_it_not_one_triangle() {
+        // A picture sheared around the new handle: the pose there is no similarity, and
+        // the fitted one is the least-squares similarity of the vertices within reach,
+        // which for a symmetric neighbourhood of a shear x' = x + k·y is a turn of
+        // atan(−k/2) and a scale of √(1 + k²/4).
+        let mut doc = document();
+        let k = 0.3;
+        doc.apply(Edit::Settings(Settings {
+            density: 8000,
+            ..doc.settings()
+        }))
+        .expect("finer");
+        let rest = DVec2::new(32.0, 24.0);
+        let reach = doc
+            .rig()
+            .nodes()
+            .iter()
+            .map(|n| doc.rig().domain().positions()[n.vertex as usize].distance(rest))
+            .fold(f64::INFINITY, f64::min);
+        // Shear the deformed picture directly (the cache the fit reads).
+        let shear: Vec<DVec2> = doc
+            .rig()
+            .domain()
+            .positions()
+            .iter()
+            .map(|p| DVec2::new(p.x + k * (p.y - rest.y), p.y))
+            .collect();
+        let version = (doc.pose_version, doc.weights_version);
+        doc.deformed = Some((version, shear));
+        let (rotate, scale) = doc.local_pose(rest, rest);
+        assert!(reach > 5.0, "{reach}");
+        assert!((rotate - (-k / 2.0).atan()).abs() < 0.02, "{rotate}");
+        assert!((scale - (1.0 + k * k / 4.0).sqrt()).abs() < 0.02, "{scale}");
     }
 
     #[test]
