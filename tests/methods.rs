@@ -712,3 +712,63 @@ fn cage_writes_a_rig_whose_cage_encloses_the_picture_and_renders_it_unchanged_at
     assert!(line.contains("3 to 1000 vertices"), "{line}");
     assert!(!refused.exists());
 }
+
+#[test]
+fn cages_too_big_or_too_thin_to_solve_are_refused_at_once() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let picture = dir.path().join("square.png");
+    image::RgbaImage::from_pixel(256, 256, image::Rgba([200, 100, 50, 255]))
+        .save(&picture)
+        .expect("write");
+    let out = dir.path().join("out.png");
+    // 64 cage vertices around a disc, 200,000 mesh vertices asked inside: minutes.
+    let ring: Vec<[f64; 2]> = (0..64)
+        .map(|k| {
+            let a = f64::from(k) / 64.0 * std::f64::consts::TAU;
+            [128.0 + 100.0 * a.cos(), 128.0 + 100.0 * a.sin()]
+        })
+        .collect();
+    let rig = dir.path().join("big.json");
+    fs::write(
+        &rig,
+        serde_json::json!({
+            "version": 1, "method": "lbc", "handles": [],
+            "cage": {"rest": ring}, "lbc": {"density": 200000}
+        })
+        .to_string(),
+    )
+    .expect("write");
+    let clock = std::time::Instant::now();
+    let line = fails(&render_args(&picture, &rig, &out, &[]));
+    assert!(line.contains("would take minutes to solve"), "{line}");
+    assert!(
+        line.contains("ask for at most 46875 mesh vertices"),
+        "{line}"
+    );
+    assert!(clock.elapsed().as_secs() < 10, "refused before meshing");
+    // A 60 px square cage asked for 4,000,000 vertices inside: capped at 4 a pixel
+    // (14,400), so it solves in seconds.
+    let rig = dir.path().join("dense.json");
+    fs::write(
+        &rig,
+        r#"{"version":1,"method":"lbc","handles":[],"cage":{"rest":[[48,48],[108,48],[108,108],[48,108]]}}"#,
+    )
+    .expect("write");
+    let clock = std::time::Instant::now();
+    ok(&render_args(
+        &picture,
+        &rig,
+        &out,
+        &["--density", "4000000"],
+    ));
+    assert!(clock.elapsed().as_secs() < 60, "{:?}", clock.elapsed());
+    // A sliver 216 px long and a billionth of a pixel wide.
+    let rig = dir.path().join("sliver.json");
+    fs::write(
+        &rig,
+        r#"{"version":1,"method":"lbc","handles":[],"cage":{"rest":[[20,100],[236,100],[236,100.000000001],[20,100.000000001]]}}"#,
+    )
+    .expect("write");
+    let line = fails(&render_args(&picture, &rig, &out, &[]));
+    assert!(line.contains("the cage is a sliver"), "{line}");
+}

@@ -17,13 +17,18 @@ pub(crate) fn orient(a: DVec2, b: DVec2, c: DVec2) -> f64 {
     (b - a).perp_dot(c - a)
 }
 
+/// A cage whose area is at most this share of its bounding box diagonal squared is
+/// refused as too thin ([`LbcError::TooThin`]).
+pub const THIN: f64 = 1e-6;
+
 impl Cage {
     /// Validates a polygon.
     ///
     /// # Errors
     /// Fewer than 3 vertices, a non-finite coordinate, two coinciding vertices, zero
-    /// area, or two edges that cross or touch (other than neighbours at their shared
-    /// vertex) are refused. Coincidence and touching are judged with a tolerance of
+    /// area (or an area of at most [`THIN`] times the squared diagonal of the bounding
+    /// box: a sliver), or two edges that cross or touch (other than neighbours at their
+    /// shared vertex) are refused. Coincidence and touching are judged with a tolerance of
     /// `1e-12` of the bounding-box diagonal, so that what is refused here is also
     /// what a triangulation could not represent.
     pub fn new(vertices: Vec<DVec2>) -> Result<Self, LbcError> {
@@ -86,9 +91,14 @@ impl Cage {
                 }
             }
         }
-        // A simple polygon that is not flat has area; this guards rounding.
-        if signed_area(&vertices).abs() <= 1e-12 * diag * diag {
+        // A simple polygon that is not flat has area, but one thinner than a millionth
+        // of its size cannot be triangulated into anything a solve can use.
+        let area = signed_area(&vertices).abs();
+        if area <= 1e-12 * diag * diag {
             return Err(LbcError::ZeroArea);
+        }
+        if area <= THIN * diag * diag {
+            return Err(LbcError::TooThin { area, size: diag });
         }
         Ok(Self { vertices })
     }

@@ -26,6 +26,17 @@ pub enum LbcError {
     /// The polygon encloses no area (all vertices on one line).
     #[error("the cage encloses no area")]
     ZeroArea,
+    /// The polygon is a sliver: its area is a millionth of its size squared or less.
+    #[error(
+        "the cage is a sliver: it encloses {area:.1e} for a size of {size:.1} across (at least a \
+         millionth of the size squared is needed); give it some width"
+    )]
+    TooThin {
+        /// Its area.
+        area: f64,
+        /// Its bounding box's diagonal.
+        size: f64,
+    },
     /// Two cage edges cross or touch (edge `i` runs from vertex `i` to `i + 1`).
     #[error("cage edges {first} and {second} intersect")]
     SelfIntersection {

@@ -131,7 +131,7 @@ mod geodesic;
 mod solve;
 mod stats;
 
-pub use cage::Cage;
+pub use cage::{Cage, THIN};
 pub use compact::{CompactWeights, Coordinates};
 pub use domain::{Domain, OnCage};
 pub use error::LbcError;

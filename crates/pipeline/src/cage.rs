@@ -27,6 +27,33 @@ pub fn cage_vertices(project: &Project, density: Option<usize>) -> usize {
         .unwrap_or(DEFAULT_CAGE_VERTICES)
 }
 
+/// The most work a solve may take: mesh vertices inside the cage times cage vertices.
+/// An ADMM iteration costs about that many operations, and a solve a few hundred
+/// iterations: at this size it takes about a minute on a 2-core machine (92,000
+/// vertices in a 16-vertex cage: 34 s). A larger request is refused, naming the limit.
+pub const MAX_CAGE_WORK: usize = 3_000_000;
+
+/// Mesh vertices inside a cage of `area` px² at most: as many per px² as a picture's
+/// mesh may have ([`mesh::MAX_VERTICES_PER_PIXEL`]); more would only slice pixels.
+pub fn cage_vertex_cap(area: f64) -> usize {
+    (mesh::MAX_VERTICES_PER_PIXEL * area).ceil().max(1.0) as usize
+}
+
+/// Refuses a solve of `cage_vertices` with `mesh_vertices` inside that would take
+/// more than about a minute.
+fn check_work(mesh_vertices: usize, cage_vertices: usize) -> Result<()> {
+    let work = mesh_vertices.saturating_mul(cage_vertices);
+    ensure!(
+        work <= MAX_CAGE_WORK,
+        "a cage of {cage_vertices} vertices with {mesh_vertices} mesh vertices inside would \
+         take minutes to solve: mesh vertices × cage vertices may be at most \
+         {MAX_CAGE_WORK} (about a minute), here {work}; ask for at most {} mesh vertices \
+         (--density or the rig's lbc.density) or use fewer cage vertices",
+        MAX_CAGE_WORK / cage_vertices.max(1)
+    );
+    Ok(())
+}
+
 /// The solver's settings for `tau` (everything else at the `lbc` crate's defaults).
 pub fn solver_settings(tau: Tau) -> lbc::Settings {
     lbc::Settings {
@@ -105,14 +132,18 @@ pub fn cage_coordinates(
     let cage = lbc::Cage::new(rest).context("the rig's cage")?;
     let domain = match mesh {
         CageMesh::Triangulate { target_vertices } => {
-            lbc::Domain::triangulate(&cage, target_vertices)
-                .context("cannot triangulate the cage")?
+            let target = target_vertices.min(cage_vertex_cap(cage.area()));
+            check_work(target, cage.len())?;
+            lbc::Domain::triangulate(&cage, target).context("cannot triangulate the cage")?
         }
         CageMesh::Given {
             positions,
             triangles,
-        } => lbc::Domain::from_mesh(&cage, positions, triangles)
-            .context("the mesh does not fit the cage")?,
+        } => {
+            check_work(positions.len(), cage.len())?;
+            lbc::Domain::from_mesh(&cage, positions, triangles)
+                .context("the mesh does not fit the cage")?
+        }
     };
     let settings = solver_settings(project.lbc.unwrap_or_default().tau);
     let coordinates = lbc::solve(&domain, &settings, progress)?;
