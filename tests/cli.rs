@@ -455,6 +455,34 @@ fn the_editor_exports_what_the_command_renders() {
         app.message
     );
     same(&mut app, "back to C²");
+    // The tail pulled beyond the picture's edge, and the canvas grown to hold it.
+    let tail = project::HandleSpec::Point {
+        rest: [685.0, 590.0],
+        translate: [330.0, 40.0],
+        rotate: 0.0,
+        scale: 1.0,
+        depth: 0,
+    };
+    assert!(
+        app.edit(editor::Edit::Add(tail.clone())),
+        "{:?}",
+        app.message
+    );
+    assert!(
+        app.edit(editor::Edit::Canvas(project::Canvas::Fit)),
+        "{:?}",
+        app.message
+    );
+    same(&mut app, "a grown canvas");
+    let grown = load(&dir.path().join(format!("exported-{round}.png")));
+    let (w, h) = pipeline::load_image(&picture)
+        .expect("picture")
+        .dimensions();
+    assert!(
+        grown.width() > w && grown.height() >= h,
+        "{:?}",
+        grown.dimensions()
+    );
 }
 
 /// How long a refusal may take at most (a hang or a 2 GB read takes far longer).

@@ -772,3 +772,86 @@ fn cages_too_big_or_too_thin_to_solve_are_refused_at_once() {
     let line = fails(&render_args(&picture, &rig, &out, &[]));
     assert!(line.contains("the cage is a sliver"), "{line}");
 }
+
+#[test]
+fn a_grown_canvas_holds_the_whole_warp_for_every_method() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let picture = data("dino.png");
+    let (w, h) = load(&picture).dimensions();
+    // The tail's handle pulled 120 px past the right edge.
+    let rig = dir.path().join("out.json");
+    fs::write(
+        &rig,
+        r#"{"version":1,"density":3000,"handles":[
+            {"type":"point","rest":[60,60]},
+            {"type":"point","rest":[150,250]},
+            {"type":"point","rest":[250,120],"translate":[140,-20]}]}"#,
+    )
+    .expect("write");
+    for method in ["c2", "arap"] {
+        let kept = dir.path().join(format!("{method}-keep.png"));
+        let grown = dir.path().join(format!("{method}-fit.png"));
+        let gpu = dir.path().join(format!("{method}-fit-gpu.png"));
+        ok(&render_args(&picture, &rig, &kept, &["--method", method]));
+        ok(&render_args(
+            &picture,
+            &rig,
+            &grown,
+            &["--method", method, "--canvas", "fit"],
+        ));
+        ok(&render_args(
+            &picture,
+            &rig,
+            &gpu,
+            &["--method", method, "--canvas", "fit", "--gpu"],
+        ));
+        let (kept, grown, gpu) = (load(&kept), load(&grown), load(&gpu));
+        assert_eq!(kept.dimensions(), (w, h));
+        assert!(grown.width() > w + 100 && grown.height() >= h, "{method}");
+        // The grown canvas starts where the warped mesh reaches furthest up and left
+        // (or at the picture's corner): the picture's frame sits there in it, with the
+        // same pixels, and more visible ones around.
+        let mesh = dir.path().join(format!("{method}.obj"));
+        deform(
+            &[os("--image"), picture.as_os_str()],
+            &rig,
+            Some(method),
+            &mesh,
+        );
+        let (moved, _) = read_obj(&mesh);
+        let least = |k: usize| {
+            moved
+                .iter()
+                .map(|p| p[k] as f32)
+                .fold(0.0f32, f32::min)
+                .floor()
+        };
+        let (ox, oy) = (-least(0) as u32, -least(1) as u32);
+        let frame = image::imageops::crop_imm(&grown, ox, oy, w, h).to_image();
+        assert!(
+            frame == kept,
+            "{method}: the kept canvas lies in the grown one at ({ox}, {oy})"
+        );
+        let visible = |img: &image::RgbaImage| img.pixels().filter(|p| p[3] > 0).count();
+        assert!(visible(&grown) > visible(&kept) + 1000, "{method}");
+        let (worst, share) = difference(&grown, &gpu, 8);
+        assert!(share < 0.01, "{method}: GPU {share} (largest {worst})");
+    }
+    // At rest, a grown canvas is the picture's own.
+    let rest = dir.path().join("rest.json");
+    fs::write(
+        &rest,
+        r#"{"version":1,"density":3000,"handles":[],"canvas":"fit"}"#,
+    )
+    .expect("write");
+    let out = dir.path().join("rest.png");
+    ok(&render_args(&picture, &rest, &out, &[]));
+    assert_eq!(load(&out).dimensions(), (w, h));
+    let refused = c2warp(&render_args(&picture, &rest, &out, &["--canvas", "huge"]));
+    assert!(!refused.status.success());
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        stderr.contains("unknown canvas \"huge\" (known: keep, fit)"),
+        "{stderr}"
+    );
+}

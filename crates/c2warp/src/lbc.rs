@@ -102,9 +102,9 @@ pub fn render(
     project::validate_density(target_vertices)?;
     let solved = solve_on(project, CageMesh::Triangulate { target_vertices })?;
     let warped = if gpu {
-        pipeline::cage::warp_by_cage_gpu(&image, &solved)?
+        pipeline::cage::warp_by_cage_gpu(&image, &solved, project.canvas)?
     } else {
-        pipeline::cage::warp_by_cage(&image, &solved)?
+        pipeline::cage::warp_by_cage(&image, &solved, project.canvas)?
     };
     Ok(render::Picture::Rgba8(warped))
 }

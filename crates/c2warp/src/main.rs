@@ -64,6 +64,11 @@ enum Command {
         /// The warping method: c2, arap or lbc (overrides the rig's `method`).
         #[arg(long)]
         method: Option<Method>,
+        /// The output's frame: `keep` the picture's size (what the warp moves beyond
+        /// its edge is cut off), or `fit` it to the warped picture (grown to hold all
+        /// of it). Overrides the rig's `canvas`.
+        #[arg(long)]
+        canvas: Option<project::Canvas>,
     },
     /// Write the deformed mesh as Wavefront OBJ: one `v x y 0` line per vertex (the
     /// input's order, inserted vertices after), then the faces.
@@ -183,7 +188,8 @@ fn run(command: Command) -> Result<()> {
             density,
             gpu,
             method,
-        } => render(&image, &rig, &output, density, gpu, method),
+            canvas,
+        } => render(&image, &rig, &output, density, gpu, method, canvas),
         Command::Deform {
             source,
             rig,
@@ -252,6 +258,7 @@ fn render(
     density: Option<usize>,
     gpu: bool,
     method: Option<Method>,
+    canvas: Option<project::Canvas>,
 ) -> Result<()> {
     if let Some(density) = density {
         // Before the slow part: the rule and the message of a rig file's density.
@@ -260,6 +267,9 @@ fn render(
     let mut project = load_project(rig)?;
     if let Some(method) = method {
         project.method = method;
+    }
+    if let Some(canvas) = canvas {
+        project.canvas = canvas;
     }
     let picture = load_picture(image)?;
     if project.method == Method::Lbc {

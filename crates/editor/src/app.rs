@@ -1252,7 +1252,15 @@ impl EditorApp {
             .map(|key| (doc.solution_for(&key).cloned(), key, doc.cage_pose()));
         Some(move || {
             if let Some((solution, key, pose)) = cage {
-                return export_cage(&image, &path, solution, &key, &pose, &cancel);
+                return export_cage(
+                    &image,
+                    &path,
+                    solution,
+                    &key,
+                    &pose,
+                    project.canvas,
+                    &cancel,
+                );
             }
             let clock = Instant::now();
             let result = (|| -> Result<()> {
@@ -1296,18 +1304,26 @@ impl EditorApp {
         }
     }
 
-    /// The canvas as the GPU draws it (no overlays), at the picture's full size, one
-    /// image pixel to one output pixel, on `gpu` (any adapter): to compare the view with
-    /// an export.
+    /// The canvas as the GPU draws it (no overlays), one image pixel to one output
+    /// pixel, in the frame an export has (the picture's, or grown to fit the warp), on
+    /// `gpu` (any adapter): to compare the view with an export.
     ///
     /// # Errors
-    /// No picture open, or a GPU failure.
+    /// No picture open, a grown canvas too large, or a GPU failure.
     pub fn view_offscreen(&mut self, gpu: &render::GpuContext) -> Result<image::RgbaImage> {
-        if self.doc.is_none() {
+        let Some(doc) = &mut self.doc else {
             anyhow::bail!("no picture is open");
-        }
+        };
+        let (w, h) = doc.image.dimensions();
+        let canvas = doc.project().canvas;
+        let lbc = doc.method() == Method::Lbc;
+        let deformed: Vec<glam::Vec2> = match doc.cage_deformed() {
+            Some(cage) if lbc => cage.iter().map(|p| p.as_vec2()).collect(),
+            _ => doc.deformed().iter().map(|p| p.as_vec2()).collect(),
+        };
+        let frame = pipeline::Frame::new(w, h, &deformed, canvas)?;
         self.update_gpu_frame();
-        Ok(self.gpu.draw_offscreen(gpu)?)
+        Ok(self.gpu.draw_offscreen(gpu, frame)?)
     }
 
     /// Brings the GPU frame up to date with the document: weights after a structural
@@ -1480,6 +1496,7 @@ fn export_cage(
     solution: Option<Arc<pipeline::cage::CageCoordinates>>,
     key: &CageKey,
     pose: &[DVec2],
+    canvas: project::Canvas,
     cancel: &CancelFlag,
 ) -> Outcome {
     let clock = Instant::now();
@@ -1488,7 +1505,7 @@ fn export_cage(
             Some(solution) => solution,
             None => crate::document::solve_cage(key, &mut |_| !cancel.is_set())?,
         };
-        let warped = pipeline::cage::warp_by_cage_posed(image, &solution, pose)?;
+        let warped = pipeline::cage::warp_by_cage_posed(image, &solution, pose, canvas)?;
         if cancel.is_set() {
             anyhow::bail!("cancelled");
         }

@@ -104,6 +104,8 @@ pub enum Edit {
     CagePose(Vec<[f64; 2]>),
     /// LBC's settings: τ and the vertex count inside the cage.
     Lbc(LbcSettings),
+    /// The frame of exports: the picture's own, or grown to fit the warp.
+    Canvas(project::Canvas),
 }
 
 /// What a cage's coordinates are solved for: the rest cage, τ and the number of mesh
@@ -656,6 +658,7 @@ impl Document {
                 project.lbc = Some(settings);
                 self.check_cage(&project)?;
             }
+            Edit::Canvas(canvas) => project.canvas = canvas,
         }
         self.restore(project)
     }

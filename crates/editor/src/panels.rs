@@ -298,6 +298,32 @@ impl EditorApp {
                     ui.close();
                     self.export();
                 }
+                if let Some(doc) = &self.doc {
+                    let canvas = doc.project().canvas;
+                    let mut grow = canvas == project::Canvas::Fit;
+                    let changed = ui
+                        .checkbox(&mut grow, "Grow the canvas to fit the warp")
+                        .on_hover_text(
+                            "Export (and c2warp render of the saved project) at a size that \
+                             holds all of the warped picture, instead of cutting off what \
+                             the warp moves beyond the picture's edge",
+                        )
+                        .changed();
+                    if changed {
+                        let canvas = if grow {
+                            project::Canvas::Fit
+                        } else {
+                            project::Canvas::Keep
+                        };
+                        if self.edit(Edit::Canvas(canvas)) {
+                            self.info(if grow {
+                                "exports grow the canvas to hold the whole warped picture"
+                            } else {
+                                "exports keep the picture's size"
+                            });
+                        }
+                    }
+                }
                 ui.separator();
                 ui.checkbox(&mut self.builtin_dialogs, "Built-in file dialogs")
                     .on_hover_text(

@@ -189,17 +189,19 @@ impl SceneResources {
 }
 
 impl GpuFrame {
-    /// Draws this frame as the canvas does (backdrop, then the mesh; no overlays) at
-    /// the picture's full size, one image pixel to one output pixel, into an offscreen
-    /// target of `gpu`: the view at full resolution, to compare with an export.
+    /// Draws this frame as the canvas does (backdrop, then the mesh; no overlays), one
+    /// image pixel to one output pixel, into an offscreen target of `gpu` covering
+    /// `frame` (the picture's rectangle, or the grown canvas of an export): the view at
+    /// full resolution, to compare with an export.
     ///
     /// # Errors
-    /// Nothing to draw yet, or a GPU failure.
+    /// An empty frame, or a GPU failure.
     pub fn draw_offscreen(
         &self,
         gpu: &render::GpuContext,
+        frame: pipeline::Frame,
     ) -> Result<RgbaImage, render::RenderError> {
-        let [w, h] = self.mesh.value.source_size;
+        let (w, h) = (frame.width, frame.height);
         if w == 0 || h == 0 {
             return Err(render::RenderError::OutputTooLarge {
                 width: w,
@@ -212,10 +214,12 @@ impl GpuFrame {
         if let Some(e) = &scene.error {
             return Err(render::RenderError::Gpu(e.clone()));
         }
-        // Image pixels to clip space: x in [0, w] to [−1, 1], y down.
+        // Image pixels to clip space, y down: the frame's corner to (−1, 1).
+        let (fw, fh) = (w as f32, h as f32);
+        let [ox, oy] = frame.origin.map(|o| o as f32);
         let params = ViewParams {
-            scale: [2.0 / w as f32, -2.0 / h as f32],
-            offset: [-1.0, 1.0],
+            scale: [2.0 / fw, -2.0 / fh],
+            offset: [-1.0 - 2.0 * ox / fw, 1.0 + 2.0 * oy / fh],
             overlay: render::Overlay::None,
             show_folds: false,
             wireframe: false,

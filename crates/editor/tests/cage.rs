@@ -351,7 +351,7 @@ fn an_lbc_export_is_what_the_pipeline_draws_for_the_saved_project() {
         &mut |_| true,
     )
     .expect("solved");
-    let expected = pipeline::cage::warp_by_cage(&doc.image, &solved).expect("warp");
+    let expected = pipeline::cage::warp_by_cage(&doc.image, &solved, project.canvas).expect("warp");
     assert!(
         changed(&exported, &expected) < 1e-4,
         "{}",

@@ -11,7 +11,9 @@
 
 use anyhow::{Context, Result, bail, ensure};
 use glam::DVec2;
-use project::{MAX_CAGE_VERTICES, Method, Project, Tau};
+use project::{Canvas, MAX_CAGE_VERTICES, Method, Project, Tau};
+
+use crate::Frame;
 
 /// Mesh vertices inside a cage when neither a `--density` nor the rig names a count:
 /// the solve's time grows quickly with it (a few seconds at this size).
@@ -169,16 +171,17 @@ pub fn uses_cage(project: &Project, method: Option<Method>) -> bool {
 /// The picture warped by a cage, as GIMP's cage tool does it: what lies inside the
 /// rest cage is taken out and drawn where the posed cage takes it; what lies outside
 /// stays as it is, and shows wherever the warped inside does not cover it (the warped
-/// inside is drawn over it, alpha blended). Drawn on the CPU at full resolution, 8 bits
-/// per channel.
+/// inside is composited over it). Drawn on the CPU at full resolution, 8 bits per
+/// channel, in the picture's own frame or one grown to fit the warp (`canvas`).
 ///
 /// # Errors
-/// Non-finite deformed positions, or a picture too large to draw.
+/// Non-finite deformed positions, or a picture (or grown canvas) too large to draw.
 pub fn warp_by_cage(
     image: &image::RgbaImage,
     solved: &CageCoordinates,
+    canvas: Canvas,
 ) -> Result<image::RgbaImage> {
-    warp_by_cage_posed(image, solved, &solved.pose)
+    warp_by_cage_posed(image, solved, &solved.pose, canvas)
 }
 
 /// As [`warp_by_cage`], with the cage in `pose` (one point per cage vertex) rather
@@ -191,6 +194,7 @@ pub fn warp_by_cage_posed(
     image: &image::RgbaImage,
     solved: &CageCoordinates,
     pose: &[DVec2],
+    canvas: Canvas,
 ) -> Result<image::RgbaImage> {
     let deformed = solved.weights.deform(pose)?;
     if deformed.iter().any(|p| !p.is_finite()) {
@@ -198,13 +202,14 @@ pub fn warp_by_cage_posed(
     }
     let rest = rest_positions(solved);
     let deformed: Vec<glam::Vec2> = deformed.iter().map(|p| p.as_vec2()).collect();
-    let mut out = image.clone();
-    clear_inside(&mut out, &solved.domain);
+    let (w, h) = image.dimensions();
+    let frame = Frame::new(w, h, &deformed, canvas)?;
+    let mut out = outside(image, solved, frame);
     render::warp_over(
         image,
         &render::WarpMesh {
             rest: &rest,
-            deformed: &deformed,
+            deformed: &frame.place(&deformed),
             triangles: solved.domain.triangles(),
         },
         &mut out,
@@ -222,6 +227,7 @@ pub fn warp_by_cage_posed(
 pub fn warp_by_cage_gpu(
     image: &image::RgbaImage,
     solved: &CageCoordinates,
+    canvas: Canvas,
 ) -> Result<image::RgbaImage> {
     if solved.pose.iter().any(|p| !p.is_finite()) {
         bail!("the cage's pose is not finite");
@@ -230,6 +236,10 @@ pub fn warp_by_cage_gpu(
     let rest = rest_positions(solved);
     let (rows, nodes, weights) = skinning_table(&solved.weights);
     let (w, h) = image.dimensions();
+    let deformed: Vec<glam::Vec2> = solved.deformed()?.iter().map(|p| p.as_vec2()).collect();
+    let frame = Frame::new(w, h, &deformed, canvas)?;
+    let shift = frame.shift();
+    let placed: Vec<DVec2> = solved.pose.iter().map(|p| *p + shift.as_dvec2()).collect();
     let layer = gpu.warp_skinned(
         image,
         &render::SkinnedMesh {
@@ -239,11 +249,11 @@ pub fn warp_by_cage_gpu(
             weights: &weights,
             triangles: solved.domain.triangles(),
         },
-        &pose_transforms(&solved.pose),
-        w,
-        h,
+        &pose_transforms(&placed),
+        frame.width,
+        frame.height,
     )?;
-    Ok(composite(image, solved, &layer))
+    Ok(composite(&outside(image, solved, frame), &layer))
 }
 
 /// The compact rows as a skinning shader reads them: row `v` is
@@ -282,15 +292,23 @@ fn rest_positions(solved: &CageCoordinates) -> Vec<glam::Vec2> {
         .collect()
 }
 
+/// The picture outside the rest cage (its inside cleared), in `frame`: transparent
+/// where the frame grows beyond the picture.
+fn outside(image: &image::RgbaImage, solved: &CageCoordinates, frame: Frame) -> image::RgbaImage {
+    let mut picture = image.clone();
+    clear_inside(&mut picture, &solved.domain);
+    if frame.origin == [0, 0] && (frame.width, frame.height) == image.dimensions() {
+        return picture;
+    }
+    let mut out = image::RgbaImage::new(frame.width, frame.height);
+    image::imageops::replace(&mut out, &picture, -frame.origin[0], -frame.origin[1]);
+    out
+}
+
 /// `layer` (the warped inside, drawn on its own; transparent where it drew nothing)
-/// over `image` with the inside of the rest cage cleared.
-fn composite(
-    image: &image::RgbaImage,
-    solved: &CageCoordinates,
-    layer: &image::RgbaImage,
-) -> image::RgbaImage {
-    let mut out = image.clone();
-    clear_inside(&mut out, &solved.domain);
+/// over `base`.
+fn composite(base: &image::RgbaImage, layer: &image::RgbaImage) -> image::RgbaImage {
+    let mut out = base.clone();
     for (base, top) in out.pixels_mut().zip(layer.pixels()) {
         if top.0[3] > 0 {
             *base = render::over(top.0, base.0).into();
@@ -511,7 +529,7 @@ mod tests {
                 &mut |_| true,
             )
             .expect("solved");
-            let at_rest = warp_by_cage(&image, &solved).expect("warp");
+            let at_rest = warp_by_cage(&image, &solved, Canvas::Keep).expect("warp");
             let changed = at_rest
                 .pixels()
                 .zip(image.pixels())
@@ -520,6 +538,40 @@ mod tests {
 
             assert_eq!(changed, 0, "{:?}", project.cage);
         }
+    }
+
+    #[test]
+    fn a_grown_canvas_holds_what_the_cage_takes_beyond_the_picture() {
+        let image = image::RgbaImage::from_fn(60, 40, |x, y| {
+            image::Rgba([(x * 4) as u8, (y * 6) as u8, 90, 255])
+        });
+        let project = Project {
+            method: Method::Lbc,
+            cage: Some(project::CageSpec {
+                rest: vec![[10.0, 10.0], [40.0, 10.0], [40.0, 30.0], [10.0, 30.0]],
+                pose: Some(vec![[40.0, -5.0], [70.0, -5.0], [70.0, 15.0], [40.0, 15.0]]),
+            }),
+            ..Project::default()
+        };
+        let solved = cage_coordinates(
+            &project,
+            CageMesh::Triangulate {
+                target_vertices: 120,
+            },
+            &mut |_| true,
+        )
+        .expect("solved");
+        let kept = warp_by_cage(&image, &solved, Canvas::Keep).expect("warp");
+        let grown = warp_by_cage(&image, &solved, Canvas::Fit).expect("warp");
+        assert_eq!(kept.dimensions(), (60, 40));
+        // Moved 30 right and 15 up: the canvas grows to x ∈ [0, 70], y ∈ [−5, 40].
+        assert_eq!(grown.dimensions(), (70, 45));
+        // The picture's frame sits 5 px down in it, as kept.
+        let frame = image::imageops::crop_imm(&grown, 0, 5, 60, 40).to_image();
+        assert_eq!(frame, kept);
+        // Beyond the picture's right edge: the cage's inside, not nothing.
+        assert_eq!(grown.get_pixel(65, 10).0[3], 255);
+        assert_eq!(grown.get_pixel(65, 30).0[3], 0);
     }
 
     #[test]
@@ -543,13 +595,13 @@ mod tests {
             &mut |_| true,
         )
         .expect("solved");
-        let at_rest = warp_by_cage(&image, &solved).expect("warp");
+        let at_rest = warp_by_cage(&image, &solved, Canvas::Keep).expect("warp");
         let shift: Vec<DVec2> = solved
             .pose
             .iter()
             .map(|p| *p + DVec2::new(5.0, 0.0))
             .collect();
-        let moved = warp_by_cage_posed(&image, &solved, &shift).expect("warp");
+        let moved = warp_by_cage_posed(&image, &solved, &shift, Canvas::Keep).expect("warp");
         // Outside the rest cage and away from its moved copy: untouched.
         for (x, y) in [(2, 2), (55, 35), (5, 20)] {
             assert_eq!(moved.get_pixel(x, y), image.get_pixel(x, y));

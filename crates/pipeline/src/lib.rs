@@ -13,12 +13,13 @@ use anyhow::{Context, Result, anyhow, bail};
 use glam::{DVec2, Vec2};
 use image::RgbaImage;
 use mesh::{Constraints, DomainOptions, Mesh, MeshError, MeshOptions};
-use project::{HandleSpec, MetricChoice, Middle, Project};
+use project::{Canvas, HandleSpec, MetricChoice, Middle, Project};
 use render::Picture;
 
 pub use arap::{ArapOptions, ArapRig, ArapTimes};
 pub use method::{Deformer, Method, Output, deformer};
 pub use order::draw_order;
+
 use weights_core::{
     Basis, Domain, Handle, Metric, MiddleControls, Placement, Rig, RigOptions, Similarity,
     VirtualHandle,
@@ -344,6 +345,8 @@ pub struct Warper {
     pub deformer: Box<dyn Deformer>,
     /// The mesh's triangles, back to front (see [`order`]).
     pub triangles: Vec<[u32; 3]>,
+    /// The frame drawn: the picture's own, or grown to fit the warp.
+    pub canvas: Canvas,
 }
 
 impl Warper {
@@ -359,6 +362,7 @@ impl Warper {
         Ok(Self {
             deformer,
             triangles,
+            canvas: project.canvas,
         })
     }
 
@@ -397,6 +401,80 @@ pub fn prepare_warper(
     Warper::new(prepared.rig, project, image)
 }
 
+/// Where an output picture lies over the source's pixels: its pixel `(0, 0)` is the
+/// source's pixel `origin`, and it is `width × height` pixels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Frame {
+    /// The source pixel at the output's top-left corner (negative when the canvas grew
+    /// up or left).
+    pub origin: [i64; 2],
+    /// Output width in pixels.
+    pub width: u32,
+    /// Output height in pixels.
+    pub height: u32,
+}
+
+impl Frame {
+    /// The frame for a `width × height` picture whose warped mesh lies at `deformed`:
+    /// the picture's own rectangle ([`Canvas::Keep`]), or that rectangle grown to the
+    /// whole pixels holding every deformed position ([`Canvas::Fit`]).
+    ///
+    /// # Errors
+    /// A grown canvas beyond [`render::ImageLimits`]' 16384 × 16384 pixels.
+    pub fn new(width: u32, height: u32, deformed: &[Vec2], canvas: Canvas) -> Result<Self> {
+        let own = Self {
+            origin: [0, 0],
+            width,
+            height,
+        };
+        if canvas == Canvas::Keep || deformed.is_empty() {
+            return Ok(own);
+        }
+        let (lo, hi) = deformed.iter().fold(
+            (Vec2::ZERO, Vec2::new(width as f32, height as f32)),
+            |(lo, hi), &p| (lo.min(p), hi.max(p)),
+        );
+        let (lo, hi) = (lo.floor(), hi.ceil());
+        let limits = render::ImageLimits::default();
+        let (w, h) = (f64::from(hi.x - lo.x), f64::from(hi.y - lo.y));
+        if w > f64::from(limits.max_width) || h > f64::from(limits.max_height) {
+            bail!(
+                "the canvas grown to fit the warped picture would be {w} × {h} pixels, more \
+                 than the {} × {} a picture may have: keep the picture's canvas, or pose the \
+                 handles nearer the picture",
+                limits.max_width,
+                limits.max_height
+            );
+        }
+        Ok(Self {
+            origin: [lo.x as i64, lo.y as i64],
+            width: w as u32,
+            height: h as u32,
+        })
+    }
+
+    /// The offset that takes source pixel coordinates to this frame's.
+    pub fn shift(&self) -> Vec2 {
+        -Vec2::new(self.origin[0] as f32, self.origin[1] as f32)
+    }
+
+    /// `positions` in this frame's pixels.
+    pub fn place(&self, positions: &[Vec2]) -> Vec<Vec2> {
+        let shift = self.shift();
+        positions.iter().map(|&p| p + shift).collect()
+    }
+}
+
+impl Warper {
+    /// The frame this warper draws a `width × height` picture into.
+    ///
+    /// # Errors
+    /// As [`Frame::new`], and non-finite deformed positions.
+    pub fn frame(&self, width: u32, height: u32) -> Result<Frame> {
+        Frame::new(width, height, &self.deformed()?, self.canvas)
+    }
+}
+
 /// The image warped by the current pose on the GPU (or a software adapter): for C²
 /// weights the vertex shader blends the node transforms with the sparse weights; for
 /// a method that gives positions, they are drawn as they are.
@@ -408,6 +486,8 @@ pub fn warp_gpu(image: &RgbaImage, warper: &Warper) -> Result<RgbaImage> {
     let rest = warper.rest();
     let triangles = &warper.triangles;
     let (w, h) = image.dimensions();
+    let frame = warper.frame(w, h)?;
+    let (fw, fh) = (frame.width, frame.height);
     match warper.deformer.output() {
         Output::Skinned(rig) => {
             let (rows, nodes, weights) = rig.weight_table();
@@ -418,16 +498,23 @@ pub fn warp_gpu(image: &RgbaImage, warper: &Warper) -> Result<RgbaImage> {
                 weights: &weights,
                 triangles,
             };
-            Ok(gpu.warp_skinned(image, &mesh, &rig.node_affines(), w, h)?)
+            // The frame's shift folded into every node's translation.
+            let shift = frame.shift();
+            let affines: Vec<render::Affine> = rig
+                .node_affines()
+                .into_iter()
+                .map(|[a, b, c, d, x, y]| [a, b, c, d, x + shift.x, y + shift.y])
+                .collect();
+            Ok(gpu.warp_skinned(image, &mesh, &affines, fw, fh)?)
         }
         Output::Positions(_) => {
-            let deformed = warper.deformed()?;
+            let deformed = frame.place(&warper.deformed()?);
             let mesh = render::WarpMesh {
                 rest: &rest,
                 deformed: &deformed,
                 triangles,
             };
-            Ok(gpu.warp(image, &mesh, w, h)?)
+            Ok(gpu.warp(image, &mesh, fw, fh)?)
         }
     }
 }
@@ -441,40 +528,43 @@ pub fn warp_gpu(image: &RgbaImage, warper: &Warper) -> Result<RgbaImage> {
 /// Only if the deformation produced non-finite positions.
 pub fn warp_picture(picture: &Picture, warper: &Warper) -> Result<Picture> {
     let rest = warper.rest();
-    let deformed = warper.deformed()?;
+    let (w, h) = picture.dimensions();
+    let frame = warper.frame(w, h)?;
+    let deformed = frame.place(&warper.deformed()?);
     let mesh = render::WarpMesh {
         rest: &rest,
         deformed: &deformed,
         triangles: &warper.triangles,
     };
-    let (w, h) = picture.dimensions();
     Ok(render::warp_picture(
         picture,
         &mesh,
-        w,
-        h,
+        frame.width,
+        frame.height,
         &render::RasterOptions::default(),
     )?)
 }
 
-/// The image warped by the current pose, at the image's full resolution.
+/// The image warped by the current pose, at the image's full resolution, in the
+/// warper's frame (the picture's own, or grown to fit the warp: see [`Frame`]).
 ///
 /// # Errors
 /// Only if the deformation produced non-finite positions.
 pub fn warp(image: &RgbaImage, warper: &Warper) -> Result<RgbaImage> {
     let rest = warper.rest();
-    let deformed = warper.deformed()?;
+    let (w, h) = image.dimensions();
+    let frame = warper.frame(w, h)?;
+    let deformed = frame.place(&warper.deformed()?);
     let mesh = render::WarpMesh {
         rest: &rest,
         deformed: &deformed,
         triangles: &warper.triangles,
     };
-    let (w, h) = image.dimensions();
     Ok(render::warp_cpu(
         image,
         &mesh,
-        w,
-        h,
+        frame.width,
+        frame.height,
         &render::RasterOptions::default(),
     )?)
 }

@@ -268,6 +268,38 @@ fn is_as_written(placement: &Placement) -> bool {
     *placement == Placement::AsWritten
 }
 
+/// The frame an exported or rendered picture has.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Canvas {
+    /// The picture's own rectangle: what the warp moves beyond its edge is cut off.
+    #[default]
+    Keep,
+    /// The picture's rectangle grown to hold all of the warped picture.
+    Fit,
+}
+
+deserialize_by_name!(Canvas, "a canvas", [
+    "keep" => Canvas::Keep,
+    "fit" => Canvas::Fit,
+]);
+
+impl std::str::FromStr for Canvas {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "keep" => Ok(Canvas::Keep),
+            "fit" => Ok(Canvas::Fit),
+            _ => Err(format!("unknown canvas {s:?} (known: keep, fit)")),
+        }
+    }
+}
+
+fn is_keep(canvas: &Canvas) -> bool {
+    *canvas == Canvas::Keep
+}
+
 /// One handle as stored.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
@@ -393,6 +425,10 @@ pub struct Project {
     /// ARAP's settings.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub arap: Option<ArapSettings>,
+    /// The frame of an export or render: the picture's own (`"keep"`, the default) or
+    /// grown to fit the warped picture (`"fit"`).
+    #[serde(default, skip_serializing_if = "is_keep")]
+    pub canvas: Canvas,
 }
 
 fn is_c2(method: &Method) -> bool {
@@ -419,6 +455,7 @@ impl Default for Project {
             cage: None,
             lbc: None,
             arap: None,
+            canvas: Canvas::Keep,
         }
     }
 }
