@@ -653,7 +653,8 @@ impl EditorApp {
     /// Under LBC the cage tool is the tool (handles act under C² and ARAP): after any
     /// change that may have chosen LBC (an undo, an opened project), it is picked.
     pub(crate) fn sync_tool(&mut self) {
-        if self.doc.as_ref().is_some_and(|d| d.method() == Method::Lbc) && self.tool != Tool::Cage {
+        let lbc = self.doc.as_ref().is_some_and(|d| d.method() == Method::Lbc);
+        if lbc && self.tool != Tool::Cage {
             self.finish_drag();
             self.tool = Tool::Cage;
             self.bar_start = None;
@@ -661,19 +662,55 @@ impl EditorApp {
         }
     }
 
+    /// After a step through the history: the tool the new state calls for. Into LBC,
+    /// the cage tool; out of LBC with no cage being drawn, the cage tool has nothing
+    /// left to act on, so the puppet tool.
+    fn sync_tool_after_history(&mut self, was_lbc: bool) {
+        let lbc = self.doc.as_ref().is_some_and(|d| d.method() == Method::Lbc);
+        if was_lbc && !lbc && self.tool == Tool::Cage && self.cage.draft.is_none() {
+            self.end_cage_gesture();
+            self.tool = Tool::Puppet;
+        }
+        self.sync_tool();
+    }
+
     /// Chooses a warping method (one undo step). LBC without a cage starts the cage
     /// tool, to draw one; leaving LBC leaves the cage tool and keeps the cage.
     pub fn choose_method(&mut self, method: Method) {
         let Some(doc) = &self.doc else { return };
         if method == doc.method() {
+            // Drawing a cage for LBC, and back to the method already in use.
+            if method != Method::Lbc && self.tool == Tool::Cage {
+                self.set_tool(Tool::Puppet);
+                self.info(format!("{}: drawing the cage dropped", method.label()));
+            }
             return;
         }
         if method == Method::Lbc {
             self.set_tool(Tool::Cage);
+            if !matches!(self.message.as_ref(), Some(m) if m.is_error) {
+                let has_cage = self.doc.as_ref().is_some_and(|d| d.cage().is_some());
+                if !has_cage {
+                    self.info(
+                        "LBC cage: click a polygon around the subject (or Cage from outline), \
+                         then Solve",
+                    );
+                }
+            }
             return;
         }
-        if self.edit(Edit::Method(method)) && self.tool == Tool::Cage {
-            self.set_tool(Tool::Puppet);
+        if self.edit(Edit::Method(method)) {
+            if self.tool == Tool::Cage {
+                self.set_tool(Tool::Puppet);
+            }
+            self.info(match method {
+                Method::C2 => "C² weights: the handles move the picture by the paper's weights",
+                Method::Arap => {
+                    "ARAP: the picture keeps its proportions; each pin holds a small disc \
+                     around it"
+                }
+                Method::Lbc => "LBC cage",
+            });
         }
     }
 
@@ -793,8 +830,11 @@ impl EditorApp {
             self.history.redo(current)
         };
         let Some(target) = taken else { return };
+        let from = doc.project().clone();
+        let was_lbc = from.method == Method::Lbc;
         match doc.undo_to(target.clone()) {
             Ok(()) => {
+                let what = crate::history::describe_change(&from, doc.project());
                 self.dirty = true;
                 self.settings_draft = None;
                 self.cage
@@ -805,7 +845,11 @@ impl EditorApp {
                 {
                     self.selected = None;
                 }
-                self.sync_tool();
+                self.sync_tool_after_history(was_lbc);
+                self.info(format!(
+                    "{}: {what}",
+                    if back { "undone" } else { "redone" }
+                ));
             }
             Err(e) => {
                 self.history.unpop(back, target);
@@ -1025,6 +1069,14 @@ impl EditorApp {
                 document: Ok(mut doc),
             } => {
                 self.end_gesture();
+                let was_lbc = self.doc.as_ref().is_some_and(|d| d.method() == Method::Lbc);
+                let history = match &cause {
+                    Rebuild::History { back } => self.doc.as_ref().map(|old| {
+                        let what = crate::history::describe_change(old.project(), doc.project());
+                        format!("{}: {what}; ", if *back { "undone" } else { "redone" })
+                    }),
+                    Rebuild::Edit { .. } => None,
+                };
                 if let Some(old) = &self.doc {
                     doc.keep_solutions_of(old);
                     doc.project_path.clone_from(&old.project_path);
@@ -1048,6 +1100,7 @@ impl EditorApp {
                     .doc
                     .as_ref()
                     .is_none_or(|old| old.settings().density != doc.settings().density);
+                let short = remeshed.then(|| mesh_shortfall(&doc)).flatten();
                 self.doc = Some(doc);
                 if self.selected.is_some_and(|s| s >= handles) {
                     self.selected = None;
@@ -1060,9 +1113,12 @@ impl EditorApp {
                 self.settings_draft = None;
                 let what = if remeshed { "re-meshed" } else { "rebuilt" };
                 self.info(format!(
-                    "{what}: {} vertices, weights in {ms:.0} ms",
-                    stats.samples
+                    "{}{what}: {} vertices, weights in {ms:.0} ms{}",
+                    history.unwrap_or_default(),
+                    stats.samples,
+                    short.unwrap_or_default()
                 ));
+                self.sync_tool_after_history(was_lbc);
             }
             Outcome::Rebuilt {
                 document: Err(e), ..
@@ -1485,6 +1541,34 @@ impl EditorApp {
         seen.cage_view = cage_view;
         seen.warping = warping;
     }
+}
+
+/// Why a new mesh has far fewer vertices than the density asked for, if it has: the
+/// mesh holds at most [`mesh::MAX_VERTICES_PER_PIXEL`] vertices a pixel of the shape.
+fn mesh_shortfall(doc: &Document) -> Option<String> {
+    let asked = doc.settings().density;
+    let domain = doc.rig().domain();
+    let got = domain.len();
+    if got as f64 >= 0.7 * asked as f64 {
+        return None;
+    }
+    let positions = domain.positions();
+    let area: f64 = domain
+        .triangles()
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|v| positions[v as usize]);
+            0.5 * (b - a).perp_dot(c - a).abs()
+        })
+        .sum();
+    // Only the cap explains it; otherwise the mesh is as close as meshes come.
+    (mesh::MAX_VERTICES_PER_PIXEL * area < asked as f64).then(|| {
+        format!(
+            " (asked for {asked}: the picture's visible shape, {area:.0} px², holds at most \
+             {} vertices a pixel)",
+            mesh::MAX_VERTICES_PER_PIXEL
+        )
+    })
 }
 
 /// The export of an LBC project: the picture warped by its cage in `pose`, with the

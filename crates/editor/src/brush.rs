@@ -48,6 +48,8 @@ pub(crate) struct PaintedCache {
     key: Option<(u64, Vec<RigidityStroke>)>,
     /// Each painted triangle's corners with its weight.
     triangles: Arc<Vec<([u32; 3], f64)>>,
+    /// The edges around the painted region (used by one painted triangle only).
+    outline: Arc<Vec<[u32; 2]>>,
 }
 
 /// `strokes` with every point within `radius` plus the stroke's own radius of the
@@ -163,6 +165,19 @@ impl EditorApp {
         }
     }
 
+    /// The brush's outline around the pointer while the rigidity tool hovers the
+    /// canvas: white, light blue for the eraser (Alt), over a dark line.
+    pub(crate) fn paint_brush_outline(&self, painter: &egui::Painter, pointer: Pos2, erase: bool) {
+        let radius = self.brush.radius as f32 * self.viewport.zoom;
+        painter.circle_stroke(pointer, radius, egui::Stroke::new(3.0, Color32::BLACK));
+        let light = if erase {
+            Color32::from_rgb(120, 200, 255)
+        } else {
+            Color32::WHITE
+        };
+        painter.circle_stroke(pointer, radius, egui::Stroke::new(1.5, light));
+    }
+
     /// The triangles the painted-rigidity overlay drew last (their corners).
     pub fn painted_triangles(&self) -> Vec<[u32; 3]> {
         self.painted.triangles.iter().map(|&(t, _)| t).collect()
@@ -186,18 +201,33 @@ impl EditorApp {
             let key = (mesh, strokes.clone());
             let domain = doc.rig().domain();
             let weights = pipeline::arap::rigidity_weights(domain, strokes);
-            let painted = weights
+            let painted: Vec<([u32; 3], f64)> = weights
                 .iter()
                 .zip(domain.triangles())
                 .filter(|(w, _)| **w != 1.0)
                 .map(|(&w, &t)| (t, w))
                 .collect();
+            let mut edges: std::collections::HashMap<[u32; 2], u32> = Default::default();
+            for (t, _) in &painted {
+                for k in 0..3 {
+                    let (a, b) = (t[k], t[(k + 1) % 3]);
+                    *edges.entry([a.min(b), a.max(b)]).or_default() += 1;
+                }
+            }
+            let mut outline: Vec<[u32; 2]> = edges
+                .into_iter()
+                .filter(|&(_, n)| n == 1)
+                .map(|(e, _)| e)
+                .collect();
+            outline.sort_unstable();
             self.painted = PaintedCache {
                 key: Some(key),
                 triangles: Arc::new(painted),
+                outline: Arc::new(outline),
             };
         }
         let painted = self.painted.triangles.clone();
+        let outline = self.painted.outline.clone();
         let deformed = doc.deformed();
         let mut mesh = Mesh::default();
         for &(t, w) in painted.iter() {
@@ -224,6 +254,18 @@ impl EditorApp {
         }
         if !mesh.is_empty() {
             painter.add(Shape::mesh(mesh));
+        }
+        // The painted region's outline, dark under light, so it shows on any picture
+        // (an orange tint alone vanishes on an orange subject).
+        for (width, color) in [(3.0, Color32::BLACK), (1.5, Color32::WHITE)] {
+            for &[a, b] in outline.iter() {
+                if let (Some(&p), Some(&q)) = (deformed.get(a as usize), deformed.get(b as usize)) {
+                    painter.line_segment(
+                        [self.viewport.to_screen(p), self.viewport.to_screen(q)],
+                        egui::Stroke::new(width, color),
+                    );
+                }
+            }
         }
         if let Some(stroke) = &self.brush_stroke {
             let color = if stroke.erase {

@@ -1001,17 +1001,21 @@ impl EditorApp {
             }
         });
         ui.horizontal_wrapped(|ui| {
+            let make = ui.button("Cage from outline").on_hover_text(
+                "A cage around everything visible in the picture, a few pixels outside \
+                     it, with the number of vertices beside",
+            );
             ui.add(
                 egui::DragValue::new(&mut self.cage.outline_vertices)
                     .range(3..=200)
+                    .prefix("with ")
                     .suffix(" vertices"),
             )
-            .on_hover_text("How many vertices the cage from the outline has");
-            if ui
-                .button("Cage from outline")
-                .on_hover_text("A cage around the picture's visible shape, a few pixels outside it")
-                .clicked()
-            {
+            .on_hover_text("How many vertices a cage from the outline gets");
+            if make.clicked() {
+                // The button gives up the keys, so Enter goes on to Solve rather than
+                // making the cage anew.
+                make.surrender_focus();
                 self.cage_from_outline();
             }
         });
@@ -1078,10 +1082,12 @@ impl EditorApp {
     /// `t`, and `Q(k)`, the share influenced by at least `k` cage vertices.
     pub(crate) fn locality_panel(&mut self, ui: &mut Ui) {
         ui.heading("Locality");
+        // While a new cage is drawn, the old one's statistics would only mislead.
+        let drawing = self.cage.draft.is_some();
         let solution = self
             .doc
             .as_ref()
-            .filter(|d| d.method() == Method::Lbc)
+            .filter(|d| d.method() == Method::Lbc && !drawing)
             .and_then(|d| d.cage_solution().cloned());
         let Some(solution) = solution else {
             ui.label(

@@ -5,7 +5,7 @@ use egui::{
     Color32, CursorIcon, Key, PointerButton, Pos2, Rect, Sense, Shape, Stroke, StrokeKind, Ui, Vec2,
 };
 use glam::DVec2;
-use project::HandleSpec;
+use project::{HandleSpec, Method};
 use weights_core::NodeKind;
 
 use crate::app::{EditorApp, Grip, HandleDrag, Tool};
@@ -127,7 +127,20 @@ impl EditorApp {
             if self.show.rigidity {
                 self.paint_rigidity(&painter);
             }
-            self.paint_overlays(&painter);
+            let (pointer, alt) = ui.input(|i| (i.pointer.latest_pos(), i.modifiers.alt));
+            if self.tool == Tool::Rigidity
+                && let Some(p) = pointer.filter(|p| rect.contains(*p))
+            {
+                self.paint_brush_outline(&painter, p, alt);
+            }
+            // Alt over a point handle shows the ring a drag turns it by.
+            let turning = match &self.drag {
+                Some(drag) if drag.grip == Grip::Rotate => Some(drag.index),
+                _ => pointer
+                    .filter(|_| alt && self.drag.is_none())
+                    .and_then(|p| self.rotation_target(p)),
+            };
+            self.paint_overlays(&painter, turning);
         }
         if let (Some(a), Some(b)) = (self.bar_start, ui.input(|i| i.pointer.latest_pos())) {
             let a = self.viewport.to_screen(a);
@@ -227,6 +240,21 @@ impl EditorApp {
         best.map(|(_, i, g)| (i, g))
     }
 
+    /// The point handle a drag from `pos` with Alt held turns: the nearest one whose
+    /// rotation ring (or anything inside it) is under the pointer, as in Puppet Warp.
+    pub(crate) fn rotation_target(&self, pos: Pos2) -> Option<usize> {
+        let doc = self.doc.as_ref()?;
+        doc.project()
+            .handles
+            .iter()
+            .enumerate()
+            .filter(|(_, h)| matches!(h, HandleSpec::Point { .. }))
+            .map(|(i, h)| (i, self.viewport.to_screen(posed(h)[0]).distance(pos)))
+            .filter(|&(_, d)| d < RING + GRAB)
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(i, _)| i)
+    }
+
     fn canvas_input(&mut self, ui: &Ui, response: &egui::Response) {
         let (modifiers, space, scroll, zoom) = ui.input(|i| {
             (
@@ -263,7 +291,13 @@ impl EditorApp {
             && !matches!(self.tool, Tool::AddBar | Tool::Rigidity | Tool::Cage)
             && let Some(pos) = press
         {
-            match self.hit(pos) {
+            // With Alt, a drag anywhere on or inside a point handle's ring turns it.
+            let turn = modifiers
+                .alt
+                .then(|| self.rotation_target(pos))
+                .flatten()
+                .map(|i| (i, Grip::Rotate));
+            match turn.or_else(|| self.hit(pos)) {
                 Some((index, grip)) => self.start_drag(index, grip, pos, modifiers),
                 None => self.panning = matches!(self.tool, Tool::Puppet | Tool::Select),
             }
@@ -400,10 +434,21 @@ impl EditorApp {
 
     /// Moves the dragged handle so the grabbed point follows the pointer.
     pub(crate) fn drag_to(&mut self, pointer: DVec2) {
-        let Some(drag) = &self.drag else { return };
-        let delta = pointer - drag.pointer;
+        let Some(drag) = &mut self.drag else { return };
         let [a, b] = posed(&drag.start);
         let centre = (a + b) * 0.5;
+        if drag.grip == Grip::Rotate {
+            // A turn started on the centre has no direction yet: it is measured from
+            // where the pointer first is a few screen points away.
+            let near = 4.0 / f64::from(self.viewport.zoom.max(1e-6));
+            if (drag.pointer - centre).length() < near {
+                if (pointer - centre).length() >= near {
+                    drag.pointer = pointer;
+                }
+                return;
+            }
+        }
+        let delta = pointer - drag.pointer;
         let turn = angle_between(drag.pointer - centre, pointer - centre);
         let stretch = ((pointer - centre).length() / (drag.pointer - centre).length().max(1e-9))
             .clamp(0.05, 20.0);
@@ -459,11 +504,15 @@ impl EditorApp {
         self.set_pose(index, handle);
     }
 
-    fn paint_overlays(&self, painter: &egui::Painter) {
+    /// Paints the handles (with the rotation ring of `turning`, the point handle Alt
+    /// is over or being turned), and for the C² weights the virtual handles and the
+    /// dual graph when asked for.
+    fn paint_overlays(&self, painter: &egui::Painter, turning: Option<usize>) {
         let Some(doc) = &self.doc else { return };
         let rig = doc.rig();
         let v = &self.viewport;
-        if self.show.dual_graph {
+        let c2 = doc.method() == Method::C2;
+        if self.show.dual_graph && c2 {
             for &(a, b) in self.dual_graph.1.iter() {
                 let (a, b) = (a as usize, b as usize);
                 if a < rig.nodes().len() && b < rig.nodes().len() {
@@ -477,7 +526,7 @@ impl EditorApp {
                 }
             }
         }
-        if self.show.virtual_handles {
+        if self.show.virtual_handles && c2 {
             for (k, node) in rig.nodes().iter().enumerate() {
                 if matches!(node.kind, NodeKind::Virtual) {
                     let c = v.to_screen(doc.node_position(k));
@@ -504,7 +553,7 @@ impl EditorApp {
             let [a, b] = posed(h).map(|p| v.to_screen(p));
             match h {
                 HandleSpec::Point { rotate, scale, .. } => {
-                    if self.selected == Some(i) {
+                    if self.selected == Some(i) || turning == Some(i) {
                         painter.circle_stroke(a, RING, Stroke::new(2.0, OUTLINE));
                         painter.circle_stroke(a, RING, Stroke::new(1.0, SELECTED));
                         let tick = Vec2::angled(*rotate as f32) * RING;
@@ -530,6 +579,19 @@ impl EditorApp {
             Stroke::new(1.0, Color32::from_gray(70)),
             StrokeKind::Inside,
         );
+    }
+
+    /// Where ARAP takes the mesh vertex under screen point `pos`, as text.
+    fn arap_readout_at(&mut self, pos: Pos2) -> Option<String> {
+        let doc = self.doc.as_mut()?;
+        let (rest, _, _) = doc.unwarp(self.viewport.to_image(pos))?;
+        let vertex = doc.rig().domain().nearest_vertex(rest)? as usize;
+        let at = doc.rig().domain().positions()[vertex];
+        let to = *doc.deformed().get(vertex)?;
+        Some(format!(
+            "vertex {vertex} at ({:.1}, {:.1})\nARAP moves it to ({:.1}, {:.1})",
+            at.x, at.y, to.x, to.y
+        ))
     }
 
     /// The C² weights of the mesh vertex under screen point `pos`, as text.
@@ -576,6 +638,16 @@ impl EditorApp {
                 return;
             }
             match self.cage_hover(pos) {
+                Some(text) => text,
+                None => return,
+            }
+        } else if self
+            .doc
+            .as_ref()
+            .is_some_and(|d| d.method() == Method::Arap)
+        {
+            // ARAP has no weights: where it takes the vertex under the pointer.
+            match self.arap_readout_at(pos) {
                 Some(text) => text,
                 None => return,
             }

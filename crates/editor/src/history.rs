@@ -1,7 +1,7 @@
 //! Undo and redo over whole rig files: a rig file is a few hundred bytes per handle,
 //! so a snapshot per step is simpler and safer than inverse commands.
 
-use project::Project;
+use project::{HandleSpec, Project};
 
 /// Steps kept before the oldest is forgotten.
 const LIMIT: usize = 500;
@@ -81,6 +81,94 @@ impl History {
     pub fn clear(&mut self) {
         self.undo.clear();
         self.redo.clear();
+    }
+}
+
+/// What changed from `from` to `to`, in a few words for the status line ("a handle
+/// added", "the method: ARAP", "the pose of handle 2"…).
+pub fn describe_change(from: &Project, to: &Project) -> String {
+    let rest = |h: &HandleSpec| match h {
+        HandleSpec::Point { rest, .. } => vec![rest[0], rest[1]],
+        HandleSpec::Bar { rest, .. } => vec![rest[0][0], rest[0][1], rest[1][0], rest[1][1]],
+    };
+    let mut parts: Vec<String> = Vec::new();
+    if from.method != to.method {
+        parts.push(format!("the method: {}", to.method.label()));
+    }
+    let (a, b) = (from.handles.len(), to.handles.len());
+    let plural = |n: usize| if n == 1 { "" } else { "s" };
+    if b > a {
+        parts.push(format!("{} handle{} added", b - a, plural(b - a)));
+    } else if a > b {
+        parts.push(format!("{} handle{} removed", a - b, plural(a - b)));
+    } else if from
+        .handles
+        .iter()
+        .map(rest)
+        .ne(to.handles.iter().map(rest))
+    {
+        parts.push("the handles".to_owned());
+    } else {
+        let posed: Vec<usize> = from
+            .handles
+            .iter()
+            .zip(&to.handles)
+            .enumerate()
+            .filter(|(_, (x, y))| x != y)
+            .map(|(i, _)| i + 1)
+            .collect();
+        match posed.as_slice() {
+            [] => {}
+            [one] => parts.push(format!("the pose of handle {one}")),
+            _ => parts.push(format!("the pose of {} handles", posed.len())),
+        }
+    }
+    if from.density != to.density {
+        parts.push(format!(
+            "the mesh density ({})",
+            to.density.map_or("default".to_owned(), |d| d.to_string())
+        ));
+    }
+    if (
+        from.alpha,
+        from.degree,
+        from.middle,
+        from.fixed_boundary,
+        from.metric,
+        from.placement,
+    ) != (
+        to.alpha,
+        to.degree,
+        to.middle,
+        to.fixed_boundary,
+        to.metric,
+        to.placement,
+    ) {
+        parts.push("the weights' settings".to_owned());
+    }
+    if from.rigidity != to.rigidity {
+        parts.push("the painted rigidity".to_owned());
+    }
+    match (&from.cage, &to.cage) {
+        (None, Some(_)) => parts.push("a cage".to_owned()),
+        (Some(_), None) => parts.push("the cage removed".to_owned()),
+        (Some(x), Some(y)) if x.rest != y.rest => parts.push("the cage".to_owned()),
+        (Some(x), Some(y)) if x.pose != y.pose => parts.push("the cage's pose".to_owned()),
+        _ => {}
+    }
+    if from.lbc != to.lbc {
+        parts.push("the cage's settings".to_owned());
+    }
+    if from.canvas != to.canvas {
+        parts.push("the export canvas".to_owned());
+    }
+    if from.arap != to.arap {
+        parts.push("ARAP's settings".to_owned());
+    }
+    if parts.is_empty() {
+        "nothing visible".to_owned()
+    } else {
+        parts.join(", ")
     }
 }
 

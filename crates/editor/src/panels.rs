@@ -55,7 +55,10 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
         "Drag a handle",
         "Move it (a bar's end: turn and stretch the bar)",
     ),
-    ("Alt + drag, or drag the ring", "Rotate the handle"),
+    (
+        "Alt + drag near a point, or drag the ring",
+        "Rotate the handle (Alt shows its ring; a drag anywhere on or in it turns)",
+    ),
     ("Shift + drag", "Scale the handle"),
     ("Alt + click a handle", "Delete it"),
     ("Drag empty canvas", "Pan (Puppet and Select tools)"),
@@ -397,9 +400,19 @@ impl EditorApp {
         let cage = self.cage_view();
         ui.checkbox(&mut self.show.mesh, "Show mesh");
         if !cage {
-            ui.checkbox(&mut self.show.virtual_handles, "Virtual handles");
-            ui.checkbox(&mut self.show.cells, "Voronoi cells");
-            ui.checkbox(&mut self.show.dual_graph, "Dual graph");
+            // Virtual handles and their dual graph belong to the C² weights.
+            let c2 = self.doc.as_ref().is_none_or(|d| d.method() == Method::C2);
+            let c2_only = "The C² weights' own: other methods have no virtual handles";
+            ui.add_enabled_ui(c2, |ui| {
+                ui.checkbox(&mut self.show.virtual_handles, "Virtual handles")
+                    .on_disabled_hover_text(c2_only);
+            });
+            ui.checkbox(&mut self.show.cells, "Voronoi cells")
+                .on_hover_text("The C² cells, which also decide the overlap order");
+            ui.add_enabled_ui(c2, |ui| {
+                ui.checkbox(&mut self.show.dual_graph, "Dual graph")
+                    .on_disabled_hover_text(c2_only);
+            });
         }
         ui.checkbox(&mut self.show.heat, "Weight heat map")
             .on_hover_text(if cage {
@@ -494,6 +507,9 @@ impl EditorApp {
         }
         ui.checkbox(&mut self.auto_rotate, "Auto-rotate points")
             .on_hover_text("Point handles turn with their neighbours' motion");
+        // The selected handle right under the tools, so it shows whatever else the
+        // panel holds.
+        self.handle_section(ui);
         ui.separator();
         ui.heading("Method");
         self.method_choice(ui);
@@ -511,12 +527,16 @@ impl EditorApp {
         }
         ui.heading("Show");
         self.overlay_toggles(ui);
-        ui.separator();
+    }
+
+    /// The selected handle: where it is, how it is posed, its overlap depth.
+    fn handle_section(&mut self, ui: &mut Ui) {
         let mut forward = None;
         if let Some(i) = self.selected
             && let Some(doc) = &self.doc
             && let Some(h) = doc.project().handles.get(i)
         {
+            ui.separator();
             ui.heading(format!("Handle {}", i + 1));
             let depth = h.depth();
             // Wrapped, so selecting a handle never widens the panel (which would
@@ -540,9 +560,12 @@ impl EditorApp {
                     ..
                 } => {
                     ui.label(format!("point at ({:.1}, {:.1})", rest[0], rest[1]));
+                    // No "-0.0" for a move that rounds to nothing.
+                    let tidy = |v: f64| if v.abs() < 0.05 { 0.0 } else { v };
                     ui.label(format!(
                         "moved by ({:.1}, {:.1})",
-                        translate[0], translate[1]
+                        tidy(translate[0]),
+                        tidy(translate[1])
                     ));
                     ui.label(format!(
                         "rotated {:.1}°, scaled {:.2}×",
@@ -563,10 +586,22 @@ impl EditorApp {
         }
     }
 
+    /// The method the method selector shows: the document's, or LBC while the cage
+    /// tool draws a cage (drawing one is LBC's, even before it exists).
+    pub fn method_shown(&self) -> Option<Method> {
+        let doc = self.doc.as_ref()?;
+        Some(if self.tool == Tool::Cage {
+            Method::Lbc
+        } else {
+            doc.method()
+        })
+    }
+
     /// The warping method: one undo step; the picture, handles and pose stay.
     fn method_choice(&mut self, ui: &mut Ui) {
-        let Some(doc) = &self.doc else { return };
-        let current = doc.method();
+        let Some(current) = self.method_shown() else {
+            return;
+        };
         let mut chosen = current;
         ui.horizontal_wrapped(|ui| {
             for m in Method::ALL {
@@ -601,7 +636,12 @@ impl EditorApp {
         let current = doc.settings();
         let mut draft = self.settings_draft.unwrap_or(current);
         let mut commit = false;
-        let released = |r: &egui::Response| r.drag_stopped() || (r.changed() && !r.dragged());
+        // A value typed into a slider's field applies when the field is left (Enter, Tab
+        // or a click elsewhere), not at every keystroke: typing 41000 must not re-mesh
+        // at 4, 41 and 410 on the way.
+        let released = |r: &egui::Response| {
+            r.drag_stopped() || r.lost_focus() || (r.changed() && !r.dragged() && !r.has_focus())
+        };
         let r = ui.add(egui::Slider::new(&mut draft.alpha, 0.0..=1.0).text("α (shape factor)"));
         commit |= released(&r);
         let r = ui.add(egui::Slider::new(&mut draft.degree, 5..=25).text("Basis degree"));
@@ -771,17 +811,26 @@ impl EditorApp {
 
     fn help_window(&mut self, ctx: &egui::Context) {
         let mut open = self.help_open;
+        // Never taller than the window: the list scrolls.
+        let height = (ctx.content_rect().height() - 80.0).max(120.0);
         egui::Window::new("Keyboard shortcuts")
             .open(&mut open)
             .resizable(false)
+            .default_height(height)
+            .max_height(height)
             .show(ctx, |ui| {
-                egui::Grid::new("shortcuts").striped(true).show(ui, |ui| {
-                    for (keys, what) in SHORTCUTS {
-                        ui.strong(*keys);
-                        ui.label(*what);
-                        ui.end_row();
-                    }
-                });
+                egui::ScrollArea::vertical()
+                    .max_height(height)
+                    .min_scrolled_height(height)
+                    .show(ui, |ui| {
+                        egui::Grid::new("shortcuts").striped(true).show(ui, |ui| {
+                            for (keys, what) in SHORTCUTS {
+                                ui.strong(*keys);
+                                ui.label(*what);
+                                ui.end_row();
+                            }
+                        });
+                    });
             });
         self.help_open = open;
     }

@@ -485,3 +485,78 @@ fn undo_to_a_posed_cage_whose_coordinates_were_forgotten_solves_it_first() {
     assert_eq!(h.state().cage_state(), CageState::Posed);
     h.state().sanity_check().expect("consistent");
 }
+
+#[test]
+fn after_a_cage_from_the_outline_enter_solves_it() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    h.state_mut().cage_vertices = DENSITY;
+    click_label(&mut h, "LBC cage");
+    // Drawing a cage is LBC's: the method shows as LBC before the cage exists.
+    assert_eq!(h.state().tool, Tool::Cage);
+    assert_eq!(h.state().method_shown(), Some(Method::Lbc));
+    click_label(&mut h, "Cage from outline");
+    let first = h.state().document().and_then(|d| d.cage()).cloned();
+    assert!(first.is_some());
+    // The button gave up the keys: Enter solves, it does not make the cage anew.
+    h.key_press(Key::Enter);
+    h.step();
+    assert!(h.state().is_busy(), "Enter started the solve");
+    settle(&mut h);
+    assert_eq!(
+        h.state().cage_state(),
+        CageState::Posed,
+        "{:?}",
+        h.state().message
+    );
+    assert_eq!(h.state().document().and_then(|d| d.cage()).cloned(), first);
+    h.state().sanity_check().expect("consistent");
+}
+
+#[test]
+fn undoing_out_of_lbc_leaves_the_cage_tool_and_says_what_it_undid() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = solved_body(dir.path());
+    assert_eq!(h.state().tool, Tool::Cage);
+    // Back to before the cage: C², nothing for the cage tool to act on.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    settle(&mut h);
+    let doc = h.state().document().expect("doc");
+    assert_eq!(doc.method(), Method::C2);
+    assert_eq!(h.state().tool, Tool::Puppet);
+    let message = h.state().message.clone().expect("a message");
+    assert!(message.text.starts_with("undone: "), "{message:?}");
+    assert!(message.text.contains("the cage removed"), "{message:?}");
+    assert!(!message.text.contains("drag a vertex"), "{message:?}");
+    // Redo comes back to LBC and its tool.
+    h.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
+    h.run();
+    settle(&mut h);
+    assert_eq!(h.state().tool, Tool::Cage);
+    let message = h.state().message.clone().expect("a message");
+    assert!(message.text.starts_with("redone: "), "{message:?}");
+    h.state().sanity_check().expect("consistent");
+}
+
+#[test]
+fn a_new_cage_being_drawn_hides_the_old_cages_statistics() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = solved_body(dir.path());
+    h.state_mut().show.locality = true;
+    h.run();
+    assert!(
+        h.query_by_label_contains("statistics (§5) of the coordinates of this cage")
+            .is_some()
+    );
+    click_label(&mut h, "New cage");
+    h.run();
+    assert!(
+        h.query_by_label_contains("statistics (§5) of the coordinates of this cage")
+            .is_none()
+    );
+    assert!(
+        h.query_by_label_contains("Once the cage is solved")
+            .is_some()
+    );
+}

@@ -162,6 +162,11 @@ fn painted_rigidity_is_one_undo_step_and_erases() {
         .filter(|w| **w > 1.0)
         .count();
     assert!(stiff > 10, "{stiff} painted triangles");
+    // The painted region shows with its outline (dark and light, so it shows on any
+    // picture), and the brush with its own where the pointer hovers.
+    h.hover_at(at(&h, 250.0, 300.0));
+    h.run();
+    h.snapshot("editor_rigidity");
 
     h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
     h.run();

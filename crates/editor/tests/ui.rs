@@ -339,3 +339,169 @@ fn crc(bytes: &[u8]) -> u32 {
     }
     !c
 }
+
+#[test]
+fn alt_drag_turns_a_pin_from_its_centre_or_anywhere_on_its_ring() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    click_label(&mut h, "Clear all handles");
+    click_label(&mut h, "Add point");
+    let pin = at(&h, 440.0, 238.0);
+    click_at(&mut h, pin);
+    click_label(&mut h, "Select");
+    h.state_mut().selected = None;
+    let rotation = |h: &Harness<'_, EditorApp>| match handles(h)[0] {
+        HandleSpec::Point { rotate, .. } => rotate,
+        HandleSpec::Bar { .. } => unreachable!(),
+    };
+    // From the centre: the turn is measured from where the pointer first leaves it.
+    let origin = h.state().viewport.origin;
+    drag(&mut h, pin, pin + Vec2::new(0.0, -20.0), Modifiers::ALT);
+    // Then a quarter turn around it… from the top to the right.
+    drag(
+        &mut h,
+        pin + Vec2::new(0.0, -20.0),
+        pin + Vec2::new(20.0, 0.0),
+        Modifiers::ALT,
+    );
+    let turned = rotation(&h);
+    assert!(
+        (turned - std::f64::consts::FRAC_PI_2).abs() < 0.2,
+        "{turned}"
+    );
+    // From inside the ring but off the dot (12 points out): a turn, not a pan.
+    drag(
+        &mut h,
+        pin + Vec2::new(12.0, 0.0),
+        pin + Vec2::new(0.0, 12.0),
+        Modifiers::ALT,
+    );
+    assert_eq!(h.state().viewport.origin, origin, "the view did not pan");
+    assert!(
+        (rotation(&h) - turned - std::f64::consts::FRAC_PI_2).abs() < 0.2,
+        "{}",
+        rotation(&h)
+    );
+    // A plain drag there pans, as before.
+    drag(
+        &mut h,
+        pin + Vec2::new(15.0, 0.0),
+        pin + Vec2::new(40.0, 0.0),
+        Modifiers::NONE,
+    );
+    assert_ne!(h.state().viewport.origin, origin);
+}
+
+#[test]
+fn undo_redo_and_method_switches_say_what_they_did() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    let text = |h: &Harness<'_, EditorApp>| {
+        h.state()
+            .message
+            .as_ref()
+            .map(|m| m.text.clone())
+            .unwrap_or_default()
+    };
+    click_label(&mut h, "ARAP");
+    assert!(text(&h).starts_with("ARAP: "), "{}", text(&h));
+    click_label(&mut h, "Add point");
+    let p = at(&h, 330.0, 330.0);
+    click_at(&mut h, p);
+    assert!(text(&h).starts_with("added a point handle"), "{}", text(&h));
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert_eq!(text(&h), "undone: 1 handle removed");
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert_eq!(text(&h), "undone: the method: C² weights");
+    h.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
+    h.run();
+    assert_eq!(text(&h), "redone: the method: ARAP");
+}
+
+#[test]
+fn a_density_typed_in_applies_when_the_field_is_left() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    let before = h.state().document().expect("doc").settings().density;
+    h.get_by_value(&before.to_string()).click();
+    h.run();
+    h.key_press_modifiers(Modifiers::COMMAND, Key::A);
+    h.run();
+    // Keystroke by keystroke, nothing is re-meshed…
+    for digit in ["4", "1", "0", "0", "0"] {
+        h.event(egui::Event::Text(digit.to_owned()));
+        h.run();
+        assert!(!h.state().is_busy(), "re-meshing at a partial number");
+        assert_eq!(
+            h.state().document().expect("doc").settings().density,
+            before
+        );
+    }
+    // …until Enter leaves the field.
+    h.key_press(Key::Enter);
+    h.step();
+    support::settle(&mut h);
+    assert_eq!(
+        h.state().document().expect("doc").settings().density,
+        41_000
+    );
+}
+
+#[test]
+fn a_click_with_the_bar_tool_says_how_to_draw_a_bar() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    click_label(&mut h, "Add bar");
+    let before = handles(&h).len();
+    let p = at(&h, 300.0, 300.0);
+    click_at(&mut h, p);
+    assert_eq!(handles(&h).len(), before);
+    let message = h.state().message.clone().expect("a message");
+    assert!(message.text.contains("drag from one end"), "{message:?}");
+}
+
+#[test]
+fn the_shortcuts_window_fits_the_window_and_scrolls() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    h.key_press(Key::F1);
+    h.run();
+    h.run();
+    let screen = h.ctx.content_rect();
+    let title = h.get_by_label("Keyboard shortcuts").rect();
+    // The last shortcut is reachable by scrolling, and the window ends on screen.
+    let last = editor::SHORTCUTS.last().expect("shortcuts").1;
+    h.get_by_label(last).scroll_to_me();
+    h.run();
+    let row = h.get_by_label(last).rect();
+    assert!(row.max.y <= screen.max.y, "{row:?} beyond {screen:?}");
+    assert!(title.min.y >= screen.min.y);
+}
+
+#[test]
+fn a_density_the_shape_cannot_hold_says_why() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    // A disc of radius 30 px: about 3,000 px², so at most about 12,000 vertices.
+    let picture = dir.path().join("disc.png");
+    image::RgbaImage::from_fn(100, 100, |x, y| {
+        let inside = (f64::from(x) - 50.0).hypot(f64::from(y) - 50.0) < 30.0;
+        image::Rgba([200, 60, 60, if inside { 255 } else { 0 }])
+    })
+    .save(&picture)
+    .expect("write");
+    let mut app = EditorApp::headless(false);
+    app.open(&picture);
+    app.wait_for_job();
+    let mut settings = app.document().expect("doc").settings();
+    settings.density = 50_000;
+    assert!(app.edit(editor::Edit::Settings(settings)));
+    app.wait_for_job();
+    let message = app.message.clone().expect("a message");
+    assert!(
+        message.text.contains("asked for 50000")
+            && message.text.contains("holds at most 4 vertices a pixel"),
+        "{message:?}"
+    );
+}
