@@ -47,16 +47,16 @@ if [ "$mode" = cage ]; then
   # (Enter) and a wait for the solve.
   xdotool key k
   sleep 1
-  xdotool mousemove 155 374 click 1
+  xdotool mousemove 67 374 click 1
   sleep 1
   xdotool key h
   sleep 0.5
   xdotool key Return
   # The solve takes a few seconds in a release build.
   sleep "${SOLVE_SECONDS:-12}"
-  # The tail's end, then the front leg.
-  drag 842 685 905 610
-  drag 707 309 775 240
+  # The cage's vertex by the tail's end, then the one by the front leg.
+  drag 933 610 975 520
+  drag 739 304 800 235
   xdotool mousemove 1100 760
   sleep 1.5
   import -window root "$out"
