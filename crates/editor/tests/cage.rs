@@ -81,17 +81,22 @@ fn solved_body(dir: &std::path::Path) -> Harness<'static, EditorApp> {
     h.state_mut().cage_vertices = DENSITY;
     draw_cage(&mut h, &BODY);
     assert_eq!(h.state().cage_state(), CageState::Rest);
+    solve_with_enter(&mut h);
+    h
+}
+
+/// Enter solves the cage at rest, on the worker; waits for it to be solved.
+fn solve_with_enter(h: &mut Harness<'_, EditorApp>) {
     h.key_press(Key::Enter);
     h.step();
     assert!(h.state().is_busy(), "the solve runs on the worker");
-    settle(&mut h);
+    settle(h);
     assert_eq!(
         h.state().cage_state(),
         CageState::Posed,
         "{:?}",
         h.state().message
     );
-    h
 }
 
 #[test]
@@ -499,16 +504,7 @@ fn after_a_cage_from_the_outline_enter_solves_it() {
     let first = h.state().document().and_then(|d| d.cage()).cloned();
     assert!(first.is_some());
     // The button gave up the keys: Enter solves, it does not make the cage anew.
-    h.key_press(Key::Enter);
-    h.step();
-    assert!(h.state().is_busy(), "Enter started the solve");
-    settle(&mut h);
-    assert_eq!(
-        h.state().cage_state(),
-        CageState::Posed,
-        "{:?}",
-        h.state().message
-    );
+    solve_with_enter(&mut h);
     assert_eq!(h.state().document().and_then(|d| d.cage()).cloned(), first);
     h.state().sanity_check().expect("consistent");
 }

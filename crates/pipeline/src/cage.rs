@@ -432,6 +432,30 @@ mod tests {
         })
     }
 
+    /// The coordinates of the cage `rest` posed at `pose`, solved on `count` vertices.
+    fn solved(rest: Vec<[f64; 2]>, pose: Option<Vec<[f64; 2]>>, count: usize) -> CageCoordinates {
+        let project = Project {
+            method: Method::Lbc,
+            cage: Some(project::CageSpec { rest, pose }),
+            ..Project::default()
+        };
+        cage_coordinates(
+            &project,
+            CageMesh::Triangulate {
+                target_vertices: count,
+            },
+            &mut |_| true,
+        )
+        .expect("solved")
+    }
+
+    /// A 60 × 40 picture of colour ramps.
+    fn ramps() -> image::RgbaImage {
+        image::RgbaImage::from_fn(60, 40, |x, y| {
+            image::Rgba([(x * 4) as u8, (y * 6) as u8, 90, 255])
+        })
+    }
+
     #[test]
     fn an_outline_cage_has_the_vertices_asked_for_and_encloses_the_whole_shape() {
         let image = cut_out();
@@ -516,19 +540,7 @@ mod tests {
             ],
         ];
         for rest in cages {
-            let project = Project {
-                method: Method::Lbc,
-                cage: Some(project::CageSpec { rest, pose: None }),
-                ..Project::default()
-            };
-            let solved = cage_coordinates(
-                &project,
-                CageMesh::Triangulate {
-                    target_vertices: 400,
-                },
-                &mut |_| true,
-            )
-            .expect("solved");
+            let solved = solved(rest, None, 400);
             let at_rest = warp_by_cage(&image, &solved, Canvas::Keep).expect("warp");
             let changed = at_rest
                 .pixels()
@@ -536,31 +548,16 @@ mod tests {
                 .filter(|(a, b)| a != b)
                 .count();
 
-            assert_eq!(changed, 0, "{:?}", project.cage);
+            assert_eq!(changed, 0, "{:?}", solved.domain.cage().vertices());
         }
     }
 
     #[test]
     fn a_grown_canvas_holds_what_the_cage_takes_beyond_the_picture() {
-        let image = image::RgbaImage::from_fn(60, 40, |x, y| {
-            image::Rgba([(x * 4) as u8, (y * 6) as u8, 90, 255])
-        });
-        let project = Project {
-            method: Method::Lbc,
-            cage: Some(project::CageSpec {
-                rest: vec![[10.0, 10.0], [40.0, 10.0], [40.0, 30.0], [10.0, 30.0]],
-                pose: Some(vec![[40.0, -5.0], [70.0, -5.0], [70.0, 15.0], [40.0, 15.0]]),
-            }),
-            ..Project::default()
-        };
-        let solved = cage_coordinates(
-            &project,
-            CageMesh::Triangulate {
-                target_vertices: 120,
-            },
-            &mut |_| true,
-        )
-        .expect("solved");
+        let image = ramps();
+        let square = vec![[10.0, 10.0], [40.0, 10.0], [40.0, 30.0], [10.0, 30.0]];
+        let moved = vec![[40.0, -5.0], [70.0, -5.0], [70.0, 15.0], [40.0, 15.0]];
+        let solved = solved(square, Some(moved), 120);
         let kept = warp_by_cage(&image, &solved, Canvas::Keep).expect("warp");
         let grown = warp_by_cage(&image, &solved, Canvas::Fit).expect("warp");
         assert_eq!(kept.dimensions(), (60, 40));
@@ -576,25 +573,9 @@ mod tests {
 
     #[test]
     fn a_posed_warp_moves_the_inside_and_keeps_the_outside() {
-        let image = image::RgbaImage::from_fn(60, 40, |x, y| {
-            image::Rgba([(x * 4) as u8, (y * 6) as u8, 90, 255])
-        });
-        let project = Project {
-            method: Method::Lbc,
-            cage: Some(project::CageSpec {
-                rest: vec![[10.0, 10.0], [40.0, 10.0], [40.0, 30.0], [10.0, 30.0]],
-                pose: None,
-            }),
-            ..Project::default()
-        };
-        let solved = cage_coordinates(
-            &project,
-            CageMesh::Triangulate {
-                target_vertices: 120,
-            },
-            &mut |_| true,
-        )
-        .expect("solved");
+        let image = ramps();
+        let square = vec![[10.0, 10.0], [40.0, 10.0], [40.0, 30.0], [10.0, 30.0]];
+        let solved = solved(square, None, 120);
         let at_rest = warp_by_cage(&image, &solved, Canvas::Keep).expect("warp");
         let shift: Vec<DVec2> = solved
             .pose

@@ -471,7 +471,11 @@ impl Warper {
     /// # Errors
     /// As [`Frame::new`], and non-finite deformed positions.
     pub fn frame(&self, width: u32, height: u32) -> Result<Frame> {
-        Frame::new(width, height, &self.deformed()?, self.canvas)
+        match self.canvas {
+            // No need to deform anything for the picture's own frame.
+            Canvas::Keep => Frame::new(width, height, &[], Canvas::Keep),
+            Canvas::Fit => Frame::new(width, height, &self.deformed()?, Canvas::Fit),
+        }
     }
 }
 
@@ -529,8 +533,9 @@ pub fn warp_gpu(image: &RgbaImage, warper: &Warper) -> Result<RgbaImage> {
 pub fn warp_picture(picture: &Picture, warper: &Warper) -> Result<Picture> {
     let rest = warper.rest();
     let (w, h) = picture.dimensions();
-    let frame = warper.frame(w, h)?;
-    let deformed = frame.place(&warper.deformed()?);
+    let deformed = warper.deformed()?;
+    let frame = Frame::new(w, h, &deformed, warper.canvas)?;
+    let deformed = frame.place(&deformed);
     let mesh = render::WarpMesh {
         rest: &rest,
         deformed: &deformed,
@@ -553,8 +558,9 @@ pub fn warp_picture(picture: &Picture, warper: &Warper) -> Result<Picture> {
 pub fn warp(image: &RgbaImage, warper: &Warper) -> Result<RgbaImage> {
     let rest = warper.rest();
     let (w, h) = image.dimensions();
-    let frame = warper.frame(w, h)?;
-    let deformed = frame.place(&warper.deformed()?);
+    let deformed = warper.deformed()?;
+    let frame = Frame::new(w, h, &deformed, warper.canvas)?;
+    let deformed = frame.place(&deformed);
     let mesh = render::WarpMesh {
         rest: &rest,
         deformed: &deformed,
