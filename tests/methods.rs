@@ -260,7 +260,8 @@ fn bad_method_fields_give_one_clear_line_and_keep_the_old_output() {
     assert!(!refused.status.success());
     let stderr = String::from_utf8_lossy(&refused.stderr);
     assert!(
-        stderr.contains("unknown method \"c3\" (known: c2, arap, lbc)"),
+        stderr.contains("invalid value 'c3' for '--method <METHOD>'")
+            && stderr.contains(&format!("[possible values: {}]", project::Method::names())),
         "{stderr}"
     );
     assert_eq!(fs::read(&out).expect("read"), b"precious");
@@ -854,4 +855,62 @@ fn a_grown_canvas_holds_the_whole_warp_for_every_method() {
         stderr.contains("unknown canvas \"huge\" (known: keep, fit)"),
         "{stderr}"
     );
+}
+
+/// Every method draws a 16-bit picture in 16 bits on the CPU (the low bits 8 bits
+/// cannot hold survive), through the one drawing path of the method seam.
+#[test]
+fn every_method_renders_a_sixteen_bit_picture_in_sixteen_bits() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let narrow = load(&data("opaque.png"));
+    let (w, h) = narrow.dimensions();
+    let wide = image::ImageBuffer::<image::Rgba<u16>, Vec<u16>>::from_fn(w, h, |x, y| {
+        let p = narrow.get_pixel(x, y).0;
+        let low = ((x + y) % 64) as u16;
+        image::Rgba(p.map(|c| (u16::from(c) * 257).saturating_sub(low)))
+    });
+    let source = dir.path().join("wide.png");
+    wide.save(&source).expect("save a 16-bit PNG");
+    let (fw, fh) = (f64::from(w), f64::from(h));
+    let rest = [
+        [fw / 4.0, fh / 4.0],
+        [3.0 * fw / 4.0, fh / 4.0],
+        [3.0 * fw / 4.0, 3.0 * fh / 4.0],
+        [fw / 4.0, 3.0 * fh / 4.0],
+    ];
+    let mut pose = rest;
+    pose[2] = [0.8 * fw, 0.85 * fh];
+    let rig = dir.path().join("rig.json");
+    fs::write(
+        &rig,
+        serde_json::json!({
+            "version": 1, "density": 800,
+            "handles": [
+                {"type": "point", "rest": [fw * 0.2, fh * 0.2]},
+                {"type": "point", "rest": [fw * 0.7, fh * 0.6], "translate": [9.0, -6.0]}
+            ],
+            "cage": {"rest": rest, "pose": pose}, "lbc": {"density": 400}
+        })
+        .to_string(),
+    )
+    .expect("write rig");
+    for method in project::Method::ALL {
+        let out = dir.path().join(format!("{}.png", method.name()));
+        ok(&render_args(
+            &source,
+            &rig,
+            &out,
+            &["--method", method.name()],
+        ));
+        let got = image::open(&out).expect("open");
+        assert_eq!(got.color(), image::ColorType::Rgba16, "{}", method.name());
+        let got = got.into_rgba16();
+        assert!(
+            got.as_raw().iter().any(|&c| c % 257 != 0),
+            "{}: low bits survive",
+            method.name()
+        );
+        // And it moved something.
+        assert_ne!(got.as_raw(), wide.as_raw(), "{}", method.name());
+    }
 }

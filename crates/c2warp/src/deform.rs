@@ -7,31 +7,29 @@ use anyhow::{Result, bail};
 use glam::DVec2;
 use pipeline::{Method, load_project};
 
-use crate::Source;
-use crate::export::{self, Built};
+use crate::{Input, Source};
 
 /// Runs `c2warp deform`: meshes (or reads) the samples, sets up `method` (else the
-/// rig's) for the rig's handles and pose, and writes one `v x y 0` line per vertex in
+/// rig's) for the rig's controls and pose, and writes one `v x y 0` line per vertex in
 /// full precision — the file's vertices in its order, then those the command inserted
 /// — and the triangles as `f a b c` (1-based).
 pub fn run(source: &Source, rig_path: &Path, method: Option<Method>, output: &Path) -> Result<()> {
     let mut project = load_project(rig_path)?;
-    let method = method.unwrap_or(project.method);
-    project.method = method;
-    if method == Method::Lbc {
-        let solved = crate::lbc::solve(source, &project)?;
-        let deformed = solved.deformed()?;
-        return write_obj(output, method, &deformed, solved.domain.triangles());
+    if let Some(method) = method {
+        project.method = method;
     }
+    let input = Input::load(source)?;
     let progress = crate::progress::Steps::new(3);
     progress.step("meshing and weighting");
-    let Built { rig, picture, .. } = export::build(source, &project, &progress.weighting())?;
+    // With --mesh, the given mesh is the method's own (ARAP solves on it, LBC takes it
+    // as the cage's inside); with --image, each meshes the picture its own way.
+    let warper = pipeline::setup(input.source(), &project, &progress)?;
+    crate::warn(&*warper.deformer);
     progress.step("deforming");
-    // With --mesh, the given mesh is ARAP's own; with --image, ARAP meshes the picture.
-    let deformer = pipeline::deformer(&project, rig, picture.as_ref())?;
+    let deformer = &warper.deformer;
     let deformed = deformer.deformed();
     progress.step("writing");
-    write_obj(output, method, &deformed, deformer.domain().triangles())?;
+    write_obj(output, project.method, &deformed, deformer.triangles())?;
     progress.finish();
     Ok(())
 }

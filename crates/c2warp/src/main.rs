@@ -3,7 +3,6 @@
 mod bench;
 mod deform;
 mod export;
-mod lbc;
 mod progress;
 mod runtime_dir;
 
@@ -16,6 +15,7 @@ use clap::{Args, Parser, Subcommand};
 use pipeline::{DEFAULT_IMAGE, DEFAULT_RIG, Deformer, Method, load_picture, load_project};
 use project::Project;
 use render::Picture;
+use weights_core::Rig;
 
 #[derive(Parser)]
 #[command(
@@ -56,13 +56,13 @@ enum Command {
         /// Target number of mesh vertices (overrides the rig's `density`).
         #[arg(long)]
         density: Option<usize>,
-        /// Draw with the GPU (a software Vulkan driver works too), blending the handle
-        /// transforms in the vertex shader, instead of on the CPU. The GPU draws in 8
-        /// bits per channel: a 16-bit source gives an 8-bit PNG.
+        /// Draw with the GPU (a software Vulkan driver works too) instead of on the
+        /// CPU: a skinned method's transforms are blended in the vertex shader. The GPU
+        /// draws in 8 bits per channel: a 16-bit source gives an 8-bit PNG.
         #[arg(long)]
         gpu: bool,
-        /// The warping method: c2, arap or lbc (overrides the rig's `method`).
-        #[arg(long)]
+        /// The warping method (overrides the rig's `method`).
+        #[arg(long, value_parser = methods())]
         method: Option<Method>,
         /// The output's frame: `keep` the picture's size (what the warp moves beyond
         /// its edge is cut off), or `fit` it to the warped picture (grown to hold all
@@ -78,8 +78,8 @@ enum Command {
         /// The rig file (RIG.json).
         #[arg(long)]
         rig: PathBuf,
-        /// The warping method: c2, arap or lbc (overrides the rig's `method`).
-        #[arg(long)]
+        /// The warping method (overrides the rig's `method`).
+        #[arg(long, value_parser = methods())]
         method: Option<Method>,
         /// Where to write the OBJ (`-`: standard output).
         #[arg(short, long)]
@@ -97,7 +97,7 @@ enum Command {
         output: PathBuf,
     },
     /// Time the method's steps and print JSON: for C², the rig build, handle insertion
-    /// and removal, and deformation; for ARAP, registration, compilation and update.
+    /// and removal, and deformation; for the others, their setup and a pose.
     Bench {
         #[command(flatten)]
         source: Source,
@@ -107,8 +107,8 @@ enum Command {
         /// Random positions to insert and remove a handle at.
         #[arg(long, default_value_t = 31)]
         positions: usize,
-        /// The method to time: c2, arap or lbc (overrides the rig's `method`).
-        #[arg(long)]
+        /// The method to time (overrides the rig's `method`).
+        #[arg(long, value_parser = methods())]
         method: Option<Method>,
     },
     /// Write a rig whose cage (LBC) encloses every visible pixel of a picture: the
@@ -153,6 +153,74 @@ struct Source {
     /// Target number of mesh vertices when meshing an image.
     #[arg(long, conflicts_with = "mesh")]
     density: Option<usize>,
+}
+
+/// `--method`: every method by its rig-file name.
+fn methods() -> impl clap::builder::TypedValueParser<Value = Method> {
+    use clap::builder::TypedValueParser as _;
+    clap::builder::PossibleValuesParser::new(Method::ALL.map(Method::name))
+        .try_map(|name| name.parse::<Method>())
+}
+
+/// A [`Source`] loaded: the picture to mesh, or the mesh given.
+enum Input {
+    Picture {
+        image: image::RgbaImage,
+        density: Option<usize>,
+    },
+    Mesh(mesh::Mesh),
+}
+
+impl Input {
+    /// Reads the picture or the OBJ mesh `source` names (a mesh is checked).
+    fn load(source: &Source) -> Result<Self> {
+        if let Some(density) = source.density {
+            // Before the slow part: the rule and the message of a rig file's density.
+            project::validate_density(density)?;
+        }
+        if let Some(path) = &source.image {
+            return Ok(Self::Picture {
+                image: pipeline::load_image(path)?,
+                density: source.density,
+            });
+        }
+        let path = source.mesh.as_deref().context("give --mesh or --image")?;
+        let mesh = pipeline::load_obj(path)?;
+        mesh.sanity_check()
+            .with_context(|| format!("mesh {}", path.display()))?;
+        Ok(Self::Mesh(mesh))
+    }
+
+    /// What a method is set up on.
+    fn source(&self) -> pipeline::Source<'_> {
+        match self {
+            Self::Picture { image, density } => pipeline::Source::Picture {
+                image,
+                density: *density,
+            },
+            Self::Mesh(mesh) => pipeline::Source::Mesh(mesh),
+        }
+    }
+
+    /// Whether the mesh is made from a picture.
+    fn is_picture(&self) -> bool {
+        matches!(self, Self::Picture { .. })
+    }
+
+    /// The vertices a mesh file had.
+    fn file_vertices(&self) -> Option<usize> {
+        match self {
+            Self::Picture { .. } => None,
+            Self::Mesh(mesh) => Some(mesh.vertices.len()),
+        }
+    }
+}
+
+/// Prints what the method says of its setup (a solve that did not converge).
+fn warn(deformer: &dyn Deformer) {
+    for note in deformer.notes() {
+        eprintln!("warning: {note}");
+    }
 }
 
 fn main() -> ExitCode {
@@ -272,10 +340,6 @@ fn render(
         project.canvas = canvas;
     }
     let picture = load_picture(image)?;
-    if project.method == Method::Lbc {
-        let warped = lbc::render(&picture, &project, density, gpu)?;
-        return write_png(output, &warped);
-    }
     warp_and_save(&picture, &project, density, output, gpu)?;
     Ok(())
 }
@@ -295,7 +359,8 @@ fn warp_and_save(
     let progress = progress::Steps::new(3);
     progress.step("meshing and weighting");
     let rgba8 = picture.to_rgba8();
-    let warper = pipeline::prepare_warper(&rgba8, project, density, &progress.weighting())?;
+    let warper = pipeline::prepare_warper(&rgba8, project, density, &progress)?;
+    warn(&*warper.deformer);
     progress.step("rendering");
     let warped = if gpu {
         Picture::Rgba8(pipeline::warp_gpu(&rgba8, &warper)?)
@@ -352,7 +417,7 @@ fn demo(output: &Path) -> Result<()> {
     let picture = render::decode_picture(DEFAULT_IMAGE, &render::ImageLimits::default())?;
     let project = Project::from_json(DEFAULT_RIG).context("built-in rig")?;
     let deformer = warp_and_save(&picture, &project, None, output, false)?;
-    let pipeline::Output::Skinned(rig) = deformer.output() else {
+    let Some(rig) = deformer.as_any().downcast_ref::<Rig>() else {
         bail!("the built-in rig uses the C² weights");
     };
     let stats = rig.stats();

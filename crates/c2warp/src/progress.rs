@@ -6,9 +6,13 @@ use std::sync::atomic::{AtomicU32, Ordering};
 use indicatif::{ProgressBar, ProgressStyle};
 use weights_core::{Phase, Progress};
 
-/// Numbered steps with a spinner.
+/// Numbered steps with a spinner; as a [`pipeline::Listener`], it shows a setup's
+/// progress (the rig build's phase and percentage, a cage solve's iterations) in the
+/// current step's message.
 pub struct Steps {
     bar: ProgressBar,
+    /// The rig build's phase and percentage last shown.
+    shown: AtomicU32,
 }
 
 impl Steps {
@@ -20,7 +24,10 @@ impl Steps {
                 .unwrap_or_else(|_| ProgressStyle::default_bar()),
         );
         bar.enable_steady_tick(std::time::Duration::from_millis(120));
-        Self { bar }
+        Self {
+            bar,
+            shown: AtomicU32::new(u32::MAX),
+        }
     }
 
     /// Starts the next step.
@@ -29,34 +36,34 @@ impl Steps {
         self.bar.set_message(message);
     }
 
-    /// A callback for a rig build ([`pipeline::prepare_with_progress`]) that shows
-    /// its phase and percentage in the current step's message.
-    pub fn weighting(&self) -> impl Fn(Progress) + Sync + '_ {
-        let shown = AtomicU32::new(u32::MAX);
-        move |progress: Progress| {
-            let percent = (progress.fraction() * 100.0) as u32;
-            let key = percent * 4 + progress.phase as u32;
-            if shown.swap(key, Ordering::Relaxed) != key {
-                let phase = match progress.phase {
-                    Phase::Partition => "Voronoi cells",
-                    Phase::VirtualHandles => "virtual handles",
-                    Phase::Weights => "weights",
-                    Phase::Transforms => "harmonic coordinates",
-                };
-                self.bar
-                    .set_message(format!("meshing and weighting: {phase}, {percent}%"));
-            }
-        }
-    }
-
-    /// Replaces the current step's message.
-    pub fn message(&self, message: String) {
-        self.bar.set_message(message);
-    }
-
     /// Clears the counter.
     pub fn finish(&self) {
         self.bar.finish_and_clear();
+    }
+}
+
+impl pipeline::Listener for Steps {
+    fn weighting(&self, progress: Progress) {
+        let percent = (progress.fraction() * 100.0) as u32;
+        let key = percent * 4 + progress.phase as u32;
+        if self.shown.swap(key, Ordering::Relaxed) != key {
+            let phase = match progress.phase {
+                Phase::Partition => "Voronoi cells",
+                Phase::VirtualHandles => "virtual handles",
+                Phase::Weights => "weights",
+                Phase::Transforms => "harmonic coordinates",
+            };
+            self.bar
+                .set_message(format!("meshing and weighting: {phase}, {percent}%"));
+        }
+    }
+
+    fn solving(&self, progress: &pipeline::SolveProgress) -> bool {
+        self.bar.set_message(format!(
+            "solving the cage's coordinates: iteration {}, residuals {:.1e} / {:.1e}",
+            progress.iteration, progress.primal_residual, progress.dual_residual
+        ));
+        true
     }
 }
 

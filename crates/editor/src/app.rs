@@ -1307,34 +1307,29 @@ impl EditorApp {
             .filter(|_| project.method == Method::Lbc)
             .map(|key| (doc.solution_for(&key).cloned(), key, doc.cage_pose()));
         Some(move || {
-            if let Some((solution, key, pose)) = cage {
-                return export_cage(
-                    &image,
-                    &path,
-                    solution,
-                    &key,
-                    &pose,
-                    project.canvas,
-                    &cancel,
-                );
-            }
             let clock = Instant::now();
             let result = (|| -> Result<()> {
-                let warper = pipeline::prepare_warper(&image, &project, None, &|_| {})?;
+                let warper = match cage {
+                    // The cage's coordinates already solved for it (else solved here).
+                    Some((solution, key, pose)) => {
+                        let solution = match solution {
+                            Some(solution) => solution,
+                            None => crate::document::solve_cage(&key, &mut |_| !cancel.is_set())?,
+                        };
+                        let deformer = pipeline::cage::CageDeformer::new(solution, pose)?;
+                        pipeline::Warper::in_mesh_order(Box::new(deformer), project.canvas)
+                    }
+                    None => pipeline::prepare_warper(&image, &project, None, &())?,
+                };
                 // A 16-bit picture exports with 16 bits, as `c2warp render` does.
-                if let Some(deep) = deep {
-                    let warped = pipeline::warp_picture(&deep, &warper)?;
-                    if cancel.is_set() {
-                        anyhow::bail!("cancelled");
-                    }
-                    render::save_png_atomic(&path, &warped)?;
-                } else {
-                    let warped = pipeline::warp(&image, &warper)?;
-                    if cancel.is_set() {
-                        anyhow::bail!("cancelled");
-                    }
-                    render::save_png_atomic(&path, &warped)?;
+                let warped = match &deep {
+                    Some(deep) => pipeline::warp_picture(deep, &warper)?,
+                    None => render::Picture::Rgba8(pipeline::warp(&image, &warper)?),
+                };
+                if cancel.is_set() {
+                    anyhow::bail!("cancelled");
                 }
+                render::save_png_atomic(&path, &warped)?;
                 Ok(())
             })()
             .with_context(|| format!("cannot export {}", path.display()));
@@ -1569,39 +1564,6 @@ fn mesh_shortfall(doc: &Document) -> Option<String> {
             mesh::MAX_VERTICES_PER_PIXEL
         )
     })
-}
-
-/// The export of an LBC project: the picture warped by its cage in `pose`, with the
-/// coordinates already solved for it (else solved here), as `c2warp render` draws the
-/// saved project (8 bits per channel).
-fn export_cage(
-    image: &image::RgbaImage,
-    path: &Path,
-    solution: Option<Arc<pipeline::cage::CageCoordinates>>,
-    key: &CageKey,
-    pose: &[DVec2],
-    canvas: project::Canvas,
-    cancel: &CancelFlag,
-) -> Outcome {
-    let clock = Instant::now();
-    let result = (|| -> Result<()> {
-        let solution = match solution {
-            Some(solution) => solution,
-            None => crate::document::solve_cage(key, &mut |_| !cancel.is_set())?,
-        };
-        let warped = pipeline::cage::warp_by_cage_posed(image, &solution, pose, canvas)?;
-        if cancel.is_set() {
-            anyhow::bail!("cancelled");
-        }
-        render::save_png_atomic(path, &warped)?;
-        Ok(())
-    })()
-    .with_context(|| format!("cannot export {}", path.display()));
-    Outcome::Exported {
-        path: path.to_path_buf(),
-        result,
-        ms: clock.elapsed().as_secs_f64() * 1e3,
-    }
 }
 
 /// A path's file name, for messages.

@@ -348,15 +348,9 @@ fn an_lbc_export_is_what_the_pipeline_draws_for_the_saved_project() {
     // project's count, solve, warp.
     let doc = h.state().document().expect("doc");
     let project = doc.project_for_saving(None);
-    let target_vertices = pipeline::cage::cage_vertices(&project, None);
-    assert_eq!(target_vertices, DENSITY);
-    let solved = pipeline::cage::cage_coordinates(
-        &project,
-        pipeline::cage::CageMesh::Triangulate { target_vertices },
-        &mut |_| true,
-    )
-    .expect("solved");
-    let expected = pipeline::cage::warp_by_cage(&doc.image, &solved, project.canvas).expect("warp");
+    assert_eq!(pipeline::cage::cage_vertices(&project, None), DENSITY);
+    let warper = pipeline::prepare_warper(&doc.image, &project, None, &()).expect("solved");
+    let expected = pipeline::warp(&doc.image, &warper).expect("warp");
     assert!(
         changed(&exported, &expected) < 1e-4,
         "{}",

@@ -41,7 +41,7 @@ fn switching_methods_keeps_the_pose_and_comes_back_and_undoes() {
     assert!(times.compile_ms > 0.0);
     // The editor's ARAP is the method's own answer for the rig's mesh and handles.
     let project = doc.project();
-    let own = pipeline::deformer(project, doc.rig().clone(), Some(&doc.image))
+    let own = pipeline::on_handles(project, doc.rig().clone(), Some(&doc.image))
         .expect("ARAP")
         .deformed();
     assert_eq!(positions(&h), own);
@@ -285,13 +285,13 @@ fn an_arap_export_is_what_the_pipeline_draws_for_the_saved_project() {
     let doc = h.state().document().expect("doc");
     let project = doc.project_for_saving(None);
     assert_eq!(project.method, Method::Arap);
-    let warper = pipeline::prepare_warper(&doc.image, &project, None, &|_| {}).expect("ARAP");
+    let warper = pipeline::prepare_warper(&doc.image, &project, None, &()).expect("ARAP");
     let expected = pipeline::warp(&doc.image, &warper).expect("warp");
     assert!(exported == expected, "the export is ARAP's picture");
     let c2 = {
         let mut project = project.clone();
         project.method = Method::C2;
-        let warper = pipeline::prepare_warper(&doc.image, &project, None, &|_| {}).expect("C²");
+        let warper = pipeline::prepare_warper(&doc.image, &project, None, &()).expect("C²");
         pipeline::warp(&doc.image, &warper).expect("warp")
     };
     assert!(changed(&c2, &exported) > 0.001, "and not C²'s");

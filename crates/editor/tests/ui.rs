@@ -145,7 +145,7 @@ fn an_editing_session() {
     let prepared = pipeline::prepare(&picture, &project, None).expect("rig");
     let expected = pipeline::warp(
         &picture,
-        &pipeline::Warper::new(prepared.rig, &project, &picture).expect("C²"),
+        &pipeline::Warper::on_rig(prepared.rig, &project, Some(&picture)).expect("C²"),
     )
     .expect("warp");
     assert_eq!(exported.dimensions(), picture.dimensions());

@@ -27,9 +27,8 @@ fn main() {
             );
             if let Some(folder) = &folder {
                 let project = case.project(arap.as_deref());
-                let warper =
-                    pipeline::prepare_warper(&case.image, &project, Some(density), &|_| {})
-                        .expect("warper");
+                let warper = pipeline::prepare_warper(&case.image, &project, Some(density), &())
+                    .expect("warper");
                 let name = case.name.split(' ').next().unwrap_or("case");
                 pipeline::warp(&case.image, &warper)
                     .expect("warp")

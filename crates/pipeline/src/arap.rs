@@ -21,15 +21,19 @@
 //! names one: a mesh given as such is taken at its word, and the paper's exact
 //! behaviour stays reachable.
 
+use std::any::Any;
 use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use glam::DVec2;
 use project::{Project, RigidityStroke};
-use weights_core::{Domain, Handle, Metric, Similarity};
+use serde::Serialize;
+use weights_core::{Domain, Handle, Metric, Rig, Similarity};
 
-use crate::method::{Deformer, Method, Output};
+use crate::method::{
+    Deformer, Follow, Method, Output, Sequence, WeightsListing, json, median, quantile,
+};
 
 /// ARAP's own mesh when the rig file names no `arap.density`.
 pub const DEFAULT_ARAP_DENSITY: usize = 3000;
@@ -203,6 +207,9 @@ pub struct ArapRig {
     /// mesh, a copy of the pose's positions).
     positions: Vec<DVec2>,
     times: ArapTimes,
+    /// The diagonal of the picture ARAP meshed, pixels (`None` on a given mesh): what
+    /// the rig file's default pin radius resolves against.
+    diagonal: Option<f64>,
 }
 
 impl ArapRig {
@@ -225,6 +232,10 @@ impl ArapRig {
             options,
             Instant::now(),
         )
+        .map(|rig| Self {
+            diagonal: None,
+            ..rig
+        })
     }
 
     /// ARAP on its own mesh of `image` at `options.density` vertices, with `picture`
@@ -249,6 +260,13 @@ impl ArapRig {
             options,
             clock,
         )
+        .map(|rig| {
+            let (w, h) = image.dimensions();
+            Self {
+                diagonal: Some(f64::from(w).hypot(f64::from(h))),
+                ..rig
+            }
+        })
     }
 
     fn set_up(
@@ -291,9 +309,39 @@ impl ArapRig {
                 compile_ms,
                 update_ms: 0.0,
             },
+            diagonal: None,
         };
         rig.update()?;
         Ok(rig)
+    }
+
+    /// `project`'s ARAP (its handles, rigidity and `"arap"` settings) on `rig`'s mesh:
+    /// on its own mesh of `picture`, which the rig's follows ([`ArapRig::with_own_mesh`]),
+    /// or without a picture on the rig's mesh itself ([`ArapRig::new`]: a mesh given as
+    /// such).
+    ///
+    /// # Errors
+    /// As [`ArapRig::with_own_mesh`].
+    pub fn on_rig(project: &Project, rig: Rig, picture: Option<&image::RgbaImage>) -> Result<Self> {
+        let handles = crate::handles(project);
+        let (domain, strokes) = (rig.domain().clone(), &project.rigidity);
+        match picture {
+            Some(picture) => {
+                let options = ArapOptions::for_picture(project, picture);
+                Self::with_own_mesh(picture, domain, &handles, strokes, options)
+            }
+            None => Self::new(domain, &handles, strokes, ArapOptions::of(project, None)),
+        }
+    }
+
+    /// The picture's mesh at rest (what is drawn).
+    pub fn domain(&self) -> &Domain {
+        &self.picture
+    }
+
+    /// The handles, in their current poses.
+    pub fn handles(&self) -> &[Handle] {
+        &self.handles
     }
 
     /// The mesh ARAP solves on: its own, or the picture's.
@@ -367,39 +415,13 @@ impl ArapRig {
         &self.strokes
     }
 
-    /// Poses the compiled system for the current handles, and the picture with it.
-    fn update(&mut self) -> Result<()> {
-        let clock = Instant::now();
-        let positions = self.arap_mesh().positions();
-        let targets: Vec<DVec2> = self
-            .pins
-            .iter()
-            .map(|&(v, h)| handle_map(&self.handles[h], positions[v as usize]))
-            .collect();
-        self.compiled.update_into(&targets, &mut self.pose)?;
-        match &self.control {
-            Some(control) => control.follow(&self.pose.positions, &mut self.positions),
-            None => self.positions.clone_from(&self.pose.positions),
-        }
-        self.times.update_ms = ms(clock);
-        Ok(())
-    }
-}
-
-impl Deformer for ArapRig {
-    fn method(&self) -> Method {
-        Method::Arap
-    }
-
-    fn domain(&self) -> &Domain {
-        &self.picture
-    }
-
-    fn handles(&self) -> &[Handle] {
-        &self.handles
-    }
-
-    fn set_handles(&mut self, handles: &[Handle]) -> Result<()> {
+    /// Takes new handles: a new pose of the same pins only updates; other pins
+    /// recompile. On error nothing changes.
+    ///
+    /// # Errors
+    /// Handles that cannot be pinned (non-finite, off the mesh), or a failed
+    /// factorisation.
+    pub fn set_handles(&mut self, handles: &[Handle]) -> Result<()> {
         let pins = pins(
             self.arap_mesh(),
             &self.registration,
@@ -434,6 +456,52 @@ impl Deformer for ArapRig {
         result
     }
 
+    /// Poses the compiled system for the current handles, and the picture with it.
+    fn update(&mut self) -> Result<()> {
+        let clock = Instant::now();
+        let positions = self.arap_mesh().positions();
+        let targets: Vec<DVec2> = self
+            .pins
+            .iter()
+            .map(|&(v, h)| handle_map(&self.handles[h], positions[v as usize]))
+            .collect();
+        self.compiled.update_into(&targets, &mut self.pose)?;
+        match &self.control {
+            Some(control) => control.follow(&self.pose.positions, &mut self.positions),
+            None => self.positions.clone_from(&self.pose.positions),
+        }
+        self.times.update_ms = ms(clock);
+        Ok(())
+    }
+}
+
+impl Deformer for ArapRig {
+    fn method(&self) -> Method {
+        Method::Arap
+    }
+
+    fn rest(&self) -> &[DVec2] {
+        self.picture.positions()
+    }
+
+    fn triangles(&self) -> &[[u32; 3]] {
+        self.picture.triangles()
+    }
+
+    fn follow(&mut self, project: &Project) -> Result<Follow> {
+        if ArapOptions::of(project, self.diagonal) != self.options {
+            return Ok(Follow::NeedsSetup);
+        }
+        let before = (self.strokes.clone(), self.handles.clone());
+        self.set_rigidity(&project.rigidity)?;
+        if let Err(e) = self.set_handles(&crate::handles(project)) {
+            // Leave it as it was: the old rigidity with the old handles.
+            let _ = self.set_rigidity(&before.0);
+            return Err(e);
+        }
+        Ok(Follow::Followed)
+    }
+
     fn deformed(&self) -> Vec<DVec2> {
         self.positions.clone()
     }
@@ -441,6 +509,101 @@ impl Deformer for ArapRig {
     fn output(&self) -> Output<'_> {
         Output::Positions(&self.positions)
     }
+
+    fn weights(&self, _listing: WeightsListing) -> Result<serde_json::Value> {
+        bail!(
+            "ARAP has no weights per handle (it solves for positions): `c2warp weights` lists \
+             C² weights (\"method\": \"c2\") or LBC coordinates (\"method\": \"lbc\")"
+        )
+    }
+
+    /// Registration (as it was measured), compilation by dropping and restoring the
+    /// last handle, updates over `poses` random poses.
+    fn bench(&mut self, _project: &Project, poses: usize) -> Result<serde_json::Value> {
+        let handles = self.handles.clone();
+        let registration_ms = self.times.registration_ms;
+        let mut compile = vec![self.times.compile_ms];
+        if let Some((_, fewer)) = handles.split_last() {
+            for _ in 0..4 {
+                self.set_handles(fewer)?;
+                self.set_handles(&handles)?;
+                compile.push(self.times.compile_ms);
+            }
+        }
+        let pinned_vertices = self.pinned();
+        let scale = self.picture.mean_edge_length() * 10.0;
+        let mut sequence = Sequence::new();
+        let mut random = || sequence.next();
+        let mut update = Vec::new();
+        for _ in 0..poses.max(1) {
+            let posed: Vec<Handle> = handles
+                .iter()
+                .map(|h| match *h {
+                    Handle::Point {
+                        rest,
+                        mut transform,
+                    } => {
+                        transform.translation += DVec2::new(random(), random()) * scale;
+                        Handle::Point { rest, transform }
+                    }
+                    Handle::Bar { rest, pose } => {
+                        let d = DVec2::new(random(), random()) * scale;
+                        Handle::Bar {
+                            rest,
+                            pose: [pose[0] + d, pose[1] + d],
+                        }
+                    }
+                })
+                .collect();
+            self.set_handles(&posed)?;
+            update.push(self.times.update_ms);
+        }
+        self.set_handles(&handles)?;
+        json(&ArapReport {
+            method: "arap",
+            samples: self.picture.len(),
+            triangles: self.picture.triangles().len(),
+            real_handles: handles.len(),
+            arap_vertices: self.arap_mesh().len(),
+            pin_radius: self.options.pin_radius,
+            pinned_vertices,
+            registration_ms,
+            compile_ms_median: median(compile),
+            update_ms_p90: quantile(update.clone(), 0.9),
+            update_ms_median: median(update.clone()),
+            poses: update.len(),
+        })
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+}
+
+/// ARAP's steps, timed (`c2warp bench`).
+#[derive(Serialize)]
+struct ArapReport {
+    method: &'static str,
+    samples: usize,
+    triangles: usize,
+    real_handles: usize,
+    /// Vertices of the mesh ARAP solves on (its own mesh of the picture, or the given
+    /// mesh).
+    arap_vertices: usize,
+    /// What each handle holds, pixels (0: its nearest vertex).
+    pin_radius: f64,
+    /// Vertices the handles pin.
+    pinned_vertices: usize,
+    /// Registration (once per mesh; ARAP's meshing of the picture included), ms.
+    registration_ms: f64,
+    /// Median compilation (factorising both steps' systems), ms.
+    compile_ms_median: f64,
+    /// Median update (a new pose: step one, the fit, step two), ms.
+    update_ms_median: f64,
+    /// 90th percentile of the updates, ms.
+    update_ms_p90: f64,
+    /// Poses timed.
+    poses: usize,
 }
 
 /// Compiles ARAP for `pins` and `rigidity`.
@@ -751,7 +914,7 @@ mod tests {
         bad[0] = point(DVec2::new(2.0, 1.0), DVec2::new(f64::NAN, 0.0), 0.0, 1.0);
         assert!(same.set_handles(&bad).is_err());
         assert_eq!(same.positions(), arap.positions());
-        assert_eq!(Deformer::handles(&same), &handles);
+        assert_eq!(same.handles(), &handles);
     }
 
     #[test]

@@ -3,17 +3,26 @@
 //! posed cage.
 //!
 //! LBC is a cage method: it moves what lies inside the cage by the cage's vertices;
-//! it has no handles. The command line's `render`, `weights`, `deform` and `bench`
-//! use it, and so does the editor's cage tool; both mesh the cage's inside to
-//! [`cage_vertices`] and draw with [`warp_by_cage`], so the editor's export is what
-//! `c2warp render` gives for the saved project. [`cage_from_outline`] makes a cage
-//! around a cut-out's visible shape.
+//! it has no handles. Behind the method seam it is a [`CageDeformer`]: the command
+//! line sets it up through [`crate::setup`] and the editor from the coordinates its
+//! cage tool solved ([`CageDeformer::new`]); both mesh the cage's inside to
+//! [`cage_vertices`] and draw through [`crate::Warper`], so the editor's export is
+//! what `c2warp render` gives for the saved project. [`cage_from_outline`] makes a
+//! cage around a cut-out's visible shape.
+
+use std::any::Any;
+use std::sync::Arc;
+use std::time::Instant;
 
 use anyhow::{Context, Result, bail, ensure};
 use glam::DVec2;
-use project::{Canvas, MAX_CAGE_VERTICES, Method, Project, Tau};
+use project::{MAX_CAGE_VERTICES, Method, Project, Tau};
+use serde::Serialize;
 
-use crate::Frame;
+use crate::method::{
+    Backdrop, Deformer, Follow, Listener, Output, SkinTable, Skinning, Source, WeightsListing,
+    json, median,
+};
 
 /// Mesh vertices inside a cage when neither a `--density` nor the rig names a count:
 /// the solve's time grows quickly with it (a few seconds at this size).
@@ -98,6 +107,10 @@ pub struct CageCoordinates {
     /// The paper's locality statistics `P(t)` (at `t` = 0, `10⁻³/n`, 0.01, 0.05, 0.1,
     /// 0.2, …, 1) and `Q(k)`, of the coordinates before compaction.
     pub locality: lbc::Locality,
+    /// The rest cage it was solved for, as the rig file gives it.
+    pub rest: Vec<DVec2>,
+    /// The locality weighting it was solved with.
+    pub tau: Tau,
     /// The posed cage (the rest cage where the rig gives no pose).
     pub pose: Vec<DVec2>,
 }
@@ -131,7 +144,7 @@ pub fn cage_coordinates(
         || rest.clone(),
         |p| p.iter().map(|&q| DVec2::from(q)).collect(),
     );
-    let cage = lbc::Cage::new(rest).context("the rig's cage")?;
+    let cage = lbc::Cage::new(rest.clone()).context("the rig's cage")?;
     let domain = match mesh {
         CageMesh::Triangulate { target_vertices } => {
             let target = target_vertices.min(cage_vertex_cap(cage.area()));
@@ -147,7 +160,8 @@ pub fn cage_coordinates(
                 .context("the mesh does not fit the cage")?
         }
     };
-    let settings = solver_settings(project.lbc.unwrap_or_default().tau);
+    let tau = project.lbc.unwrap_or_default().tau;
+    let settings = solver_settings(tau);
     let coordinates = lbc::solve(&domain, &settings, progress)?;
     let report = coordinates.report.clone();
     let n = coordinates.cage_vertices().max(1) as f64;
@@ -159,101 +173,269 @@ pub fn cage_coordinates(
         domain,
         report,
         locality,
+        rest,
+        tau,
         pose,
     })
 }
 
-/// Whether `project` (with `method` overriding its own) warps by a cage.
-pub fn uses_cage(project: &Project, method: Option<Method>) -> bool {
-    method.unwrap_or(project.method) == Method::Lbc
+/// LBC behind the method seam: a cage's solved coordinates and the cage's pose.
+///
+/// It moves the mesh of the cage's inside (not the picture's mesh) and keeps the
+/// picture outside the rest cage in place ([`Backdrop::PictureOutsideMesh`]), as
+/// GIMP's cage tool does: what lies inside the rest cage is taken out and drawn where
+/// the posed cage takes it, over what lies outside. It draws skinned: the compact rows
+/// are the weight rows, and each cage vertex a node whose transform has no linear part
+/// and the posed vertex as its translation ([`skinning_table`], [`pose_transforms`]).
+pub struct CageDeformer {
+    solved: Arc<CageCoordinates>,
+    pose: Vec<DVec2>,
+    positions: Vec<DVec2>,
 }
 
-/// The picture warped by a cage, as GIMP's cage tool does it: what lies inside the
-/// rest cage is taken out and drawn where the posed cage takes it; what lies outside
-/// stays as it is, and shows wherever the warped inside does not cover it (the warped
-/// inside is composited over it). Drawn on the CPU at full resolution, 8 bits per
-/// channel, in the picture's own frame or one grown to fit the warp (`canvas`).
-///
-/// # Errors
-/// Non-finite deformed positions, or a picture (or grown canvas) too large to draw.
-pub fn warp_by_cage(
-    image: &image::RgbaImage,
-    solved: &CageCoordinates,
-    canvas: Canvas,
-) -> Result<image::RgbaImage> {
-    warp_by_cage_posed(image, solved, &solved.pose, canvas)
-}
-
-/// As [`warp_by_cage`], with the cage in `pose` (one point per cage vertex) rather
-/// than the pose it was solved with.
-///
-/// # Errors
-/// A pose of the wrong length, non-finite deformed positions, or a picture too large
-/// to draw.
-pub fn warp_by_cage_posed(
-    image: &image::RgbaImage,
-    solved: &CageCoordinates,
-    pose: &[DVec2],
-    canvas: Canvas,
-) -> Result<image::RgbaImage> {
-    let deformed = solved.weights.deform(pose)?;
-    if deformed.iter().any(|p| !p.is_finite()) {
-        bail!("the cage sent a vertex to a non-finite position");
+impl CageDeformer {
+    /// The cage of `solved` in `pose` (one point per cage vertex).
+    ///
+    /// # Errors
+    /// A pose of the wrong length.
+    pub fn new(solved: Arc<CageCoordinates>, pose: Vec<DVec2>) -> Result<Self> {
+        let positions = solved.weights.deform(&pose)?;
+        Ok(Self {
+            solved,
+            pose,
+            positions,
+        })
     }
-    let rest = rest_positions(solved);
-    let deformed: Vec<glam::Vec2> = deformed.iter().map(|p| p.as_vec2()).collect();
-    let (w, h) = image.dimensions();
-    let frame = Frame::new(w, h, &deformed, canvas)?;
-    let mut out = outside(image, solved, frame);
-    render::warp_over(
-        image,
-        &render::WarpMesh {
-            rest: &rest,
-            deformed: &frame.place(&deformed),
-            triangles: solved.domain.triangles(),
-        },
-        &mut out,
-    )?;
-    Ok(out)
+
+    /// Solves `project`'s cage on `source` (a picture: the cage's inside triangulated
+    /// to [`cage_vertices`]; a mesh: the cage's inside as given), telling `listener`
+    /// each iteration, and poses it as the rig file does.
+    ///
+    /// # Errors
+    /// As [`cage_coordinates`], a density out of range, and a cage off the picture.
+    pub fn set_up(source: Source<'_>, project: &Project, listener: &dyn Listener) -> Result<Self> {
+        let mesh = match source {
+            Source::Picture { image, density } => {
+                project.validate(Some(image.dimensions()))?;
+                let target_vertices = cage_vertices(project, density);
+                project::validate_density(target_vertices)?;
+                CageMesh::Triangulate { target_vertices }
+            }
+            Source::Mesh(mesh) => {
+                project.validate(None)?;
+                CageMesh::Given {
+                    positions: mesh.vertices.clone(),
+                    triangles: mesh.triangles.clone(),
+                }
+            }
+        };
+        let solved = cage_coordinates(project, mesh, &mut |p| listener.solving(p))?;
+        let pose = solved.pose.clone();
+        Self::new(Arc::new(solved), pose)
+    }
+
+    /// The solved coordinates.
+    pub fn solution(&self) -> &Arc<CageCoordinates> {
+        &self.solved
+    }
+
+    /// The cage's pose.
+    pub fn pose(&self) -> &[DVec2] {
+        &self.pose
+    }
 }
 
-/// As [`warp_by_cage`], with the inside drawn on a GPU (or a software adapter) by the
-/// skinning shader the C² weights use: the compact rows are its weight rows and each
-/// cage vertex a node whose transform has no linear part and the posed vertex as its
-/// translation ([`skinning_table`], [`pose_transforms`]).
-///
-/// # Errors
-/// No usable adapter, non-finite pose, or a picture too large for the device.
-pub fn warp_by_cage_gpu(
-    image: &image::RgbaImage,
-    solved: &CageCoordinates,
-    canvas: Canvas,
-) -> Result<image::RgbaImage> {
-    if solved.pose.iter().any(|p| !p.is_finite()) {
-        bail!("the cage's pose is not finite");
+impl Skinning for CageDeformer {
+    fn table(&self) -> SkinTable {
+        let (rows, nodes, weights) = skinning_table(&self.solved.weights);
+        SkinTable {
+            rows,
+            nodes,
+            weights,
+        }
     }
-    let gpu = render::GpuContext::new()?;
-    let rest = rest_positions(solved);
-    let (rows, nodes, weights) = skinning_table(&solved.weights);
-    let (w, h) = image.dimensions();
-    let deformed: Vec<glam::Vec2> = solved.deformed()?.iter().map(|p| p.as_vec2()).collect();
-    let frame = Frame::new(w, h, &deformed, canvas)?;
-    let shift = frame.shift();
-    let placed: Vec<DVec2> = solved.pose.iter().map(|p| *p + shift.as_dvec2()).collect();
-    let layer = gpu.warp_skinned(
-        image,
-        &render::SkinnedMesh {
-            rest: &rest,
-            rows: &rows,
-            nodes: &nodes,
-            weights: &weights,
-            triangles: solved.domain.triangles(),
-        },
-        &pose_transforms(&placed),
-        frame.width,
-        frame.height,
-    )?;
-    Ok(composite(&outside(image, solved, frame), &layer))
+
+    fn transforms(&self) -> Vec<render::Affine> {
+        pose_transforms(&self.pose)
+    }
+}
+
+impl Deformer for CageDeformer {
+    fn method(&self) -> Method {
+        Method::Lbc
+    }
+
+    fn rest(&self) -> &[DVec2] {
+        self.solved.domain.positions()
+    }
+
+    fn triangles(&self) -> &[[u32; 3]] {
+        self.solved.domain.triangles()
+    }
+
+    fn follow(&mut self, project: &Project) -> Result<Follow> {
+        let Some(spec) = &project.cage else {
+            bail!("the rig has no \"cage\" (LBC warps by a cage)");
+        };
+        let rest: Vec<DVec2> = spec.rest.iter().map(|&p| DVec2::from(p)).collect();
+        if rest != self.solved.rest || project.lbc.unwrap_or_default().tau != self.solved.tau {
+            return Ok(Follow::NeedsSetup);
+        }
+        let pose = spec
+            .pose
+            .as_ref()
+            .map_or(rest, |p| p.iter().map(|&q| DVec2::from(q)).collect());
+        self.positions = self.solved.weights.deform(&pose)?;
+        self.pose = pose;
+        Ok(Follow::Followed)
+    }
+
+    fn deformed(&self) -> Vec<DVec2> {
+        self.positions.clone()
+    }
+
+    fn output(&self) -> Output<'_> {
+        Output::Skinned(self)
+    }
+
+    fn backdrop(&self) -> Backdrop {
+        Backdrop::PictureOutsideMesh
+    }
+
+    fn notes(&self) -> Vec<String> {
+        let report = &self.solved.report;
+        if report.converged {
+            return Vec::new();
+        }
+        let residuals = report.last.map_or(String::new(), |p| {
+            format!(
+                " (relative residuals {:.1e} and {:.1e} of their thresholds)",
+                p.primal_residual / p.primal_threshold,
+                p.dual_residual / p.dual_threshold
+            )
+        });
+        vec![format!(
+            "the cage's coordinates did not converge in {} ADMM iterations{residuals}; the \
+             warp may be off",
+            report.iterations
+        )]
+    }
+
+    /// The nodes are the cage's vertices in order; every mesh vertex lists its non-zero
+    /// `[cage vertex, weight]` pairs.
+    fn weights(&self, listing: WeightsListing) -> Result<serde_json::Value> {
+        let solved = &self.solved;
+        let positions = solved.domain.positions();
+        let nodes = solved
+            .domain
+            .cage_vertices()
+            .iter()
+            .enumerate()
+            .map(|(index, &vertex)| CageNode {
+                index,
+                kind: "cage",
+                vertex,
+                position: positions[vertex as usize].to_array(),
+            })
+            .collect();
+        json(&LbcWeights {
+            method: "lbc",
+            samples: positions.len(),
+            file_vertices: listing.file_vertices,
+            nodes,
+            vertices: listing
+                .positions
+                .then(|| positions.iter().map(|p| p.to_array()).collect()),
+            weights: (0..positions.len())
+                .map(|v| solved.weights.row(v).to_vec())
+                .collect(),
+            iterations: solved.report.iterations,
+            converged: solved.report.converged,
+            objective: solved.report.objective,
+        })
+    }
+
+    /// The solve's phases (as measured when it was solved) and 15 deformations.
+    fn bench(&mut self, _project: &Project, _poses: usize) -> Result<serde_json::Value> {
+        let solved = &self.solved;
+        let mut deform = Vec::new();
+        for _ in 0..15 {
+            let clock = Instant::now();
+            std::hint::black_box(solved.weights.deform(&self.pose)?);
+            deform.push(clock.elapsed().as_secs_f64() * 1e3);
+        }
+        let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+        let report = &solved.report;
+        json(&LbcBench {
+            method: "lbc",
+            samples: solved.domain.positions().len(),
+            triangles: solved.domain.triangles().len(),
+            cage_vertices: solved.domain.cage_vertices().len(),
+            geodesics_ms: ms(report.geodesics),
+            factorisation_ms: ms(report.factorisation),
+            admm_iterations: report.iterations,
+            admm_ms: ms(report.admm),
+            projection_ms: ms(report.projection),
+            converged: report.converged,
+            nonzeros_per_vertex: solved.weights.len() as f64
+                / solved.domain.positions().len().max(1) as f64,
+            deform_ms_median: median(deform),
+            locality_p: solved
+                .locality
+                .t
+                .iter()
+                .zip(&solved.locality.p)
+                .map(|(&t, &p)| [t, p])
+                .collect(),
+            locality_q: solved.locality.q.clone(),
+        })
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+}
+
+#[derive(Serialize)]
+struct CageNode {
+    index: usize,
+    kind: &'static str,
+    vertex: u32,
+    position: [f64; 2],
+}
+
+#[derive(Serialize)]
+struct LbcWeights {
+    method: &'static str,
+    samples: usize,
+    file_vertices: usize,
+    nodes: Vec<CageNode>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    vertices: Option<Vec<[f64; 2]>>,
+    weights: Vec<Vec<(u32, f64)>>,
+    iterations: usize,
+    converged: bool,
+    objective: f64,
+}
+
+#[derive(Serialize)]
+struct LbcBench {
+    method: &'static str,
+    samples: usize,
+    triangles: usize,
+    cage_vertices: usize,
+    geodesics_ms: f64,
+    factorisation_ms: f64,
+    admm_iterations: usize,
+    admm_ms: f64,
+    projection_ms: f64,
+    converged: bool,
+    nonzeros_per_vertex: f64,
+    deform_ms_median: f64,
+    /// The paper's P(t) as `[t, P(t)]` pairs (eq. 20).
+    locality_p: Vec<[f64; 2]>,
+    /// The paper's Q(k) for k = 0, 1, … n (eq. 21).
+    locality_q: Vec<f64>,
 }
 
 /// The compact rows as a skinning shader reads them: row `v` is
@@ -282,63 +464,24 @@ pub fn pose_transforms(pose: &[DVec2]) -> Vec<render::Affine> {
         .collect()
 }
 
-/// The mesh's rest positions, in single precision for drawing.
-fn rest_positions(solved: &CageCoordinates) -> Vec<glam::Vec2> {
-    solved
-        .domain
-        .positions()
-        .iter()
-        .map(|p| p.as_vec2())
-        .collect()
-}
-
-/// The picture outside the rest cage (its inside cleared), in `frame`: transparent
-/// where the frame grows beyond the picture.
-fn outside(image: &image::RgbaImage, solved: &CageCoordinates, frame: Frame) -> image::RgbaImage {
-    let mut picture = image.clone();
-    clear_inside(&mut picture, &solved.domain);
-    if frame.origin == [0, 0] && (frame.width, frame.height) == image.dimensions() {
-        return picture;
-    }
-    let mut out = image::RgbaImage::new(frame.width, frame.height);
-    image::imageops::replace(&mut out, &picture, -frame.origin[0], -frame.origin[1]);
-    out
-}
-
-/// `layer` (the warped inside, drawn on its own; transparent where it drew nothing)
-/// over `base`.
-fn composite(base: &image::RgbaImage, layer: &image::RgbaImage) -> image::RgbaImage {
-    let mut out = base.clone();
-    for (base, top) in out.pixels_mut().zip(layer.pixels()) {
-        if top.0[3] > 0 {
-            *base = render::over(top.0, base.0).into();
-        }
-    }
-    out
-}
-
 /// Makes transparent every pixel the mesh of a cage's inside covers at rest, by the
 /// rasteriser's own rule (pixel centres, top-left fill rule): the picture outside the
-/// cage, as [`warp_by_cage`] keeps it. The warped inside is drawn over it, so at rest
+/// cage, as [`CageDeformer`] keeps it. The warped inside is drawn over it, so at rest
 /// every cleared pixel is drawn again from itself and the picture comes back exactly.
 pub fn clear_inside(image: &mut image::RgbaImage, domain: &lbc::Domain) {
-    let (w, h) = image.dimensions();
+    let mut picture = render::Picture::Rgba8(std::mem::take(image));
     let rest: Vec<glam::Vec2> = domain.positions().iter().map(|p| p.as_vec2()).collect();
-    let mesh = render::WarpMesh {
-        rest: &rest,
-        deformed: &rest,
-        triangles: domain.triangles(),
-    };
     // The mesh comes from a validated cage, so it draws; if it did not, nothing is
     // cleared.
-    let Ok(covered) = render::coverage_counts(&mesh, w, h) else {
-        return;
-    };
-    for (pixel, &count) in image.pixels_mut().zip(&covered) {
-        if count > 0 {
-            *pixel = image::Rgba([0, 0, 0, 0]);
-        }
-    }
+    let _ = render::clear_covered(
+        &mut picture,
+        &render::WarpMesh {
+            rest: &rest,
+            deformed: &rest,
+            triangles: domain.triangles(),
+        },
+    );
+    *image = picture.into_rgba8();
 }
 
 /// A cage around `image`'s visible shape (every pixel with alpha > 0, in every piece;
@@ -421,6 +564,7 @@ mod tests {
     }
 
     use super::*;
+    use project::Canvas;
 
     /// A disc and a thin bar off it, as a cut-out.
     fn cut_out() -> image::RgbaImage {
@@ -433,20 +577,49 @@ mod tests {
     }
 
     /// The coordinates of the cage `rest` posed at `pose`, solved on `count` vertices.
-    fn solved(rest: Vec<[f64; 2]>, pose: Option<Vec<[f64; 2]>>, count: usize) -> CageCoordinates {
+    fn solved(
+        rest: Vec<[f64; 2]>,
+        pose: Option<Vec<[f64; 2]>>,
+        count: usize,
+    ) -> Arc<CageCoordinates> {
         let project = Project {
             method: Method::Lbc,
             cage: Some(project::CageSpec { rest, pose }),
             ..Project::default()
         };
-        cage_coordinates(
+        let solved = cage_coordinates(
             &project,
             CageMesh::Triangulate {
                 target_vertices: count,
             },
             &mut |_| true,
-        )
-        .expect("solved")
+        );
+        Arc::new(solved.expect("solved"))
+    }
+
+    /// The warper of `solved` with the cage in `pose`.
+    fn warper(solved: &Arc<CageCoordinates>, pose: &[DVec2], canvas: Canvas) -> crate::Warper {
+        let deformer = CageDeformer::new(solved.clone(), pose.to_vec()).expect("a pose");
+        crate::Warper::in_mesh_order(Box::new(deformer), canvas)
+    }
+
+    /// `image` warped by the cage of `solved` in `pose`.
+    fn warp_by_cage_posed(
+        image: &image::RgbaImage,
+        solved: &Arc<CageCoordinates>,
+        pose: &[DVec2],
+        canvas: Canvas,
+    ) -> image::RgbaImage {
+        crate::warp(image, &warper(solved, pose, canvas)).expect("warp")
+    }
+
+    /// `image` warped by the cage of `solved` in the pose it was solved with.
+    fn warp_by_cage(
+        image: &image::RgbaImage,
+        solved: &Arc<CageCoordinates>,
+        canvas: Canvas,
+    ) -> image::RgbaImage {
+        warp_by_cage_posed(image, solved, &solved.pose, canvas)
     }
 
     /// A 60 × 40 picture of colour ramps.
@@ -541,7 +714,7 @@ mod tests {
         ];
         for rest in cages {
             let solved = solved(rest, None, 400);
-            let at_rest = warp_by_cage(&image, &solved, Canvas::Keep).expect("warp");
+            let at_rest = warp_by_cage(&image, &solved, Canvas::Keep);
             let changed = at_rest
                 .pixels()
                 .zip(image.pixels())
@@ -558,8 +731,8 @@ mod tests {
         let square = vec![[10.0, 10.0], [40.0, 10.0], [40.0, 30.0], [10.0, 30.0]];
         let moved = vec![[40.0, -5.0], [70.0, -5.0], [70.0, 15.0], [40.0, 15.0]];
         let solved = solved(square, Some(moved), 120);
-        let kept = warp_by_cage(&image, &solved, Canvas::Keep).expect("warp");
-        let grown = warp_by_cage(&image, &solved, Canvas::Fit).expect("warp");
+        let kept = warp_by_cage(&image, &solved, Canvas::Keep);
+        let grown = warp_by_cage(&image, &solved, Canvas::Fit);
         assert_eq!(kept.dimensions(), (60, 40));
         // Moved 30 right and 15 up: the canvas grows to x ∈ [0, 70], y ∈ [−5, 40].
         assert_eq!(grown.dimensions(), (70, 45));
@@ -576,13 +749,13 @@ mod tests {
         let image = ramps();
         let square = vec![[10.0, 10.0], [40.0, 10.0], [40.0, 30.0], [10.0, 30.0]];
         let solved = solved(square, None, 120);
-        let at_rest = warp_by_cage(&image, &solved, Canvas::Keep).expect("warp");
+        let at_rest = warp_by_cage(&image, &solved, Canvas::Keep);
         let shift: Vec<DVec2> = solved
             .pose
             .iter()
             .map(|p| *p + DVec2::new(5.0, 0.0))
             .collect();
-        let moved = warp_by_cage_posed(&image, &solved, &shift, Canvas::Keep).expect("warp");
+        let moved = warp_by_cage_posed(&image, &solved, &shift, Canvas::Keep);
         // Outside the rest cage and away from its moved copy: untouched.
         for (x, y) in [(2, 2), (55, 35), (5, 20)] {
             assert_eq!(moved.get_pixel(x, y), image.get_pixel(x, y));
@@ -590,5 +763,71 @@ mod tests {
         // Inside: the picture shifted right by 5 pixels.
         assert_eq!(moved.get_pixel(30, 20), at_rest.get_pixel(25, 20));
         assert_ne!(moved.get_pixel(30, 20), image.get_pixel(30, 20));
+    }
+
+    #[test]
+    fn a_sixteen_bit_picture_warps_by_its_cage_in_sixteen_bits() {
+        let wide = render::Rgba16Image::from_fn(60, 40, |x, y| {
+            image::Rgba([(x * 1000) as u16 + 7, (y * 1500) as u16 + 3, 40_001, 65_535])
+        });
+        let picture = render::Picture::Rgba16(wide.clone());
+        let square = vec![[10.0, 10.0], [40.0, 10.0], [40.0, 30.0], [10.0, 30.0]];
+        let solved = solved(square, None, 120);
+        // At rest: every 16-bit value back, inside the cage and out.
+        let at_rest = crate::warp_picture(&picture, &warper(&solved, &solved.pose, Canvas::Keep))
+            .expect("warp");
+        assert_eq!(at_rest, picture);
+        // Moved 5 px right: the inside shifted in 16 bits, the outside kept.
+        let shift: Vec<DVec2> = solved.pose.iter().map(|p| *p + DVec2::X * 5.0).collect();
+        let moved =
+            crate::warp_picture(&picture, &warper(&solved, &shift, Canvas::Keep)).expect("warp");
+        let render::Picture::Rgba16(moved) = moved else {
+            panic!("16 bits in, 16 bits out");
+        };
+        assert_eq!(moved.get_pixel(30, 20), wide.get_pixel(25, 20));
+        assert_eq!(moved.get_pixel(55, 35), wide.get_pixel(55, 35));
+    }
+
+    #[test]
+    fn the_deformer_follows_a_new_pose_and_asks_for_a_solve_for_a_new_cage() {
+        let square = vec![[10.0, 10.0], [40.0, 10.0], [40.0, 30.0], [10.0, 30.0]];
+        let solved = solved(square.clone(), None, 120);
+        let mut deformer = CageDeformer::new(solved.clone(), solved.pose.clone()).expect("pose");
+        let mut project = Project {
+            method: Method::Lbc,
+            cage: Some(project::CageSpec {
+                rest: square.clone(),
+                pose: Some(square.iter().map(|p| [p[0] + 3.0, p[1] - 2.0]).collect()),
+            }),
+            ..Project::default()
+        };
+        assert_eq!(deformer.follow(&project).expect("a pose"), Follow::Followed);
+        // A translated cage translates everything inside it, to rounding.
+        for (p, q) in deformer.rest().iter().zip(deformer.deformed()) {
+            assert!((q - *p - DVec2::new(3.0, -2.0)).length() < 1e-9);
+        }
+        assert_eq!(deformer.backdrop(), Backdrop::PictureOutsideMesh);
+        // Another rest cage, or another τ: a new solve; nothing changed meanwhile.
+        let before = deformer.deformed();
+        let mut other = project.clone();
+        other.cage.as_mut().expect("a cage").rest[0] = [9.0, 10.0];
+        assert_eq!(
+            deformer.follow(&other).expect("no error"),
+            Follow::NeedsSetup
+        );
+        other = project.clone();
+        other.lbc = Some(project::LbcSettings {
+            tau: Tau::Linear,
+            ..Default::default()
+        });
+        assert_eq!(
+            deformer.follow(&other).expect("no error"),
+            Follow::NeedsSetup
+        );
+        assert_eq!(deformer.deformed(), before);
+        // A pose of the wrong length is an error.
+        project.cage.as_mut().expect("a cage").pose = Some(vec![[0.0, 0.0]]);
+        assert!(deformer.follow(&project).is_err());
+        assert_eq!(deformer.deformed(), before);
     }
 }

@@ -2,6 +2,7 @@
 //! the editor share, so an export from either gives the same pixels.
 
 pub mod arap;
+mod c2;
 pub mod cage;
 pub mod method;
 pub mod order;
@@ -17,7 +18,10 @@ use project::{Canvas, HandleSpec, MetricChoice, Middle, Project};
 use render::Picture;
 
 pub use arap::{ArapOptions, ArapRig, ArapTimes};
-pub use method::{Deformer, Method, Output, deformer};
+pub use method::{
+    Backdrop, Controls, Deformer, Follow, Listener, Method, Output, SkinTable, Skinning,
+    SolveProgress, Source, WeightsListing, on_handles, setup,
+};
 pub use order::draw_order;
 
 use weights_core::{
@@ -338,8 +342,80 @@ pub fn prepare_with_progress(
     Ok(Prepared { rig })
 }
 
-/// A picture's mesh with a method set up on it and the order its triangles are drawn
-/// in: what [`warp`], [`warp_picture`] and [`warp_gpu`] draw.
+/// Builds `project`'s C² rig on a given mesh (`--mesh`): its vertices are used as
+/// given, in file order; a handle (or bar sample, or saved virtual handle) that
+/// coincides with a vertex uses it, and one that does not is inserted as a new vertex,
+/// splitting the triangle (or edge) it lies on. Inserted vertices come after the
+/// file's.
+///
+/// # Errors
+/// Invalid handles, a handle off the mesh, more virtual handles than the mesh has
+/// vertices, a degenerate mesh.
+pub fn rig_on_mesh(
+    mesh: &Mesh,
+    project: &Project,
+    progress: &(dyn Fn(weights_core::Progress) + Sync),
+) -> Result<Rig> {
+    project.validate(None)?;
+    let mut mesh = mesh.clone();
+    let file_vertices = mesh.vertices.len();
+    // Each virtual handle takes a vertex of its own; more than the mesh has cannot have
+    // been saved on it (and would each be inserted into it, one by one).
+    anyhow::ensure!(
+        project.virtual_handles.len() <= file_vertices,
+        "the rig lists {} virtual handles, more than the mesh's {file_vertices} vertices \
+         (at most one a vertex); leave out \"virtual_handles\" to have them placed afresh",
+        project.virtual_handles.len(),
+    );
+    let handles = handles(project);
+    let mut points: Vec<DVec2> = Vec::new();
+    for (i, h) in handles.iter().enumerate() {
+        match h {
+            Handle::Point { rest, .. } => points.push(*rest),
+            Handle::Bar { rest, .. } => points.extend(
+                weights_core::bar_samples(*rest, weights_core::bar_spacing(&handles, i))
+                    .into_iter()
+                    .map(|(_, p)| p),
+            ),
+        }
+    }
+    points.extend(project.virtual_handles.iter().map(|&p| DVec2::from(p)));
+    let mut virtual_handles = Vec::new();
+    let first_virtual = points.len() - project.virtual_handles.len();
+    for (i, p) in points.into_iter().enumerate() {
+        let v = mesh
+            .insert_point(p)
+            .with_context(|| format!("handle point ({}, {}) is not on the mesh", p.x, p.y))?;
+        if i >= first_virtual {
+            virtual_handles.push(VirtualHandle {
+                vertex: v,
+                placed_for: project
+                    .virtual_placed_for
+                    .get(i - first_virtual)
+                    .copied()
+                    .flatten(),
+            });
+        }
+    }
+    let provisional = Domain::new(
+        mesh.vertices.clone(),
+        mesh.triangles.clone(),
+        Metric::Intrinsic,
+    )?;
+    let metric = metric(project.metric, provisional.is_convex());
+    let domain = Domain::new(mesh.vertices, mesh.triangles, metric)?;
+    Ok(Rig::with_progress(
+        domain,
+        handles,
+        &virtual_handles,
+        rig_options(project)?,
+        progress,
+    )?)
+}
+
+/// A method set up on a picture, with its mesh's triangles in the order they are
+/// drawn: what [`warp`], [`warp_picture`] and [`warp_gpu`] draw, the same way for every
+/// method.
 pub struct Warper {
     /// The method, posed.
     pub deformer: Box<dyn Deformer>,
@@ -350,30 +426,34 @@ pub struct Warper {
 }
 
 impl Warper {
-    /// Sets up `project`'s method (its rigidity included) on the rig `prepare` built
-    /// from `picture`, with the overlap order of its handles' depths.
+    /// `project`'s handle method on the rig [`prepare`] built from `picture` (see
+    /// [`on_handles`]), with the overlap order of its handles' depths.
     ///
     /// # Errors
     /// What the method refuses.
-    pub fn new(rig: Rig, project: &Project, picture: &RgbaImage) -> Result<Self> {
+    pub fn on_rig(rig: Rig, project: &Project, picture: Option<&RgbaImage>) -> Result<Self> {
         let depths: Vec<i32> = project.handles.iter().map(HandleSpec::depth).collect();
         let triangles = draw_order(&rig, &depths);
-        let deformer = deformer(project, rig, Some(picture))?;
         Ok(Self {
-            deformer,
+            deformer: on_handles(project, rig, picture)?,
             triangles,
             canvas: project.canvas,
         })
     }
 
+    /// `deformer` with its triangles drawn in the mesh's order.
+    pub fn in_mesh_order(deformer: Box<dyn Deformer>, canvas: Canvas) -> Self {
+        let triangles = deformer.triangles().to_vec();
+        Self {
+            deformer,
+            triangles,
+            canvas,
+        }
+    }
+
     /// The mesh's vertices at rest in f32: its texture coordinates.
     fn rest(&self) -> Vec<Vec2> {
-        self.deformer
-            .domain()
-            .positions()
-            .iter()
-            .map(|p| p.as_vec2())
-            .collect()
+        self.deformer.rest().iter().map(|p| p.as_vec2()).collect()
     }
 
     /// The deformed positions in f32 for drawing.
@@ -384,10 +464,70 @@ impl Warper {
         }
         Ok(deformed.iter().map(|p| p.as_vec2()).collect())
     }
+
+    /// What shows behind the warped mesh, in `frame`, in `picture`'s depth: nothing
+    /// (transparent), or the picture with what the rest mesh covers cleared.
+    fn backdrop(&self, picture: &Picture, frame: Frame) -> Result<Picture> {
+        let blank = |picture: &Picture| blank(picture.bits_per_channel(), frame);
+        match self.deformer.backdrop() {
+            Backdrop::Transparent => blank(picture),
+            Backdrop::PictureOutsideMesh => {
+                let rest = self.rest();
+                let mut outside = picture.clone();
+                render::clear_covered(
+                    &mut outside,
+                    &render::WarpMesh {
+                        rest: &rest,
+                        deformed: &rest,
+                        triangles: &self.triangles,
+                    },
+                )?;
+                if frame.origin == [0, 0] && (frame.width, frame.height) == picture.dimensions() {
+                    return Ok(outside);
+                }
+                let (x, y) = (-frame.origin[0], -frame.origin[1]);
+                let mut out = blank(picture)?;
+                match (&mut out, &outside) {
+                    (Picture::Rgba8(out), Picture::Rgba8(outside)) => {
+                        image::imageops::replace(out, outside, x, y);
+                    }
+                    (Picture::Rgba16(out), Picture::Rgba16(outside)) => {
+                        image::imageops::replace(out, outside, x, y);
+                    }
+                    _ => unreachable!("a blank picture of the same depth"),
+                }
+                Ok(out)
+            }
+        }
+    }
+}
+
+/// A transparent picture of `bits` per channel (8 or 16) the size of `frame`.
+///
+/// # Errors
+/// Not enough memory for it.
+fn blank(bits: u8, frame: Frame) -> Result<Picture> {
+    let (width, height) = (frame.width, frame.height);
+    let len = 4 * width as usize * height as usize;
+    let too_large = || anyhow!("a {width} × {height} picture is too large to allocate");
+    fn zeros<T: Clone + Default>(len: usize) -> Option<Vec<T>> {
+        let mut v = Vec::new();
+        v.try_reserve_exact(len).ok()?;
+        v.resize(len, T::default());
+        Some(v)
+    }
+    Ok(if bits == 16 {
+        let data = zeros::<u16>(len).ok_or_else(too_large)?;
+        Picture::Rgba16(render::Rgba16Image::from_raw(width, height, data).ok_or_else(too_large)?)
+    } else {
+        let data = zeros::<u8>(len).ok_or_else(too_large)?;
+        Picture::Rgba8(RgbaImage::from_raw(width, height, data).ok_or_else(too_large)?)
+    })
 }
 
 /// Meshes `image` for `project`, weights it and sets up the project's method: the
-/// whole way from a picture and a rig file to something to draw.
+/// whole way from a picture and a rig file to something to draw ([`setup`] on a
+/// picture).
 ///
 /// # Errors
 /// As [`prepare`], and what the method refuses.
@@ -395,10 +535,9 @@ pub fn prepare_warper(
     image: &RgbaImage,
     project: &Project,
     density: Option<usize>,
-    progress: &(dyn Fn(weights_core::Progress) + Sync),
+    listener: &dyn Listener,
 ) -> Result<Warper> {
-    let prepared = prepare_with_progress(image, project, density, progress)?;
-    Warper::new(prepared.rig, project, image)
+    setup(Source::Picture { image, density }, project, listener)
 }
 
 /// Where an output picture lies over the source's pixels: its pixel `(0, 0)` is the
@@ -479,9 +618,10 @@ impl Warper {
     }
 }
 
-/// The image warped by the current pose on the GPU (or a software adapter): for C²
-/// weights the vertex shader blends the node transforms with the sparse weights; for
-/// a method that gives positions, they are drawn as they are.
+/// The image warped by the current pose on the GPU (or a software adapter), 8 bits
+/// per channel: a skinned method's weights and transforms are blended in the vertex
+/// shader; a method that gives positions has them drawn as they are; over the
+/// method's backdrop.
 ///
 /// # Errors
 /// No adapter, or a GPU failure.
@@ -490,46 +630,61 @@ pub fn warp_gpu(image: &RgbaImage, warper: &Warper) -> Result<RgbaImage> {
     let rest = warper.rest();
     let triangles = &warper.triangles;
     let (w, h) = image.dimensions();
-    let frame = warper.frame(w, h)?;
+    let deformed = warper.deformed()?;
+    let frame = Frame::new(w, h, &deformed, warper.canvas)?;
     let (fw, fh) = (frame.width, frame.height);
-    match warper.deformer.output() {
-        Output::Skinned(rig) => {
-            let (rows, nodes, weights) = rig.weight_table();
+    let layer = match warper.deformer.output() {
+        Output::Skinned(skin) => {
+            let table = skin.table();
             let mesh = render::SkinnedMesh {
                 rest: &rest,
-                rows: &rows,
-                nodes: &nodes,
-                weights: &weights,
+                rows: &table.rows,
+                nodes: &table.nodes,
+                weights: &table.weights,
                 triangles,
             };
             // The frame's shift folded into every node's translation.
             let shift = frame.shift();
-            let affines: Vec<render::Affine> = rig
-                .node_affines()
+            let affines: Vec<render::Affine> = skin
+                .transforms()
                 .into_iter()
                 .map(|[a, b, c, d, x, y]| [a, b, c, d, x + shift.x, y + shift.y])
                 .collect();
-            Ok(gpu.warp_skinned(image, &mesh, &affines, fw, fh)?)
+            gpu.warp_skinned(image, &mesh, &affines, fw, fh)?
         }
         Output::Positions(_) => {
-            let deformed = frame.place(&warper.deformed()?);
+            let deformed = frame.place(&deformed);
             let mesh = render::WarpMesh {
                 rest: &rest,
                 deformed: &deformed,
                 triangles,
             };
-            Ok(gpu.warp(image, &mesh, fw, fh)?)
+            gpu.warp(image, &mesh, fw, fh)?
         }
-    }
+    };
+    Ok(match warper.deformer.backdrop() {
+        Backdrop::Transparent => layer,
+        Backdrop::PictureOutsideMesh => {
+            let base = warper.backdrop(&Picture::Rgba8(image.clone()), frame)?;
+            let mut out = base.into_rgba8();
+            for (base, top) in out.pixels_mut().zip(layer.pixels()) {
+                if top.0[3] > 0 {
+                    *base = render::over(top.0, base.0).into();
+                }
+            }
+            out
+        }
+    })
 }
 
 /// The picture warped by the current pose on the CPU, at its full resolution and in
-/// its own depth: a 16-bit picture gives a 16-bit picture (write it with
-/// [`render::save_png_atomic`] for a 16-bit PNG); an 8-bit one exactly what [`warp`]
-/// gives.
+/// its own depth, over the method's backdrop, in the warper's frame (the picture's
+/// own, or grown to fit the warp: see [`Frame`]): a 16-bit picture gives a 16-bit
+/// picture (write it with [`render::save_png_atomic`] for a 16-bit PNG); an 8-bit one
+/// exactly what [`warp`] gives.
 ///
 /// # Errors
-/// Only if the deformation produced non-finite positions.
+/// Non-finite deformed positions, or a grown canvas too large.
 pub fn warp_picture(picture: &Picture, warper: &Warper) -> Result<Picture> {
     let rest = warper.rest();
     let (w, h) = picture.dimensions();
@@ -541,20 +696,16 @@ pub fn warp_picture(picture: &Picture, warper: &Warper) -> Result<Picture> {
         deformed: &deformed,
         triangles: &warper.triangles,
     };
-    Ok(render::warp_picture(
-        picture,
-        &mesh,
-        frame.width,
-        frame.height,
-        &render::RasterOptions::default(),
-    )?)
+    let mut out = warper.backdrop(picture, frame)?;
+    render::warp_picture_over(picture, &mesh, &mut out)?;
+    Ok(out)
 }
 
-/// The image warped by the current pose, at the image's full resolution, in the
-/// warper's frame (the picture's own, or grown to fit the warp: see [`Frame`]).
+/// The image warped by the current pose, at the image's full resolution, 8 bits per
+/// channel (see [`warp_picture`]).
 ///
 /// # Errors
-/// Only if the deformation produced non-finite positions.
+/// As [`warp_picture`].
 pub fn warp(image: &RgbaImage, warper: &Warper) -> Result<RgbaImage> {
     let rest = warper.rest();
     let (w, h) = image.dimensions();
@@ -566,13 +717,14 @@ pub fn warp(image: &RgbaImage, warper: &Warper) -> Result<RgbaImage> {
         deformed: &deformed,
         triangles: &warper.triangles,
     };
-    Ok(render::warp_cpu(
-        image,
-        &mesh,
-        frame.width,
-        frame.height,
-        &render::RasterOptions::default(),
-    )?)
+    let mut out = match warper.deformer.backdrop() {
+        Backdrop::Transparent => blank(8, frame)?.into_rgba8(),
+        Backdrop::PictureOutsideMesh => warper
+            .backdrop(&Picture::Rgba8(image.clone()), frame)?
+            .into_rgba8(),
+    };
+    render::warp_over(image, &mesh, &mut out)?;
+    Ok(out)
 }
 
 #[cfg(test)]

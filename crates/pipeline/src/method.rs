@@ -1,114 +1,282 @@
 //! The seam where the editor and the command line choose a warping method.
 //!
-//! Every method answers one question — given this rest mesh and these handles, where
-//! does every vertex go? — through [`Deformer`]. Each has an expensive step when the
-//! set of handles (or the method's parameters) changes: building weights, factorising
-//! systems; and a cheap step when only the handles' poses change, as in a drag. Both
-//! happen in [`Deformer::set_handles`], which tells them apart by comparing the
-//! handles' rest positions.
+//! Every method answers one question — where does every point of the picture go? —
+//! through [`Deformer`], whatever the artist moves: handles (C², ARAP) or a cage
+//! (LBC; see [`project::Method::controls`]). A method is set up once on a picture (or
+//! a given mesh) for a rig file ([`setup`]: meshing, weights, factorisations, a cage's
+//! solve), then follows the rig file's poses cheaply ([`Deformer::follow`]). What it
+//! gives is drawn the same way for every method ([`crate::Warper`]): a mesh at rest
+//! (the texture coordinates), where its vertices go ([`Output`]: sparse skinning rows
+//! and one transform per control, or a position per vertex), and what shows behind it
+//! ([`Backdrop`]).
 //!
-//! The methods:
-//! - [`Method::C2`]: the C² weights of `weights-core` ([`Rig`]); its result is best
-//!   drawn skinned (sparse weights and one transform per node, blended per vertex).
-//! - [`Method::Arap`]: as-rigid-as-possible manipulation of the `arap` crate
-//!   ([`ArapRig`], in [`crate::arap`]); its result is a position per vertex.
+//! The methods, each in its own file:
+//! - [`Method::C2`] (`c2.rs`): the C² weights of `weights-core`, a [`Rig`] as it is.
+//! - [`Method::Arap`] (`arap.rs`): as-rigid-as-possible manipulation, [`ArapRig`].
+//! - [`Method::Lbc`] (`cage.rs`): local barycentric coordinates of a cage,
+//!   [`CageDeformer`].
 //!
 //! To add a method: a variant of [`Method`] (in the `project` crate, with its rig-file
-//! name), a type implementing [`Deformer`], and a case in [`deformer`].
+//! name and its controls), a file here with a type implementing [`Deformer`], and its
+//! line in [`on_handles`] (a handle method) or [`setup`] (a cage method).
 
-use anyhow::Result;
+use std::any::Any;
+
+use anyhow::{Context, Result, bail};
 use glam::DVec2;
-pub use project::Method;
+use image::RgbaImage;
+pub use lbc::Progress as SolveProgress;
 use project::Project;
-use weights_core::{Domain, Handle, Rig};
+pub use project::{Controls, Method};
+use weights_core::Rig;
 
-use crate::arap::{ArapOptions, ArapRig};
+use crate::Warper;
+use crate::arap::ArapRig;
+use crate::cage::CageDeformer;
 
-/// How a method's result is best drawn.
+/// How a method's result is drawn.
 pub enum Output<'a> {
-    /// Sparse weights and node transforms, blended per vertex (on the GPU, in the
-    /// vertex shader): only the transforms change during a drag.
-    Skinned(&'a Rig),
+    /// Sparse weights and one transform per control, blended per vertex (on the GPU,
+    /// in the vertex shader): only the transforms change during a drag.
+    Skinned(&'a dyn Skinning),
     /// A deformed position per mesh vertex (8 bytes a vertex to upload in f32).
     Positions(&'a [DVec2]),
 }
 
-/// A warping method set up on a rest mesh and a set of handles.
+/// A method whose result is a linear blend of transforms: every vertex `x` goes to
+/// `Σ wᵢ Aᵢ x` over the rows of [`Skinning::table`] and the transforms of
+/// [`Skinning::transforms`].
+pub trait Skinning {
+    /// Every vertex's weights: row `v` is `nodes[rows[v]..rows[v + 1]]` with
+    /// `weights` alongside, as [`render::SkinnedMesh`] takes them.
+    fn table(&self) -> SkinTable;
+
+    /// One affine map per node in the current pose, in image pixels.
+    fn transforms(&self) -> Vec<render::Affine>;
+}
+
+/// Sparse skinning rows (see [`Skinning::table`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SkinTable {
+    /// Row starts, one more than the vertices.
+    pub rows: Vec<u32>,
+    /// The node of each entry.
+    pub nodes: Vec<u32>,
+    /// The weight of each entry.
+    pub weights: Vec<f32>,
+}
+
+/// What shows behind a method's warped mesh.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Backdrop {
+    /// Nothing: the mesh covers every visible pixel of the picture, and what it leaves
+    /// uncovered in the warp is transparent.
+    Transparent,
+    /// The picture where the mesh does not cover it at rest (a cage's outside), kept in
+    /// place; the pixels the rest mesh covers are cleared
+    /// ([`render::clear_covered`]) and the warped mesh is drawn over them.
+    PictureOutsideMesh,
+}
+
+/// Whether a method followed a rig file ([`Deformer::follow`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Follow {
+    /// It is up to date: posed, or set up again where handles came or went.
+    Followed,
+    /// The rig file asks for what only a new [`setup`] gives (new settings, another
+    /// rest cage); nothing changed.
+    NeedsSetup,
+}
+
+/// What `c2warp weights` lists beside a method's weights.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct WeightsListing {
+    /// Vertices the mesh file had (vertices after them were inserted for handles);
+    /// for a picture, the mesh's vertex count.
+    pub file_vertices: usize,
+    /// Whether to list the vertices' positions (the mesh was made, not given).
+    pub positions: bool,
+}
+
+/// A warping method set up on a rest mesh for a rig file's controls.
 pub trait Deformer: Send {
     /// Which method this is.
     fn method(&self) -> Method;
 
-    /// The rest mesh.
-    fn domain(&self) -> &Domain;
+    /// The mesh it moves, at rest: vertex positions in image pixels (the texture
+    /// coordinates of the drawing).
+    fn rest(&self) -> &[DVec2];
 
-    /// The handles, in their current poses.
-    fn handles(&self) -> &[Handle];
+    /// The mesh's triangles (indices into [`Deformer::rest`]), in the mesh's order.
+    fn triangles(&self) -> &[[u32; 3]];
 
-    /// Takes new handles: the expensive step when handles were added, removed or moved
-    /// at rest, else the cheap one (a new pose). On error nothing changes.
+    /// Follows `project`, a rig file for the same picture and density as the one set
+    /// up: a new pose of the same controls is cheap; handles added or removed set up
+    /// what they need. On error nothing changes.
     ///
     /// # Errors
-    /// Handles the method refuses (off the shape, coincident, non-finite).
-    fn set_handles(&mut self, handles: &[Handle]) -> Result<()>;
+    /// Controls the method refuses (off the shape, coincident, non-finite).
+    fn follow(&mut self, project: &Project) -> Result<Follow>;
 
-    /// Where every mesh vertex goes in the current pose.
+    /// Where every vertex of [`Deformer::rest`] goes in the current pose.
     fn deformed(&self) -> Vec<DVec2>;
 
     /// The result, in the form that draws best.
     fn output(&self) -> Output<'_>;
+
+    /// What shows behind the warped mesh.
+    fn backdrop(&self) -> Backdrop {
+        Backdrop::Transparent
+    }
+
+    /// What a user should hear about the setup (a solve that did not converge).
+    fn notes(&self) -> Vec<String> {
+        Vec::new()
+    }
+
+    /// `c2warp weights`: the nodes and every vertex's non-zero weights, as JSON.
+    ///
+    /// # Errors
+    /// A method without weights per control.
+    fn weights(&self, listing: WeightsListing) -> Result<serde_json::Value>;
+
+    /// `c2warp bench`: the method's steps timed (its setup as it was measured, then
+    /// `poses` poses or insertions), as JSON.
+    ///
+    /// # Errors
+    /// What the method refuses while being timed.
+    fn bench(&mut self, project: &Project, poses: usize) -> Result<serde_json::Value>;
+
+    /// The concrete type, for what only one method shows (the editor's overlays).
+    fn as_any(&self) -> &dyn Any;
 }
 
-impl Deformer for Rig {
-    fn method(&self) -> Method {
-        Method::C2
-    }
+/// Where a method's mesh comes from.
+#[derive(Clone, Copy)]
+pub enum Source<'a> {
+    /// A picture, meshed (at `density` vertices, else the rig file's, else the
+    /// default); a cage method meshes the inside of its cage.
+    Picture {
+        /// The picture.
+        image: &'a RgbaImage,
+        /// Target vertex count, overriding the rig file's.
+        density: Option<usize>,
+    },
+    /// A given mesh (`--mesh`): its vertices as they are; handles that miss its
+    /// vertices are inserted after them ([`crate::rig_on_mesh`]); a cage method takes
+    /// it as the cage's inside.
+    Mesh(&'a mesh::Mesh),
+}
 
-    fn domain(&self) -> &Domain {
-        Rig::domain(self)
-    }
-
-    fn handles(&self) -> &[Handle] {
-        Rig::handles(self)
-    }
-
-    fn set_handles(&mut self, handles: &[Handle]) -> Result<()> {
-        Ok(Rig::set_handles(self, handles.to_vec())?)
-    }
-
-    fn deformed(&self) -> Vec<DVec2> {
-        self.deform()
-    }
-
-    fn output(&self) -> Output<'_> {
-        Output::Skinned(self)
+impl<'a> Source<'a> {
+    /// The picture, if the mesh is made from one.
+    pub fn picture(&self) -> Option<&'a RgbaImage> {
+        match *self {
+            Source::Picture { image, .. } => Some(image),
+            Source::Mesh(_) => None,
+        }
     }
 }
 
-/// Sets up the rig file's method (`project.method`) on the mesh of `rig` (the C² rig
-/// built by [`crate::prepare`]) with its handles: for ARAP, on its own mesh of
-/// `picture` (see [`crate::arap`]), or on the rig's mesh itself without a picture (a
-/// mesh given as such, `c2warp deform --mesh`).
+/// Hears how a setup is coming along. Called from the setup's threads: keep it short.
+pub trait Listener: Sync {
+    /// The rig build's progress (see [`weights_core::Progress`]).
+    fn weighting(&self, _progress: weights_core::Progress) {}
+
+    /// A cage solve's iteration; `false` cancels the solve.
+    fn solving(&self, _progress: &SolveProgress) -> bool {
+        true
+    }
+}
+
+/// Hears nothing.
+impl Listener for () {}
+
+/// Sets up `project`'s method on `source`, with its triangles in drawing order: the
+/// whole way from a picture (or a mesh) and a rig file to something to draw.
 ///
 /// # Errors
-/// What the method refuses.
-pub fn deformer(
+/// What meshing, the rig build or the method refuses, each as one sentence.
+pub fn setup(source: Source<'_>, project: &Project, listener: &dyn Listener) -> Result<Warper> {
+    match project.method.controls() {
+        // LBC is the one cage method.
+        Controls::Cage => {
+            let deformer = CageDeformer::set_up(source, project, listener)?;
+            Ok(Warper::in_mesh_order(Box::new(deformer), project.canvas))
+        }
+        Controls::Handles => {
+            let weighting = |p| listener.weighting(p);
+            let rig = match source {
+                Source::Picture { image, density } => {
+                    crate::prepare_with_progress(image, project, density, &weighting)?.rig
+                }
+                Source::Mesh(mesh) => crate::rig_on_mesh(mesh, project, &weighting)?,
+            };
+            Warper::on_rig(rig, project, source.picture())
+        }
+    }
+}
+
+/// Sets up `project`'s handle method on `rig` (the picture's mesh with the rig file's
+/// handles, as [`crate::prepare`] builds it; the editor keeps one): C² is the rig
+/// itself; ARAP meshes `picture` its own way and the rig's mesh follows (without a
+/// picture it solves on the rig's mesh: a mesh given as such).
+///
+/// # Errors
+/// What the method refuses, and a cage method (set up by [`setup`], or from its solved
+/// coordinates: [`CageDeformer::new`]).
+pub fn on_handles(
     project: &Project,
     rig: Rig,
-    picture: Option<&image::RgbaImage>,
+    picture: Option<&RgbaImage>,
 ) -> Result<Box<dyn Deformer>> {
     Ok(match project.method {
         Method::C2 => Box::new(rig),
-        Method::Arap => {
-            let (domain, handles) = (rig.domain().clone(), rig.handles());
-            let strokes = &project.rigidity;
-            Box::new(match picture {
-                Some(picture) => {
-                    let options = ArapOptions::for_picture(project, picture);
-                    ArapRig::with_own_mesh(picture, domain, handles, strokes, options)?
-                }
-                None => ArapRig::new(domain, handles, strokes, ArapOptions::of(project, None))?,
-            })
-        }
-        Method::Lbc => anyhow::bail!("LBC warps by a cage, not by handles (see pipeline::cage)"),
+        Method::Arap => Box::new(ArapRig::on_rig(project, rig, picture)?),
+        Method::Lbc => bail!("LBC warps by a cage, not by handles"),
     })
+}
+
+/// The median of `values` (NaN for none): for the benchmarks' reports.
+pub(crate) fn median(values: Vec<f64>) -> f64 {
+    quantile(values, 0.5)
+}
+
+/// The `q`-quantile (nearest rank) of `values`; NaN for none.
+pub(crate) fn quantile(mut values: Vec<f64>, q: f64) -> f64 {
+    if values.is_empty() {
+        return f64::NAN;
+    }
+    values.sort_by(f64::total_cmp);
+    let rank = ((q * values.len() as f64).ceil() as usize).clamp(1, values.len());
+    values[rank - 1]
+}
+
+/// A report as JSON.
+pub(crate) fn json(report: &impl serde::Serialize) -> Result<serde_json::Value> {
+    serde_json::to_value(report).context("cannot write the report as JSON")
+}
+
+/// A fixed sequence of numbers in [−0.5, 0.5) (xorshift), so that benchmark runs
+/// compare.
+pub(crate) struct Sequence(u64);
+
+impl Sequence {
+    /// The sequence every benchmark starts from.
+    pub(crate) fn new() -> Self {
+        Self(0x2545_F491_4F6C_DD1D)
+    }
+
+    /// The next raw 64-bit value.
+    pub(crate) fn next_u64(&mut self) -> u64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        self.0
+    }
+
+    /// The next number in [−0.5, 0.5).
+    pub(crate) fn next(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    }
 }

@@ -249,7 +249,7 @@ fn identity_keeps_every_visible_pixel(name: &str, img: &RgbaImage) {
             let vertices = prepared.rig.domain().len();
             let out = pipeline::warp(
                 img,
-                &pipeline::Warper::new(prepared.rig, &project, img).unwrap(),
+                &pipeline::Warper::on_rig(prepared.rig, &project, Some(img)).unwrap(),
             )
             .unwrap();
             let mut lost = 0;

@@ -81,6 +81,28 @@ impl Method {
             Method::Lbc => "LBC cage",
         }
     }
+
+    /// What the artist moves to drive it.
+    pub fn controls(self) -> Controls {
+        match self {
+            Method::C2 | Method::Arap => Controls::Handles,
+            Method::Lbc => Controls::Cage,
+        }
+    }
+
+    /// The names of every method, for messages: `c2, arap, lbc`.
+    pub fn names() -> String {
+        Method::ALL.map(Method::name).join(", ")
+    }
+}
+
+/// What the artist moves to drive a method.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Controls {
+    /// Point and bar handles on the picture (the rig file's `"handles"`).
+    Handles,
+    /// A cage around the picture (the rig file's `"cage"`).
+    Cage,
 }
 
 impl std::str::FromStr for Method {
@@ -90,7 +112,7 @@ impl std::str::FromStr for Method {
         Method::ALL
             .into_iter()
             .find(|m| m.name() == s)
-            .ok_or_else(|| format!("unknown method {s:?} (known: c2, arap, lbc)"))
+            .ok_or_else(|| format!("unknown method {s:?} (known: {})", Method::names()))
     }
 }
 

@@ -175,6 +175,15 @@ pub enum RenderError {
         height: u32,
     },
 
+    /// A picture drawn over one of another depth.
+    #[error("a {texture}-bit picture cannot be drawn over a {target}-bit one")]
+    DepthMismatch {
+        /// Bits per channel of the picture drawn.
+        texture: u8,
+        /// Bits per channel of the picture drawn over.
+        target: u8,
+    },
+
     /// The requested output image cannot be allocated.
     #[error("output image {width}x{height} is too large to allocate")]
     OutputTooLarge {

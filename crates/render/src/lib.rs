@@ -47,4 +47,7 @@ pub use image_io::{ImageLimits, decode_image, decode_picture, load_image, load_p
 pub use mesh::WarpMesh;
 pub use picture::{Picture, Rgba16Image};
 pub use view::{MeshView, Overlay, ViewParams};
-pub use warp::{RasterOptions, coverage_counts, warp_cpu, warp_over, warp_picture};
+pub use warp::{
+    RasterOptions, clear_covered, coverage_counts, warp_cpu, warp_over, warp_picture,
+    warp_picture_over,
+};

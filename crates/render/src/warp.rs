@@ -154,6 +154,67 @@ pub fn warp_over(
     Ok(())
 }
 
+/// As [`warp_over`], in the picture's own depth: `texture` and `target` must have the
+/// same depth (a 16-bit picture is drawn over a 16-bit target with 16 bits per
+/// channel).
+///
+/// # Errors
+/// As [`warp_over`], and [`RenderError::DepthMismatch`] for pictures of different
+/// depths.
+pub fn warp_picture_over(
+    texture: &Picture,
+    mesh: &WarpMesh,
+    target: &mut Picture,
+) -> Result<(), RenderError> {
+    let (tw, th) = texture.dimensions();
+    check(mesh, tw, th)?;
+    let (width, height) = target.dimensions();
+    match (texture, target) {
+        (Picture::Rgba8(texture), Picture::Rgba8(target)) => {
+            draw_texels(texture.as_raw(), tw, th, mesh, target, width, height);
+        }
+        (Picture::Rgba16(texture), Picture::Rgba16(target)) => {
+            draw_texels(texture.as_raw(), tw, th, mesh, target, width, height);
+        }
+        (texture, target) => {
+            return Err(RenderError::DepthMismatch {
+                texture: texture.bits_per_channel(),
+                target: target.bits_per_channel(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Makes transparent every pixel of `picture` that `mesh` covers at its deformed
+/// positions, by the rasteriser's own rule (pixel centres, top-left fill rule): the
+/// pixels [`warp_picture_over`] would draw. Drawing the same mesh over the cleared
+/// picture at rest gives the picture back exactly.
+///
+/// # Errors
+/// An invalid mesh, or a picture too large to count coverage for.
+pub fn clear_covered(picture: &mut Picture, mesh: &WarpMesh) -> Result<(), RenderError> {
+    let (w, h) = picture.dimensions();
+    let covered = coverage_counts(mesh, w, h)?;
+    match picture {
+        Picture::Rgba8(image) => clear_where(image.pixels_mut().map(|p| &mut p.0), &covered),
+        Picture::Rgba16(image) => clear_where(image.pixels_mut().map(|p| &mut p.0), &covered),
+    }
+    Ok(())
+}
+
+/// Sets to transparent black each pixel whose count is positive.
+fn clear_where<'a, C: Default + Copy + 'a>(
+    pixels: impl Iterator<Item = &'a mut [C; 4]>,
+    counts: &[u32],
+) {
+    for (pixel, &count) in pixels.zip(counts) {
+        if count > 0 {
+            *pixel = [C::default(); 4];
+        }
+    }
+}
+
 /// Refuses an invalid mesh or an empty texture.
 fn check(mesh: &WarpMesh, tw: u32, th: u32) -> Result<(), RenderError> {
     mesh.validate()?;

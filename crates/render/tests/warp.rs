@@ -662,3 +662,50 @@ fn warp_over_keeps_what_it_does_not_cover_and_composites_the_rest() {
     render::warp_over(&texture, &mesh, &mut opaque).expect("warp");
     assert!(opaque.pixels().all(|p| p[3] == 255));
 }
+
+#[test]
+fn a_picture_cleared_where_a_mesh_covers_it_comes_back_when_the_mesh_is_drawn_at_rest() {
+    let image = random_image(40, 30, 5);
+    let wide = render::Picture::Rgba16(widen(&image));
+    // A mesh over part of the picture only: its left two thirds.
+    let grid = Grid::new(26.0, 30.0, 4, 3);
+    let mesh = WarpMesh {
+        rest: &grid.positions,
+        deformed: &grid.positions,
+        triangles: &grid.triangles,
+    };
+    for picture in [render::Picture::Rgba8(image.clone()), wide] {
+        let mut cleared = picture.clone();
+        render::clear_covered(&mut cleared, &mesh).expect("clear");
+        let counts = coverage_counts(&mesh, 40, 30).expect("coverage");
+        let narrow = cleared.to_rgba8();
+        for (i, p) in narrow.pixels().enumerate() {
+            let (x, y) = (i as u32 % 40, i as u32 / 40);
+            if counts[i] > 0 {
+                assert_eq!(p.0, [0; 4], "({x}, {y}) is cleared");
+            } else {
+                assert_eq!(p, image.get_pixel(x, y), "({x}, {y}) is kept");
+            }
+        }
+        assert!(counts.contains(&0) && counts.iter().any(|&c| c > 0));
+        // Drawn back at rest over the cleared picture: exactly the picture, in its
+        // own depth.
+        render::warp_picture_over(&picture, &mesh, &mut cleared).expect("warp");
+        assert_eq!(cleared, picture);
+    }
+    // Depths must agree.
+    let mut narrow = render::Picture::Rgba8(image.clone());
+    let err =
+        render::warp_picture_over(&render::Picture::Rgba16(widen(&image)), &mesh, &mut narrow)
+            .expect_err("16 over 8");
+    assert!(
+        matches!(
+            err,
+            RenderError::DepthMismatch {
+                texture: 16,
+                target: 8
+            }
+        ),
+        "{err}"
+    );
+}

@@ -139,9 +139,15 @@ pub fn warp(
     arap: Option<&str>,
 ) -> (weights_core::Domain, Vec<DVec2>) {
     let project = case.project(arap);
-    let warper = pipeline::prepare_warper(&case.image, &project, Some(density), &|_| {})
+    let warper = pipeline::prepare_warper(&case.image, &project, Some(density), &())
         .unwrap_or_else(|e| panic!("{} at density {density}: {e:#}", case.name));
-    let domain = warper.deformer.domain().clone();
+    let deformer = &warper.deformer;
+    let domain = weights_core::Domain::new(
+        deformer.rest().to_vec(),
+        deformer.triangles().to_vec(),
+        weights_core::Metric::Euclidean,
+    )
+    .expect("the picture's mesh");
     let deformed = warper.deformer.deformed();
     (domain, deformed)
 }
