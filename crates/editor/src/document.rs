@@ -17,7 +17,7 @@ use anyhow::{Context, Result, bail};
 use glam::DVec2;
 use image::RgbaImage;
 use pipeline::cage::{CageCoordinates, CageMesh};
-use pipeline::{ArapRig, ArapTimes, Deformer, Method};
+use pipeline::{ArapRig, Controls, Deformer, Follow, Method};
 use project::{
     CageSpec, HandleSpec, LbcSettings, MetricChoice, Middle, Placement, Project, RigidityStroke,
     Tau,
@@ -207,9 +207,10 @@ pub struct Document {
     deformed: Option<((u64, u64), Vec<DVec2>)>,
     /// Bumped when the picture is meshed anew.
     mesh_version: u64,
-    /// With ARAP chosen: its deformer, and the mesh version it was set up on. The C²
-    /// rig stays beside it: it holds the mesh and the handles, and its heat maps.
-    arap: Option<(u64, ArapRig)>,
+    /// With a handle method other than C² chosen: its deformer, and the mesh version
+    /// it was set up on ([`pipeline::beside_rig`]). The C² rig stays beside it: it
+    /// holds the mesh and the handles, and its heat maps.
+    method: Option<(u64, Box<dyn Deformer>)>,
     /// Solved cages, the most recent last (at most [`SOLUTIONS_KEPT`]).
     solutions: Vec<(CageKey, Arc<CageCoordinates>)>,
     /// The solved cage's mesh deformed by the cage's pose, and the (pose, weights)
@@ -263,7 +264,7 @@ impl Document {
             last_update_ms: ms(clock),
             deformed: None,
             mesh_version: 1,
-            arap: None,
+            method: None,
             solutions: Vec::new(),
             cage_deformed: None,
         }
@@ -277,31 +278,24 @@ impl Document {
         Ok(self)
     }
 
-    /// Brings the method's deformer in line with the rig file: for ARAP, set up (on a
-    /// new mesh, when first chosen or with new settings), repainted and posed with the
-    /// rig's handles; for C², none.
+    /// Brings the method's deformer in line with the rig file: a handle method other
+    /// than C² follows the rig file's handles and settings (set up anew on a new mesh,
+    /// when first chosen or with new settings); C² is the rig itself; a cage method is
+    /// the solved cage's ([`Document::cage_solution`]).
     fn sync_method(&mut self) -> Result<()> {
-        if self.project.method != Method::Arap {
-            self.arap = None;
+        if self.project.method.controls() != Controls::Handles {
+            self.method = None;
             return Ok(());
         }
-        let options = pipeline::ArapOptions::for_picture(&self.project, &self.image);
-        match &mut self.arap {
-            Some((mesh, arap)) if *mesh == self.mesh_version && arap.options() == options => {
-                arap.set_rigidity(&self.project.rigidity)?;
-                arap.set_handles(self.rig.handles())?;
-            }
-            _ => {
-                let arap = ArapRig::with_own_mesh(
-                    &self.image,
-                    self.rig.domain().clone(),
-                    self.rig.handles(),
-                    &self.project.rigidity,
-                    options,
-                )?;
-                self.arap = Some((self.mesh_version, arap));
-            }
+        if let Some((mesh, deformer)) = &mut self.method
+            && *mesh == self.mesh_version
+            && deformer.method() == self.project.method
+            && deformer.follow(&self.project)? == Follow::Followed
+        {
+            return Ok(());
         }
+        self.method = pipeline::beside_rig(&self.project, &self.rig, Some(&self.image))?
+            .map(|deformer| (self.mesh_version, deformer));
         Ok(())
     }
 
@@ -322,22 +316,19 @@ impl Document {
         self.project.method
     }
 
-    /// The method's deformer: the ARAP rig, or the C² rig.
+    /// The handle method's deformer: the C² rig itself, or the one set up beside it.
     pub fn deformer(&self) -> &dyn Deformer {
-        match &self.arap {
-            Some((_, arap)) => arap,
+        match &self.method {
+            Some((_, deformer)) => deformer.as_ref(),
             None => &self.rig,
         }
     }
 
-    /// ARAP's step times, when ARAP is in use.
-    pub fn arap_times(&self) -> Option<ArapTimes> {
-        self.arap.as_ref().map(|(_, arap)| arap.times())
-    }
-
-    /// ARAP's per-triangle rigidity, when ARAP is in use.
-    pub fn rigidity(&self) -> Option<&[f64]> {
-        self.arap.as_ref().map(|(_, arap)| arap.rigidity())
+    /// The ARAP rig, when ARAP is in use (its step times, its rigidity per triangle).
+    pub fn arap(&self) -> Option<&ArapRig> {
+        self.method
+            .as_ref()
+            .and_then(|(_, deformer)| deformer.as_any().downcast_ref::<ArapRig>())
     }
 
     /// The cage, if the rig file has one.
@@ -863,40 +854,46 @@ impl Document {
         if let Some(v) = self.rig.deform().iter().position(|p| !p.is_finite()) {
             bail!("sample {v} deforms to a non-finite point");
         }
-        match (&self.arap, self.project.method) {
-            (None, Method::C2 | Method::Lbc) => {}
-            (Some((mesh, arap)), Method::Arap) => {
-                if *mesh != self.mesh_version {
-                    bail!("the ARAP deformer was set up on another mesh");
-                }
-                if arap.handles() != self.rig.handles() {
-                    bail!("the ARAP deformer has other handles than the rig");
-                }
-                if arap.strokes() != self.project.rigidity.as_slice() {
-                    bail!("the ARAP deformer has other rigidity than the rig file");
-                }
-                let positions = arap.positions();
-                if positions.len() != self.rig.domain().len() {
-                    bail!(
-                        "ARAP gives {} positions for {} samples",
-                        positions.len(),
-                        self.rig.domain().len()
-                    );
-                }
-                if let Some(v) = positions.iter().position(|p| !p.is_finite()) {
-                    bail!("ARAP sends sample {v} to a non-finite point");
-                }
-            }
-            (arap, method) => bail!(
-                "method {} with{} an ARAP deformer",
-                method.name(),
-                if arap.is_some() { "" } else { "out" }
-            ),
-        }
+        self.method_sanity_check()?;
         if self.weights_version == 0 || self.pose_version == 0 {
             bail!("versions start at 1");
         }
         self.cage_sanity_check()
+    }
+
+    /// The method's deformer is in step with the rig file: set up on this mesh for the
+    /// method chosen, and following the rig file again changes nothing.
+    fn method_sanity_check(&self) -> Result<()> {
+        let method = self.project.method;
+        let Some((mesh, deformer)) = &self.method else {
+            // The rig is the deformer (C²), or the method has no handles.
+            if method.controls() == Controls::Handles && Deformer::method(&self.rig) != method {
+                bail!("method {} has no deformer", method.name());
+            }
+            return Ok(());
+        };
+        if method.controls() != Controls::Handles || deformer.method() != method {
+            bail!(
+                "method {} with a deformer of {}",
+                method.name(),
+                deformer.method().name()
+            );
+        }
+        if *mesh != self.mesh_version || deformer.rest() != self.rig.domain().positions() {
+            bail!("the {} deformer was set up on another mesh", method.name());
+        }
+        let deformed = deformer.deformed();
+        if let Some(v) = deformed.iter().position(|p| !p.is_finite()) {
+            bail!("{} sends sample {v} to a non-finite point", method.label());
+        }
+        let mut again = deformer.clone_box();
+        if again.follow(&self.project)? != Follow::Followed || again.deformed() != deformed {
+            bail!(
+                "the {} deformer is out of step with the rig file",
+                method.label()
+            );
+        }
+        Ok(())
     }
 
     /// Checks that the rig file this document saves gives back what the document

@@ -4,6 +4,7 @@
 use std::time::Instant;
 
 use egui::{Key, KeyboardShortcut, Modifiers, Ui};
+use pipeline::ArapRig;
 use project::{Method, MetricChoice, Middle, Placement};
 
 use crate::app::{EditorApp, Pending, Tool};
@@ -716,7 +717,7 @@ impl EditorApp {
                     ui.separator();
                     ui.label(format!("weights updated in {:.1} ms", doc.last_update_ms));
                 }
-                if let Some(times) = doc.arap_times() {
+                if let Some(times) = doc.arap().map(ArapRig::times) {
                     ui.separator();
                     ui.label(format!(
                         "ARAP: compiled in {:.1} ms, updated in {:.2} ms",

@@ -37,7 +37,10 @@ fn switching_methods_keeps_the_pose_and_comes_back_and_undoes() {
     assert_eq!(method(&h), Method::Arap);
     let doc = h.state().document().expect("doc");
     assert_eq!(doc.project().handles, handles, "same handles and pose");
-    let times = doc.arap_times().expect("ARAP is set up");
+    let times = doc
+        .arap()
+        .map(pipeline::ArapRig::times)
+        .expect("ARAP is set up");
     assert!(times.compile_ms > 0.0);
     // The editor's ARAP is the method's own answer for the rig's mesh and handles.
     let project = doc.project();
@@ -97,7 +100,7 @@ fn a_drag_under_arap_moves_the_handle_and_keeps_the_compiled_system() {
     let compile = h
         .state()
         .document()
-        .and_then(|d| d.arap_times())
+        .and_then(|d| d.arap().map(pipeline::ArapRig::times))
         .expect("ARAP");
     // Handle 2 is a point at (440, 238) moved by (-20, -60); drag it 20 px right and
     // 10 px down.
@@ -112,7 +115,7 @@ fn a_drag_under_arap_moves_the_handle_and_keeps_the_compiled_system() {
         "moved by {moved}"
     );
     let doc = h.state().document().expect("doc");
-    let after = doc.arap_times().expect("ARAP");
+    let after = doc.arap().map(pipeline::ArapRig::times).expect("ARAP");
     assert_eq!(
         after.compile_ms, compile.compile_ms,
         "a translation drag recompiles nothing"
@@ -156,7 +159,8 @@ fn painted_rigidity_is_one_undo_step_and_erases() {
     let stiff = h
         .state()
         .document()
-        .and_then(|d| d.rigidity())
+        .and_then(|d| d.arap())
+        .map(pipeline::ArapRig::rigidity)
         .expect("ARAP")
         .iter()
         .filter(|w| **w > 1.0)

@@ -322,7 +322,11 @@ impl ArapRig {
     ///
     /// # Errors
     /// As [`ArapRig::with_own_mesh`].
-    pub fn on_rig(project: &Project, rig: Rig, picture: Option<&image::RgbaImage>) -> Result<Self> {
+    pub fn on_rig(
+        project: &Project,
+        rig: &Rig,
+        picture: Option<&image::RgbaImage>,
+    ) -> Result<Self> {
         let handles = crate::handles(project);
         let (domain, strokes) = (rig.domain().clone(), &project.rigidity);
         match picture {
@@ -577,6 +581,10 @@ impl Deformer for ArapRig {
 
     fn as_any(&self) -> &dyn Any {
         self
+    }
+
+    fn clone_box(&self) -> Box<dyn Deformer> {
+        Box::new(self.clone())
     }
 }
 

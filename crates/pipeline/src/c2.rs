@@ -150,6 +150,10 @@ impl Deformer for Rig {
     fn as_any(&self) -> &dyn Any {
         self
     }
+
+    fn clone_box(&self) -> Box<dyn Deformer> {
+        Box::new(self.clone())
+    }
 }
 
 fn metric_name(metric: Metric) -> &'static str {

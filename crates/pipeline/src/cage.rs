@@ -187,6 +187,7 @@ pub fn cage_coordinates(
 /// the posed cage takes it, over what lies outside. It draws skinned: the compact rows
 /// are the weight rows, and each cage vertex a node whose transform has no linear part
 /// and the posed vertex as its translation ([`skinning_table`], [`pose_transforms`]).
+#[derive(Clone)]
 pub struct CageDeformer {
     solved: Arc<CageCoordinates>,
     pose: Vec<DVec2>,
@@ -393,6 +394,10 @@ impl Deformer for CageDeformer {
 
     fn as_any(&self) -> &dyn Any {
         self
+    }
+
+    fn clone_box(&self) -> Box<dyn Deformer> {
+        Box::new(self.clone())
     }
 }
 

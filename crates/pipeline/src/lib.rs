@@ -20,7 +20,7 @@ use render::Picture;
 pub use arap::{ArapOptions, ArapRig, ArapTimes};
 pub use method::{
     Backdrop, Controls, Deformer, Follow, Listener, Method, Output, SkinTable, Skinning,
-    SolveProgress, Source, WeightsListing, on_handles, setup,
+    SolveProgress, Source, WeightsListing, beside_rig, on_handles, setup,
 };
 pub use order::draw_order;
 

@@ -18,7 +18,7 @@
 //!
 //! To add a method: a variant of [`Method`] (in the `project` crate, with its rig-file
 //! name and its controls), a file here with a type implementing [`Deformer`], and its
-//! line in [`on_handles`] (a handle method) or [`setup`] (a cage method).
+//! line in [`beside_rig`] (a handle method) or [`setup`] (a cage method).
 
 use std::any::Any;
 
@@ -149,6 +149,15 @@ pub trait Deformer: Send {
 
     /// The concrete type, for what only one method shows (the editor's overlays).
     fn as_any(&self) -> &dyn Any;
+
+    /// A copy (a document copied to a worker thread takes its method along).
+    fn clone_box(&self) -> Box<dyn Deformer>;
+}
+
+impl Clone for Box<dyn Deformer> {
+    fn clone(&self) -> Self {
+        self.clone_box()
+    }
 }
 
 /// Where a method's mesh comes from.
@@ -218,21 +227,38 @@ pub fn setup(source: Source<'_>, project: &Project, listener: &dyn Listener) -> 
 }
 
 /// Sets up `project`'s handle method on `rig` (the picture's mesh with the rig file's
-/// handles, as [`crate::prepare`] builds it; the editor keeps one): C² is the rig
-/// itself; ARAP meshes `picture` its own way and the rig's mesh follows (without a
-/// picture it solves on the rig's mesh: a mesh given as such).
+/// handles, as [`crate::prepare`] builds it): C² is the rig itself; ARAP meshes
+/// `picture` its own way and the rig's mesh follows (without a picture it solves on
+/// the rig's mesh: a mesh given as such).
 ///
 /// # Errors
-/// What the method refuses, and a cage method (set up by [`setup`], or from its solved
-/// coordinates: [`CageDeformer::new`]).
+/// As [`beside_rig`].
 pub fn on_handles(
     project: &Project,
     rig: Rig,
     picture: Option<&RgbaImage>,
 ) -> Result<Box<dyn Deformer>> {
+    Ok(match beside_rig(project, &rig, picture)? {
+        Some(deformer) => deformer,
+        None => Box::new(rig),
+    })
+}
+
+/// **The one place a handle method is chosen.** `project`'s handle method set up beside
+/// `rig` (which the editor keeps for its mesh, its handles and its overlays): `None`
+/// where the rig is the method's deformer itself (C²).
+///
+/// # Errors
+/// What the method refuses, and a cage method (set up by [`setup`], or from its solved
+/// coordinates: [`CageDeformer::new`]).
+pub fn beside_rig(
+    project: &Project,
+    rig: &Rig,
+    picture: Option<&RgbaImage>,
+) -> Result<Option<Box<dyn Deformer>>> {
     Ok(match project.method {
-        Method::C2 => Box::new(rig),
-        Method::Arap => Box::new(ArapRig::on_rig(project, rig, picture)?),
+        Method::C2 => None,
+        Method::Arap => Some(Box::new(ArapRig::on_rig(project, rig, picture)?)),
         Method::Lbc => bail!("LBC warps by a cage, not by handles"),
     })
 }
