@@ -3,35 +3,42 @@
 //!
 //! At a vertex `v` every variant's answer is linear in the posed control positions
 //! `q_j` (a posed point, or one end of a posed bar) — for rigid, the unnormalised
-//! vector `f⃗_r(v)` and the centroid `q*` are. With the weighted centroid
-//! `p* = Σ m_j y_j / Σ m_j` of the rest positions `y_j` (masses `m_j`: a point's
-//! weight `w_i`; a bar's ends `δ00 + δ01` and `δ01 + δ11`), `p̂_j = y_j − p*`, and the
-//! *moment vector* of each position
+//! vector `f⃗_r(v)` and the centroid `q*` are. With the weights `w_i` of the point
+//! handles, the bar integrals, the weighted centroid `p*`, `p̂ = p − p*`, and for each
+//! posed position its *moment vector*
 //!
 //! ```text
-//! point i:         e = w_i p̂_i
-//! bar end a (c):   e = δ00 â + δ01 b̂
-//! bar end b (d):   e = δ01 â + δ11 b̂
+//! point i:           e = w_i p̂_i
+//! bar end a (→ c):   e = ∫ w p̂(t) (1 − t) ds   (= δ00 â + δ01 b̂ in the paper's terms)
+//! bar end b (→ d):   e = ∫ w p̂(t) t ds         (= δ01 â + δ11 b̂)
 //! ```
 //!
-//! the paper's sums and integrals are `Σ_j p̂_jᵀ e_j` (the 2×2 moment matrix of
-//! affine), `μ_s = Σ_j p̂_j · e_j` (similarity) and `Σ_j q̂_j ⊗ e_j` (both). Written
-//! with complex numbers (a row vector times `[[α, β], [−β, α]]` is a complex product
-//! by `α + iβ`), the paper's matrix `A_j` of §2.2 is the complex number
-//! `conj(e_j)·(v − p*)`, so
+//! the paper's sums over handles become sums over positions:
+//! `Σ w_i p̂_iᵀ q̂_i = Σ_j e_jᵀ q_j` (affine), `Σ w_i q̂_i A_i = Σ_j q_j ⊗ conj(e_j)(v − p*)`
+//! (similarity and rigid; a row vector times `[[α, β], [−β, α]]` is the complex
+//! product by `α + iβ`, and the paper's `A_i` of §2.2 is `conj(w_i p̂_i)·(v − p*)`),
+//! and `q* = Σ_j (m_j / W) q_j` with the masses `m_j` (`w_i`; `∫ w (1 − t)`,
+//! `∫ w t`) and `W = Σ m_j`. (`q̂_j` may be replaced by `q_j` because `Σ_j e_j = 0`.)
+//! So
 //!
 //! ```text
 //! affine      f(v) = Σ_j (A_j + m_j/W) q_j,      A_j = (v − p*) G⁻¹ e_jᵀ   (real)
 //! similarity  f(v) = Σ_j (c_j/μ_s + m_j/W) q_j,  c_j = conj(e_j)(v − p*)  (complex)
-//! rigid       f(v) = |v − p*| f⃗/|f⃗| + q*,  f⃗ = Σ_j c_j q_j,  q* = Σ_j (m_j/W) q_j
+//! rigid       f(v) = |v − p*| f⃗/|f⃗| + q*,  f⃗ = Σ_j c_j q_j
 //! ```
 //!
-//! (`q̂_j` may be replaced by `q_j` because `Σ_j e_j = 0`.) This module finds these
-//! coefficients for one vertex; `table` stores them and applies a pose.
+//! with `G = Σ w_i p̂_iᵀ p̂_i + Σ_bars ∫ w p̂(t)ᵀ p̂(t) ds` and `μ_s` its trace.
+//!
+//! A bar's share of `p*`, `G` and `μ_s`, and its moment vectors, are taken from its
+//! integrals about its point nearest to `v` ([`Moments`]) rather than from the
+//! paper's `δ00, δ01, δ11` and the end offsets `â, b̂`: the two are equal, but near
+//! the bar the latter form `∫ w |p̂|²` (of order `h^{1−2α}·h²`) as a difference of
+//! terms of order `h^{1−2α}·L²` and lose every digit, where the former add terms of
+//! the size of the result.
 
 use glam::DVec2;
 
-use crate::segment::{Deltas, Frame, Weight, deltas};
+use crate::segment::{Frame, Moments, Weight, moments};
 use crate::{Control, Variant};
 
 /// Relative size of the on-control tolerance: a vertex within
@@ -39,9 +46,14 @@ use crate::{Control, Variant};
 pub(crate) const ON_CONTROL: f64 = 1e-12;
 
 /// The affine moment matrix `G` counts as singular when
-/// `det G ≤ AFFINE_SINGULAR · (tr G)²` (its eigenvalues more than about 4·10¹²
-/// apart).
-pub(crate) const AFFINE_SINGULAR: f64 = 1e-12;
+/// `det G ≤ AFFINE_SINGULAR · (tr G)²` (its eigenvalues about 4·10¹³ or more apart;
+/// exactly singular matrices come out near 1e-16 after rounding).
+pub(crate) const AFFINE_SINGULAR: f64 = 1e-13;
+
+/// Below this fraction of `Σ|c_j| · max|q_j − o|`, the rigid vector `f⃗` is taken
+/// for zero (its direction would be rounding) and the vertex is translated by
+/// `q* − p*`.
+pub(crate) const RIGID_VANISHING: f64 = 1e-12;
 
 /// The on-control tolerance at `v`, pixels.
 pub(crate) fn tolerance(v: DVec2) -> f64 {
@@ -73,12 +85,11 @@ pub(crate) enum Header {
     Affine,
     /// `f(v) = Σ (re_j + i·im_j + om_j) ⊗ q_j`.
     Similarity,
-    /// `f(v) = |d| f⃗/|f⃗| + Σ om_j q_j`, `f⃗ = Σ (re_j + i·im_j) ⊗ q_j`, `d = v − p*`;
-    /// `spread = Σ |c_j|`, for telling a vanishing `f⃗` from rounding.
+    /// `f(v) = |d| f⃗/|f⃗| + Σ om_j q_j`, `f⃗ = Σ (re_j + i·im_j) ⊗ q_j`, `d = v − p*`.
     Rigid {
         /// `v − p*`.
         d: DVec2,
-        /// `Σ_j |c_j|`.
+        /// `Σ_j |c_j|`, for telling a vanishing `f⃗` from rounding.
         spread: f64,
     },
 }
@@ -116,14 +127,26 @@ impl Rest {
     }
 }
 
+/// A control as the fit at one vertex sees it: an anchor point, a direction (zero
+/// for a point handle) and its integrals about the anchor. A point handle is an
+/// element whose only non-zero moment is `a0 = w_i`.
+#[derive(Clone, Copy, Debug)]
+struct Element {
+    /// Index of its first posed position.
+    first: usize,
+    /// Whether it has a second (a bar).
+    bar: bool,
+    anchor: DVec2,
+    dir: DVec2,
+    m: Moments,
+}
+
 /// Reusable per-thread buffers.
 #[derive(Default)]
 pub(crate) struct Scratch {
     frames: Vec<Option<Frame>>,
-    mass: Vec<f64>,
+    elements: Vec<Element>,
     moment: Vec<DVec2>,
-    hat: Vec<DVec2>,
-    deltas: Vec<Deltas>,
 }
 
 /// Fills `coef` (one per rest position) for vertex `v` and says how they combine.
@@ -145,7 +168,12 @@ pub(crate) fn fit_vertex(
         Control::Point(p) => (*p - v).length_squared() <= tol2,
         Control::Bar(_) => false,
     };
-    let on = rest.controls.iter().zip(&rest.first).filter(on_point).count();
+    let on = rest
+        .controls
+        .iter()
+        .zip(&rest.first)
+        .filter(on_point)
+        .count();
     if on > 0 {
         let share = 1.0 / on as f64;
         for (_, j) in rest.controls.iter().zip(&rest.first).filter(on_point) {
@@ -200,38 +228,48 @@ pub(crate) fn fit_vertex(
     } else {
         1.0
     };
-    let weight = Weight {
-        alpha,
-        inv_scale2,
-    };
+    let weight = Weight { alpha, inv_scale2 };
 
-    // Masses of the rest positions, and the bars' integrals.
-    let k = rest.positions.len();
-    scratch.mass.clear();
-    scratch.mass.resize(k, 0.0);
-    scratch.deltas.clear();
-    let mut j = 0;
-    for (control, frame) in rest.controls.iter().zip(&scratch.frames) {
-        match (control, frame) {
-            (Control::Point(p), _) => {
-                scratch.mass[j] = weight.of_squared((*p - v).length_squared());
-                j += 1;
-            }
-            (Control::Bar(_), Some(frame)) => {
-                let d = deltas(frame, &weight);
-                scratch.mass[j] = d.d00 + d.d01;
-                scratch.mass[j + 1] = d.d01 + d.d11;
-                scratch.deltas.push(d);
-                j += 2;
-            }
-            (Control::Bar(_), None) => j += 2,
-        }
+    // Every control as an element.
+    scratch.elements.clear();
+    for ((control, frame), first) in rest.controls.iter().zip(&scratch.frames).zip(&rest.first) {
+        let element = match (*control, frame) {
+            (Control::Point(p), _) => Element {
+                first: *first,
+                bar: false,
+                anchor: p,
+                dir: DVec2::ZERO,
+                m: Moments {
+                    a0: weight.of_squared((p - v).length_squared()),
+                    ..Moments::default()
+                },
+            },
+            (Control::Bar([a, b]), Some(frame)) => Element {
+                first: *first,
+                bar: true,
+                anchor: frame.nearest(a, b),
+                dir: frame.dir,
+                m: moments(frame, &weight),
+            },
+            (Control::Bar([a, _]), None) => Element {
+                first: *first,
+                bar: true,
+                anchor: a,
+                dir: DVec2::ZERO,
+                m: Moments::default(),
+            },
+        };
+        scratch.elements.push(element);
     }
-    let total: f64 = scratch.mass.iter().sum();
-    if !(total > 0.0 && total.is_finite()) || scratch.mass.iter().any(|m| !m.is_finite()) {
+    let total: f64 = scratch.elements.iter().map(|e| e.m.a0 + e.m.a1).sum();
+    let finite = scratch.elements.iter().all(|e| {
+        let m = e.m;
+        (m.a0 + m.a1 + m.b0.abs() + m.b1.abs() + m.c).is_finite()
+    });
+    if !(total > 0.0 && total.is_finite() && finite) {
         // Not reached for valid input (the nearest control has a weight of order
         // one); a defined answer all the same: translation by the mean motion.
-        let share = 1.0 / k as f64;
+        let share = 1.0 / rest.positions.len() as f64;
         let mean = rest.positions.iter().copied().sum::<DVec2>() * share;
         for c in coef.iter_mut() {
             c.om = share;
@@ -239,62 +277,49 @@ pub(crate) fn fit_vertex(
         return Header::Translation(v - mean);
     }
 
-    // Differences from the heaviest position, so that a dominant mass does not
-    // drown the others' p̂ in rounding.
-    let mut heaviest = 0;
-    for (i, m) in scratch.mass.iter().enumerate() {
-        if *m > scratch.mass[heaviest] {
-            heaviest = i;
-        }
-    }
-    let origin = rest.positions[heaviest];
+    // The weighted centroid p*, relative to the anchor of the heaviest element so
+    // that a dominant weight does not drown the others' offsets in rounding.
+    let heaviest = scratch
+        .elements
+        .iter()
+        .enumerate()
+        .max_by(|(_, x), (_, y)| (x.m.a0 + x.m.a1).total_cmp(&(y.m.a0 + y.m.a1)))
+        .map_or(0, |(i, _)| i);
+    let origin = scratch.elements[heaviest].anchor;
     let mut shift = DVec2::ZERO;
-    for (y, m) in rest.positions.iter().zip(&scratch.mass) {
-        shift += (*y - origin) * (*m / total);
+    for e in &scratch.elements {
+        let (m0, m1) = (e.m.a0 + e.m.a1, e.m.b0 + e.m.b1);
+        shift += (e.anchor - origin) * (m0 / total) + e.dir * (m1 / total);
     }
-    // p* = origin + shift; v − p*:
+    // v − p*.
     let d = (v - origin) - shift;
-    scratch.hat.clear();
-    scratch
-        .hat
-        .extend(rest.positions.iter().map(|y| (*y - origin) - shift));
 
-    // Moment vectors e_j.
+    // Moment vectors e_j, the moment matrix G and μ_s = tr G.
     scratch.moment.clear();
-    scratch.moment.resize(k, DVec2::ZERO);
-    let mut j = 0;
-    let mut bars = scratch.deltas.iter();
-    for control in &rest.controls {
-        match control {
-            Control::Point(_) => {
-                scratch.moment[j] = scratch.hat[j] * scratch.mass[j];
-                j += 1;
-            }
-            Control::Bar(_) => {
-                let dl = bars.next().copied().unwrap_or_default();
-                let (ah, bh) = (scratch.hat[j], scratch.hat[j + 1]);
-                scratch.moment[j] = ah * dl.d00 + bh * dl.d01;
-                scratch.moment[j + 1] = ah * dl.d01 + bh * dl.d11;
-                j += 2;
-            }
+    scratch.moment.resize(rest.positions.len(), DVec2::ZERO);
+    let (mut g11, mut g12, mut g22) = (0.0, 0.0, 0.0);
+    for e in &scratch.elements {
+        let Moments { a0, a1, b0, b1, c } = e.m;
+        let (m0, m1) = (a0 + a1, b0 + b1);
+        // p̂ at the anchor; along the bar p̂ = f + σ·dir.
+        let f = (e.anchor - origin) - shift;
+        let u = e.dir;
+        g11 += m0 * f.x * f.x + 2.0 * m1 * f.x * u.x + c * u.x * u.x;
+        g12 += m0 * f.x * f.y + m1 * (f.x * u.y + u.x * f.y) + c * u.x * u.y;
+        g22 += m0 * f.y * f.y + 2.0 * m1 * f.y * u.y + c * u.y * u.y;
+        scratch.moment[e.first] = f * a0 + u * b0;
+        coef[e.first].om = a0 / total;
+        if e.bar {
+            scratch.moment[e.first + 1] = f * a1 + u * b1;
+            coef[e.first + 1].om = a1 / total;
         }
-    }
-    for (c, m) in coef.iter_mut().zip(&scratch.mass) {
-        c.om = *m / total;
     }
 
     if variant == Variant::Affine {
-        // G = Σ p̂_jᵀ e_j (symmetric).
-        let (mut g11, mut g12, mut g22) = (0.0, 0.0, 0.0);
-        for (p, e) in scratch.hat.iter().zip(&scratch.moment) {
-            g11 += p.x * e.x;
-            g12 += 0.5 * (p.x * e.y + p.y * e.x);
-            g22 += p.y * e.y;
-        }
         let det = g11 * g22 - g12 * g12;
         let trace = g11 + g22;
         if trace > 0.0 && det > AFFINE_SINGULAR * trace * trace && det.is_finite() {
-            // Row vector (v − p*) G⁻¹.
+            // The row vector (v − p*) G⁻¹.
             let r = DVec2::new(d.x * g22 - d.y * g12, d.y * g11 - d.x * g12) / det;
             for (c, e) in coef.iter_mut().zip(&scratch.moment) {
                 c.re = r.dot(*e);
@@ -306,10 +331,6 @@ pub(crate) fn fit_vertex(
     }
 
     // c_j = conj(e_j)·(v − p*).
-    let mut mu = 0.0;
-    for (p, e) in scratch.hat.iter().zip(&scratch.moment) {
-        mu += p.dot(*e);
-    }
     for (c, e) in coef.iter_mut().zip(&scratch.moment) {
         c.re = e.dot(d);
         c.im = e.perp_dot(d);
@@ -320,6 +341,7 @@ pub(crate) fn fit_vertex(
             Header::Rigid { d, spread }
         }
         Variant::Similarity | Variant::Affine => {
+            let mu = g11 + g22;
             if mu > 0.0 && mu.is_finite() {
                 for c in coef.iter_mut() {
                     c.re /= mu;
@@ -337,21 +359,20 @@ pub(crate) fn fit_vertex(
     }
 }
 
-/// Below this fraction of `Σ|c_j| · max|q_j − o|`, the rigid vector `f⃗` is taken
-/// for zero (its direction would be rounding) and the vertex is translated by
-/// `q* − p*`.
-pub(crate) const RIGID_VANISHING: f64 = 1e-12;
-
 /// The answer at one vertex from its coefficients and the posed positions, given as
 /// `q_j − o` with `o` their mean and `reach = max_j |q_j − o|`.
-pub(crate) fn apply(header: Header, coef: &[Coef], centred: &[DVec2], o: DVec2, reach: f64) -> DVec2 {
+pub(crate) fn apply(
+    header: Header,
+    coef: &[Coef],
+    centred: &[DVec2],
+    o: DVec2,
+    reach: f64,
+) -> DVec2 {
     match header {
         Header::Snap => o + sum_real(coef.iter().map(|c| c.om), centred),
         Header::Translation(d) => o + d + sum_real(coef.iter().map(|c| c.om), centred),
         Header::Affine => o + sum_real(coef.iter().map(|c| c.re + c.om), centred),
-        Header::Similarity => {
-            o + sum_complex(coef.iter().map(|c| (c.re + c.om, c.im)), centred)
-        }
+        Header::Similarity => o + sum_complex(coef.iter().map(|c| (c.re + c.om, c.im)), centred),
         Header::Rigid { d, spread } => {
             let f = sum_complex(coef.iter().map(|c| (c.re, c.im)), centred);
             let q_star = o + sum_real(coef.iter().map(|c| c.om), centred);

@@ -73,7 +73,10 @@ mod tests {
                 } else {
                     0.0
                 };
-                assert!((got - want).abs() < 1e-14, "n {n} degree {degree}: {got} vs {want}");
+                assert!(
+                    (got - want).abs() < 1e-14,
+                    "n {n} degree {degree}: {got} vs {want}"
+                );
             }
         }
     }

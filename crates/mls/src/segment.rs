@@ -1,33 +1,34 @@
 //! The integrals a bar (line-segment handle) contributes at one vertex (§4 of the
-//! paper): with the rest bar `p(t) = (1 − t)·a + t·b`, `t ∈ [0, 1]`, of length `L`,
-//! and the weight `w(t) = 1 / |p(t) − v|^{2α}` taken with respect to arc length
-//! (`ds = L dt`),
+//! paper). With the rest bar `p(t) = (1 − t)·a + t·b`, `t ∈ [0, 1]`, of length `L`,
+//! the weight `w = 1 / |p(t) − v|^{2α}` is integrated with respect to arc length
+//! (`ds = L dt`); the paper's `W` matrix holds
 //!
 //! ```text
 //! δ00 = ∫ w (1 − t)² ds,   δ01 = ∫ w (1 − t) t ds,   δ11 = ∫ w t² ds.
 //! ```
 //!
-//! Every integrand is positive, so every δ is computed to a relative accuracy of
-//! about 1e-13 for any α > 0 and any position of the vertex: the paper's closed forms
-//! exist for α = 2 only and cancel badly near the bar's line.
+//! The deformation itself uses the same integrals regrouped as moments about the
+//! bar's point nearest to the vertex ([`Moments`]); see `precompute` for why.
 //!
-//! With `h` the distance from `v` to the bar's line and `s` the signed arc-length
-//! coordinate from the foot of the perpendicular, `|p − v|² = h² + s²`. The range
-//! of `s` is cut in three:
+//! Every integral is computed to a relative accuracy of about 1e-13 for any α > 0
+//! and any position of the vertex (the paper's closed forms hold for α = 2 only and
+//! cancel badly near the bar's line). With `h` the distance from `v` to the bar's
+//! line and `s` the signed arc-length coordinate from the foot of the
+//! perpendicular, `|p − v|² = h² + s²`, and the range of `s` is cut in three:
 //! - the *core* `|s| ≤ h`, integrated in `θ` with `s = h·tan θ` (`|θ| ≤ π/4`), where
-//!   the integrand `h·sec²θ·(h·sec θ)^{−2α}·poly(h tan θ)` is smooth; one
-//!   sub-interval;
-//! - each *flank* `h ≤ |s|`, integrated in `|s|` on geometrically growing
+//!   the integrand `h·sec²θ·(h·sec θ)^{−2α}·g(h tan θ)` is smooth;
+//! - each *flank* `|s| ≥ h`, integrated in `|s|` on geometrically growing
 //!   sub-intervals `[u, 2u]` (the nearest singularities, `s = ±i·h`, stay well
 //!   outside each sub-interval's Bernstein ellipse); this also covers a vertex on the
 //!   line beyond the bar's end, where `h` is tiny or zero next to the distance;
 //! - only for α < ½ and a vertex exactly on the bar (`h = 0`, foot inside) is the
-//!   integral finite with a singular integrand; there `∫ |s|^{−2α} sᵏ ds` is taken
-//!   in closed form. For α ≥ ½ such a vertex is never integrated: it lies on the bar
-//!   and goes to the posed bar (see `precompute`).
+//!   integral finite with a singular integrand `|s|^{−2α}·g(s)`; there the 2-point
+//!   Gauss–Jacobi rule for the weight `|s|^{−2α}` is exact (every `g` here is a
+//!   polynomial of degree ≤ 2). For α ≥ ½ such a vertex is never integrated: it lies
+//!   on the bar and goes to the posed bar (see `precompute`).
 //!
-//! Sub-intervals use the 16-point Gauss–Legendre rule; for large α they are
-//! subdivided further (the integrand's dynamic range on a sub-interval grows like
+//! Sub-intervals use the 16-point Gauss–Legendre rule; for α > 3 they are cut into
+//! `⌈α/3⌉` parts (the integrand's dynamic range on a sub-interval grows like
 //! `2^{2α}`).
 
 use glam::DVec2;
@@ -36,6 +37,7 @@ use crate::quadrature::RULE;
 
 /// The three integrals of one bar at one vertex (already multiplied by the common
 /// weight scale, see [`Weight`]).
+#[cfg(test)]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct Deltas {
     /// `∫ w (1 − t)² ds`.
@@ -44,17 +46,6 @@ pub(crate) struct Deltas {
     pub d01: f64,
     /// `∫ w t² ds`.
     pub d11: f64,
-}
-
-impl Deltas {
-    /// Adds `weight · [(1 − t)², (1 − t) t, t²]`.
-    #[inline]
-    fn add(&mut self, weight: f64, t: f64, omt: f64) {
-        let (t, omt) = (t.clamp(0.0, 1.0), omt.clamp(0.0, 1.0));
-        self.d00 += weight * omt * omt;
-        self.d01 += weight * omt * t;
-        self.d11 += weight * t * t;
-    }
 }
 
 /// The weight of a squared distance `x`: `(x · inv_scale2)^{−α}`. The scale is one
@@ -99,8 +90,13 @@ pub(crate) struct Frame {
     pub s_a: f64,
     /// The same for the end `b` (`s_b > s_a`).
     pub s_b: f64,
+    /// The coordinate of the bar's point nearest to `v`: `0` clamped to
+    /// `[s_a, s_b]`.
+    pub s_c: f64,
     /// Squared distance from `v` to the nearest point of the bar, pixels².
     pub dist2: f64,
+    /// Unit vector from `a` to `b`.
+    pub dir: DVec2,
 }
 
 impl Frame {
@@ -116,37 +112,56 @@ impl Frame {
         } else {
             vb.perp_dot(dir).abs()
         };
-        let dist2 = if s_a >= 0.0 {
-            va.length_squared()
+        let (s_c, dist2) = if s_a >= 0.0 {
+            (s_a, va.length_squared())
         } else if s_b <= 0.0 {
-            vb.length_squared()
+            (s_b, vb.length_squared())
         } else {
-            h * h
+            (0.0, h * h)
         };
-        Frame { h, s_a, s_b, dist2 }
+        Frame {
+            h,
+            s_a,
+            s_b,
+            s_c,
+            dist2,
+            dir,
+        }
     }
 
     /// The bar's parameter `t ∈ [0, 1]` of the point nearest to `v`.
     pub fn nearest_t(&self) -> f64 {
         let span = self.s_b - self.s_a;
         if span > 0.0 {
-            (-self.s_a / span).clamp(0.0, 1.0)
+            ((self.s_c - self.s_a) / span).clamp(0.0, 1.0)
         } else {
             0.0
         }
     }
+
+    /// The bar's point nearest to `v` (an end exactly where it is one).
+    pub fn nearest(&self, a: DVec2, b: DVec2) -> DVec2 {
+        if self.s_c == self.s_a {
+            a
+        } else if self.s_c == self.s_b {
+            b
+        } else {
+            a - self.dir * self.s_a
+        }
+    }
 }
 
-/// `δ00, δ01, δ11` of the bar with frame `frame` under `weight`.
+/// Calls `visit(s, w)` for the nodes of a quadrature of `∫ w(s) g(s) ds` over the
+/// bar, for any smooth `g`: `s` is the signed arc-length coordinate from the foot
+/// of the perpendicular, `w` the node's share (the quadrature weight times the
+/// Jacobian times the weight function). See the module documentation.
 ///
 /// The caller never asks for a vertex on the bar (`h = 0` with the foot inside)
-/// with α ≥ ½, where the integrals diverge; those give infinities.
-pub(crate) fn deltas(frame: &Frame, weight: &Weight) -> Deltas {
+/// with α ≥ ½, where the integrals diverge; those visit infinite weights.
+fn visit_nodes(frame: &Frame, weight: &Weight, mut visit: impl FnMut(f64, f64)) {
     let Frame { h, s_a, s_b, .. } = *frame;
-    let span = s_b - s_a;
-    let mut acc = Deltas::default();
-    if span <= 0.0 {
-        return acc;
+    if s_b <= s_a {
+        return;
     }
     let parts = weight.parts();
 
@@ -158,17 +173,17 @@ pub(crate) fn deltas(frame: &Frame, weight: &Weight) -> Deltas {
             let (t0, t1) = ((lo / h).atan(), (hi / h).atan());
             let step = (t1 - t0) / parts as f64;
             for part in 0..parts {
-                let a = t0 + step * part as f64;
                 let half = 0.5 * step;
-                let mid = a + half;
+                let mid = t0 + step * part as f64 + half;
                 for &(x, wq) in RULE.iter() {
                     let theta = mid + half * x;
                     let (sin, cos) = theta.sin_cos();
-                    let s = h * sin / cos;
                     let sec2 = 1.0 / (cos * cos);
-                    // ds = h sec²θ dθ, |p − v|² = h² sec²θ.
-                    let w = weight.of_squared(h * h * sec2) * h * sec2 * wq * half;
-                    acc.add(w, (s - s_a) / span, (s_b - s) / span);
+                    // s = h tan θ, ds = h sec²θ dθ, |p − v|² = h² sec²θ.
+                    visit(
+                        h * sin / cos,
+                        weight.of_squared(h * h * sec2) * h * sec2 * wq * half,
+                    );
                 }
             }
         }
@@ -186,7 +201,7 @@ pub(crate) fn deltas(frame: &Frame, weight: &Weight) -> Deltas {
         }
         if lo <= 0.0 {
             // h = 0 and the foot is on the bar: only finite for α < ½.
-            closed_form_from_foot(&mut acc, sign, hi, s_a, s_b, weight);
+            visit_from_foot(sign, hi, weight, &mut visit);
             continue;
         }
         let mut a = lo;
@@ -201,39 +216,90 @@ pub(crate) fn deltas(frame: &Frame, weight: &Weight) -> Deltas {
                 let mid = u0 + half;
                 for &(x, wq) in RULE.iter() {
                     let u = mid + half * x;
-                    let s = sign * u;
-                    let w = weight.of_squared(h * h + u * u) * wq * half;
-                    acc.add(w, (s - s_a) / span, (s_b - s) / span);
+                    visit(sign * u, weight.of_squared(h * h + u * u) * wq * half);
                 }
                 u0 = u1;
             }
             a = b;
         }
     }
+}
+
+/// The nodes of `∫_0^U` over `u = |s|` on the side `sign` of the foot, for a vertex
+/// on the bar's line with the foot inside the bar (`h = 0`), where the weight is
+/// `(u² · inv_scale2)^{−α} = inv_scale2^{−α} · u^{−2α}`: the 2-point Gauss–Jacobi
+/// rule for the weight `x^{−2α}` on [0, 1], exact for the cubics and lower that the
+/// callers integrate (finite for α < ½ only).
+fn visit_from_foot(sign: f64, big_u: f64, weight: &Weight, visit: &mut impl FnMut(f64, f64)) {
+    let beta = -2.0 * weight.alpha;
+    if beta <= -1.0 {
+        visit(0.0, f64::INFINITY);
+        return;
+    }
+    // Moments m_k = ∫_0^1 x^{k+β} dx; the monic orthogonal quadratic x² + p x + q.
+    let m = [0.0, 1.0, 2.0, 3.0].map(|k| 1.0 / (k + 1.0 + beta));
+    let det = m[1] * m[1] - m[0] * m[2];
+    let p = (m[0] * m[3] - m[1] * m[2]) / det;
+    let q = (m[2] * m[2] - m[1] * m[3]) / det;
+    let root = (0.25 * p * p - q).max(0.0).sqrt();
+    let (x1, x2) = (-0.5 * p - root, -0.5 * p + root);
+    let w2 = (m[1] - x1 * m[0]) / (x2 - x1);
+    let w1 = m[0] - w2;
+    let scale = big_u.powf(1.0 + beta) * weight.inv_scale2.powf(-weight.alpha);
+    visit(sign * big_u * x1, w1 * scale);
+    visit(sign * big_u * x2, w2 * scale);
+}
+
+/// `δ00, δ01, δ11` of the bar with frame `frame` under `weight` (the paper's `W`
+/// matrix entries, §4).
+#[cfg(test)]
+pub(crate) fn deltas(frame: &Frame, weight: &Weight) -> Deltas {
+    let Frame { s_a, s_b, .. } = *frame;
+    let span = s_b - s_a;
+    let mut acc = Deltas::default();
+    visit_nodes(frame, weight, |s, w| {
+        let (t, omt) = (
+            ((s - s_a) / span).clamp(0.0, 1.0),
+            ((s_b - s) / span).clamp(0.0, 1.0),
+        );
+        acc.d00 += w * omt * omt;
+        acc.d01 += w * omt * t;
+        acc.d11 += w * t * t;
+    });
     acc
 }
 
-/// Adds `∫_0^U` over `u = |s|` on the side `sign` of the foot, for a vertex on the
-/// bar's line with the foot inside the bar (`h = 0`): the weight is
-/// `(u² · inv_scale2)^{−α}`, the integrands are quadratics in `u`, and
-/// `∫_0^U u^{k−2α} du = U^{k+1−2α} / (k + 1 − 2α)` (finite for α < ½ only).
-fn closed_form_from_foot(acc: &mut Deltas, sign: f64, big_u: f64, s_a: f64, s_b: f64, weight: &Weight) {
+/// A bar's integrals at one vertex about its point nearest to the vertex: with
+/// `σ = s − s_c` the arc-length coordinate from that point,
+/// `a0 = ∫ w (1 − t)`, `a1 = ∫ w t`, `b0 = ∫ w σ (1 − t)`, `b1 = ∫ w σ t`,
+/// `c = ∫ w σ²` (all `ds`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct Moments {
+    pub a0: f64,
+    pub a1: f64,
+    pub b0: f64,
+    pub b1: f64,
+    pub c: f64,
+}
+
+/// The [`Moments`] of the bar with frame `frame` under `weight`.
+pub(crate) fn moments(frame: &Frame, weight: &Weight) -> Moments {
+    let Frame { s_a, s_b, s_c, .. } = *frame;
     let span = s_b - s_a;
-    let beta = 1.0 - 2.0 * weight.alpha;
-    if beta <= 0.0 {
-        acc.d00 = f64::INFINITY;
-        acc.d01 = f64::INFINITY;
-        acc.d11 = f64::INFINITY;
-        return;
-    }
-    let factor = weight.inv_scale2.powf(-weight.alpha);
-    let m = [0.0, 1.0, 2.0].map(|k| big_u.powf(k + beta) / (k + beta) * factor);
-    // t = t0 + t1 u, 1 − t = o0 + o1 u.
-    let (t0, t1) = (-s_a / span, sign / span);
-    let (o0, o1) = (s_b / span, -sign / span);
-    acc.d00 += o0 * o0 * m[0] + 2.0 * o0 * o1 * m[1] + o1 * o1 * m[2];
-    acc.d01 += t0 * o0 * m[0] + (t0 * o1 + t1 * o0) * m[1] + t1 * o1 * m[2];
-    acc.d11 += t0 * t0 * m[0] + 2.0 * t0 * t1 * m[1] + t1 * t1 * m[2];
+    let mut acc = Moments::default();
+    visit_nodes(frame, weight, |s, w| {
+        let (t, omt) = (
+            ((s - s_a) / span).clamp(0.0, 1.0),
+            ((s_b - s) / span).clamp(0.0, 1.0),
+        );
+        let sigma = s - s_c;
+        acc.a0 += w * omt;
+        acc.a1 += w * t;
+        acc.b0 += w * sigma * omt;
+        acc.b1 += w * sigma * t;
+        acc.c += w * sigma * sigma;
+    });
+    acc
 }
 
 #[cfg(test)]

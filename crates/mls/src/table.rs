@@ -82,7 +82,11 @@ impl Mls {
     /// Errors: α not finite and positive, a non-finite vertex or control, a bar of
     /// zero length ([`MlsError::ZeroLengthBar`]). No controls is allowed (every pose
     /// is then the identity).
-    pub fn new(vertices: &[DVec2], controls: &[Control], options: &MlsOptions) -> Result<Mls, MlsError> {
+    pub fn new(
+        vertices: &[DVec2],
+        controls: &[Control],
+        options: &MlsOptions,
+    ) -> Result<Mls, MlsError> {
         validate_options(options)?;
         if let Some(vertex) = vertices.iter().position(|v| !v.is_finite()) {
             return Err(MlsError::NonFiniteVertex { vertex });
@@ -91,7 +95,10 @@ impl Mls {
         let rest = Rest::new(controls);
         let k = rest.positions.len();
         let n = vertices.len();
-        let bars = controls.iter().map(|c| matches!(c, Control::Bar(_))).collect();
+        let bars = controls
+            .iter()
+            .map(|c| matches!(c, Control::Bar(_)))
+            .collect();
         if k == 0 {
             return Ok(Mls {
                 bars,
@@ -126,7 +133,11 @@ impl Mls {
                     .collect();
                 Table::Rigid { c, frame }
             }
-            Variant::Affine if headers.iter().all(|h| matches!(h, Header::Affine | Header::Snap)) => {
+            Variant::Affine
+                if headers
+                    .iter()
+                    .all(|h| matches!(h, Header::Affine | Header::Snap)) =>
+            {
                 Table::Real(coef.par_iter().map(|c| c.re + c.om).collect())
             }
             Variant::Affine | Variant::Similarity => {
@@ -196,7 +207,8 @@ impl Mls {
                     .zip(coef.par_chunks(CHUNK * k))
                     .zip(offset.par_chunks(CHUNK))
                     .for_each(|((out, coef), offset)| {
-                        for ((f, coef), off) in out.iter_mut().zip(coef.chunks_exact(k)).zip(offset) {
+                        for ((f, coef), off) in out.iter_mut().zip(coef.chunks_exact(k)).zip(offset)
+                        {
                             let (mut x, mut y) = (o.x + off.x, o.y + off.y);
                             for ([re, im], qj) in coef.iter().zip(&centred) {
                                 x += qj.x * re - qj.y * im;
@@ -211,7 +223,9 @@ impl Mls {
                     .zip(c.par_chunks(CHUNK * k))
                     .zip(frame.par_chunks(CHUNK))
                     .for_each(|((out, coef), frame)| {
-                        for ((f, coef), [dx, dy, spread]) in out.iter_mut().zip(coef.chunks_exact(k)).zip(frame) {
+                        for ((f, coef), [dx, dy, spread]) in
+                            out.iter_mut().zip(coef.chunks_exact(k)).zip(frame)
+                        {
                             let (mut fx, mut fy, mut sx, mut sy) = (0.0, 0.0, 0.0, 0.0);
                             for ([re, im, om], qj) in coef.iter().zip(&centred) {
                                 fx += qj.x * re - qj.y * im;
@@ -249,7 +263,10 @@ pub fn deform_point(
         return Err(MlsError::NonFiniteVertex { vertex: 0 });
     }
     validate_rest(controls)?;
-    let bars: Vec<bool> = controls.iter().map(|c| matches!(c, Control::Bar(_))).collect();
+    let bars: Vec<bool> = controls
+        .iter()
+        .map(|c| matches!(c, Control::Bar(_)))
+        .collect();
     let q = flatten_pose(&bars, posed)?;
     if q.is_empty() {
         return Ok(v);
