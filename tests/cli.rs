@@ -441,7 +441,7 @@ fn the_editor_exports_what_the_command_renders() {
     set_density(&mut app, 6000);
     app.add_point(glam::DVec2::new(640.0, 560.0));
     same(&mut app, "a new density");
-    // Method switches, and an insertion under ARAP.
+    // Method switches, and an insertion under ARAP and under MLS.
     assert!(
         app.edit(editor::Edit::Method(pipeline::Method::Arap)),
         "{:?}",
@@ -449,6 +449,13 @@ fn the_editor_exports_what_the_command_renders() {
     );
     app.add_point(glam::DVec2::new(300.0, 150.0));
     same(&mut app, "ARAP");
+    assert!(
+        app.edit(editor::Edit::Method(pipeline::Method::Mls)),
+        "{:?}",
+        app.message
+    );
+    app.add_point(glam::DVec2::new(420.0, 380.0));
+    same(&mut app, "MLS");
     assert!(
         app.edit(editor::Edit::Method(pipeline::Method::C2)),
         "{:?}",

@@ -61,7 +61,7 @@ fn deform_moves_the_mesh_rigidly_under_a_rigid_motion_for_every_method() {
     .expect("write rig");
     let mesh = data("strip.obj");
     let rest = strip_rest();
-    for method in ["c2", "arap"] {
+    for method in ["c2", "arap", "mls"] {
         let out = dir.path().join(format!("{method}.obj"));
         deform(&[os("--mesh"), mesh.as_os_str()], &rig, Some(method), &out);
         let (moved, faces) = read_obj(&out);
@@ -118,30 +118,44 @@ fn deform_from_an_image_gives_the_methods_own_answers() {
     let image = data("dino.png");
     let source = [os("--image"), image.as_os_str()];
     let rig = data("dino-rig.json");
-    let (c2, arap) = (dir.path().join("c2.obj"), dir.path().join("arap.obj"));
-    deform(&source, &rig, Some("c2"), &c2);
-    deform(&source, &rig, Some("arap"), &arap);
-    let (a, fa) = read_obj(&c2);
-    let (b, fb) = read_obj(&arap);
-    assert_eq!(fa, fb, "the same mesh");
-    assert_eq!(a.len(), b.len());
-    let apart = a
+    let methods = ["c2", "arap", "mls"];
+    let meshes: Vec<_> = methods
         .iter()
-        .zip(&b)
-        .filter(|(p, q)| (p[0] - q[0]).hypot(p[1] - q[1]) > 0.5)
-        .count();
-    assert!(apart > a.len() / 10, "the methods differ: {apart} vertices");
-    // The point handle at (250, 120) went by (10, -30) under both: its vertex (the
-    // one nearest it, within half a mesh edge) moved exactly so in both files.
-    let pinned = a
-        .iter()
-        .zip(&b)
-        .position(|(p, q)| {
-            (p[0] - 10.0 - 250.0).hypot(p[1] + 30.0 - 120.0) < 4.0
-                && (p[0] - q[0]).hypot(p[1] - q[1]) < 1e-9
+        .map(|method| {
+            let out = dir.path().join(format!("{method}.obj"));
+            deform(&source, &rig, Some(method), &out);
+            read_obj(&out)
         })
-        .expect("both methods move the handle's vertex with it");
-    assert!((a[pinned][0] - 260.0).hypot(a[pinned][1] - 90.0) < 4.0);
+        .collect();
+    let (a, fa) = &meshes[0];
+    for (method, (b, fb)) in methods.iter().zip(&meshes).skip(1) {
+        assert_eq!(fa, fb, "{method}: the same mesh");
+        assert_eq!(a.len(), b.len());
+        let apart = a
+            .iter()
+            .zip(b)
+            .filter(|(p, q)| (p[0] - q[0]).hypot(p[1] - q[1]) > 0.5)
+            .count();
+        assert!(
+            apart > a.len() / 10,
+            "{method} differs from c2: {apart} vertices"
+        );
+        // The point handle at (250, 120) went by (10, -30): its vertex (the one
+        // nearest it, within half a mesh edge) moved exactly so under C² and ARAP,
+        // which pin it. MLS interpolates at the handle's own position, which the
+        // vertex need not be at, so there it moved so up to the warp's slope over
+        // that little distance.
+        let tolerance = if *method == "mls" { 1.0 } else { 1e-9 };
+        let pinned = a
+            .iter()
+            .zip(b)
+            .position(|(p, q)| {
+                (p[0] - 10.0 - 250.0).hypot(p[1] + 30.0 - 120.0) < 4.0
+                    && (p[0] - q[0]).hypot(p[1] - q[1]) < tolerance
+            })
+            .unwrap_or_else(|| panic!("c2 and {method} move the handle's vertex with it"));
+        assert!((a[pinned][0] - 260.0).hypot(a[pinned][1] - 90.0) < 4.0);
+    }
 }
 
 #[test]
@@ -221,7 +235,7 @@ fn bad_method_fields_give_one_clear_line_and_keep_the_old_output() {
     let cases = [
         (
             r#""method":"lbc3""#,
-            r#"method: invalid value: string "lbc3", expected a method: "c2", "arap" or "lbc""#,
+            r#"method: invalid value: string "lbc3", expected a method: "c2", "arap", "mls" or "lbc""#,
         ),
         (
             r#""method":2"#,
@@ -239,11 +253,19 @@ fn bad_method_fields_give_one_clear_line_and_keep_the_old_output() {
             r#""rigidity":[{"stroke":[[1,1]],"radius":2,"weight":0}]"#,
             "weight must be between 0.001 and 1e8",
         ),
+        (
+            r#""mls":{"alpha":0}"#,
+            "mls.alpha must be a number above 0 and at most 10, got 0",
+        ),
+        (
+            r#""mls":{"variant":"stiff"}"#,
+            r#"expected an MLS variant: "rigid", "similarity" or "affine""#,
+        ),
     ];
     for (i, (field, expected)) in cases.into_iter().enumerate() {
         let rig = dir.path().join(format!("bad{i}.json"));
         fs::write(&rig, format!(r#"{{"version":1,{field},{handles}}}"#)).expect("write");
-        for extra in [&[][..], &["--method", "arap"][..]] {
+        for extra in [&[][..], &["--method", "arap"][..], &["--method", "mls"][..]] {
             let line = fails(&render_args(&data("dino.png"), &rig, &out, extra));
             assert!(line.contains(expected), "{field}: {line}");
         }
@@ -913,4 +935,97 @@ fn every_method_renders_a_sixteen_bit_picture_in_sixteen_bits() {
         // And it moved something.
         assert_ne!(got.as_raw(), wide.as_raw(), "{}", method.name());
     }
+}
+
+#[test]
+fn mls_reads_its_variant_from_the_rig_and_reproduces_that_class() {
+    // The handles moved by one similarity (turned 0.4 rad, scaled 1.3, shifted): the
+    // similarity variant moves every vertex of the strip by it exactly; the rigid
+    // one cannot scale, so it does not.
+    let (turn, scale, shift) = (0.4f64, 1.3, [12.0, -5.0]);
+    let map = |[x, y]: [f64; 2]| {
+        let (s, c) = turn.sin_cos();
+        [
+            scale * (c * x - s * y) + shift[0],
+            scale * (s * x + c * y) + shift[1],
+        ]
+    };
+    let dir = tempfile::tempdir().expect("temp dir");
+    let points = [[0.0, 0.0], [120.0, 30.0], [30.0, 25.0]];
+    let bar = [[60.0, 0.0], [60.0, 30.0]];
+    let handles: Vec<serde_json::Value> = points
+        .iter()
+        .map(|&p| {
+            let q = map(p);
+            serde_json::json!({"type": "point", "rest": p, "translate": [q[0] - p[0], q[1] - p[1]]})
+        })
+        .chain([serde_json::json!({"type": "bar", "rest": bar, "pose": bar.map(map)})])
+        .collect();
+    let rest = strip_rest();
+    for (variant, reproduces) in [("similarity", true), ("rigid", false)] {
+        let rig = dir.path().join(format!("{variant}.json"));
+        let file = serde_json::json!({
+            "version": 1, "method": "mls", "handles": handles,
+            "mls": {"alpha": 1.5, "variant": variant}
+        });
+        fs::write(&rig, file.to_string()).expect("write rig");
+        let out = dir.path().join(format!("{variant}.obj"));
+        deform(
+            &[os("--mesh"), data("strip.obj").as_os_str()],
+            &rig,
+            None,
+            &out,
+        );
+        let (moved, _) = read_obj(&out);
+        let worst = moved
+            .iter()
+            .zip(&rest)
+            .map(|(p, r)| {
+                let want = map(*r);
+                (p[0] - want[0]).hypot(p[1] - want[1])
+            })
+            .fold(0.0, f64::max);
+        assert_eq!(
+            worst < 1e-9,
+            reproduces,
+            "{variant}: {worst} px from the similarity"
+        );
+    }
+}
+
+#[test]
+fn mls_renders_and_benches_through_the_seam() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let rig = data("dino-rig.json");
+    let image = data("dino.png");
+    let out = ok(&[
+        os("bench"),
+        os("--image"),
+        image.as_os_str(),
+        os("--rig"),
+        rig.as_os_str(),
+        os("--method"),
+        os("mls"),
+    ]);
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    assert_eq!(json["method"], "mls", "{json}");
+    assert_eq!(json["variant"], "rigid");
+    assert_eq!(json["alpha"], 1.0);
+    assert_eq!(json["real_handles"], 4);
+    assert!(json["samples"].as_u64().is_some_and(|n| n > 1000), "{json}");
+    for key in ["precompute_ms", "pose_ms_median", "pose_ms_p90"] {
+        assert!(
+            json[key].as_f64().is_some_and(|t| t >= 0.0),
+            "{key}: {json}"
+        );
+    }
+    // The render differs from C²'s (the weights are Euclidean, not the shape's) but
+    // not wildly: the same handles pull the same way, so most channels agree.
+    let (mls, c2) = (dir.path().join("mls.png"), dir.path().join("c2.png"));
+    ok(&render_args(&image, &rig, &mls, &["--method", "mls"]));
+    ok(&render_args(&image, &rig, &c2, &["--method", "c2"]));
+    let (a, b) = (load(&mls), load(&c2));
+    assert_eq!(a.dimensions(), b.dimensions());
+    let (worst, over) = difference(&a, &b, 8);
+    assert!(worst > 8 && over < 0.2, "{worst}, {over}");
 }

@@ -191,6 +191,8 @@ pub struct EditorApp {
     seen: Seen,
     pub(crate) dual_graph: (u64, Arc<Vec<(u32, u32)>>),
     pub(crate) settings_draft: Option<crate::document::Settings>,
+    /// MLS's α and fit while its slider is dragged.
+    pub(crate) mls_draft: Option<(f64, project::MlsVariant)>,
     pub(crate) job: Option<Job>,
     /// The checkerboard behind transparent pixels.
     pub(crate) checker: Option<egui::TextureHandle>,
@@ -300,6 +302,7 @@ impl EditorApp {
             seen: Seen::default(),
             dual_graph: (0, Arc::new(Vec::new())),
             settings_draft: None,
+            mls_draft: None,
             job: None,
             checker: None,
             wake: None,
@@ -703,14 +706,7 @@ impl EditorApp {
             if self.tool == Tool::Cage {
                 self.set_tool(Tool::Puppet);
             }
-            self.info(match method {
-                Method::C2 => "C² weights: the handles move the picture by the paper's weights",
-                Method::Arap => {
-                    "ARAP: the picture keeps its proportions; each pin holds a small disc \
-                     around it"
-                }
-                Method::Lbc => "LBC cage",
-            });
+            self.info(format!("{}: {}", method.label(), method.about()));
         }
     }
 

@@ -106,6 +106,8 @@ pub enum Edit {
     Lbc(LbcSettings),
     /// The frame of exports: the picture's own, or grown to fit the warp.
     Canvas(project::Canvas),
+    /// Moving least squares' settings: α and the class of map fitted.
+    Mls(project::MlsSettings),
 }
 
 /// What a cage's coordinates are solved for: the rest cage, τ and the number of mesh
@@ -650,6 +652,12 @@ impl Document {
                 self.check_cage(&project)?;
             }
             Edit::Canvas(canvas) => project.canvas = canvas,
+            Edit::Mls(settings) => {
+                project.mls = Some(settings);
+                project
+                    .validate(Some(self.image.dimensions()))
+                    .context("MLS's settings")?;
+            }
         }
         self.restore(project)
     }

@@ -165,6 +165,9 @@ pub fn describe_change(from: &Project, to: &Project) -> String {
     if from.arap != to.arap {
         parts.push("ARAP's settings".to_owned());
     }
+    if from.mls != to.mls {
+        parts.push("MLS's settings".to_owned());
+    }
     if parts.is_empty() {
         "nothing visible".to_owned()
     } else {

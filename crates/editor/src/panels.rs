@@ -521,6 +521,11 @@ impl EditorApp {
             self.cage_panel(ui);
             ui.separator();
         }
+        if self.doc.as_ref().is_some_and(|d| d.method() == Method::Mls) {
+            ui.heading("MLS");
+            self.mls_panel(ui);
+            ui.separator();
+        }
         if !lbc {
             ui.heading("Weights");
             self.parameters(ui);
@@ -607,26 +612,52 @@ impl EditorApp {
         ui.horizontal_wrapped(|ui| {
             for m in Method::ALL {
                 ui.selectable_value(&mut chosen, m, m.label())
-                    .on_hover_text(match m {
-                        Method::C2 => {
-                            "Closed-form C² weights (Xian, Jin and Wang): smooth, local, \
-                             with virtual handles"
-                        }
-                        Method::Arap => {
-                            "As-rigid-as-possible (Igarashi, Moscovich and Hughes 2005): \
-                             shapes keep their proportions; the C² weights' settings do \
-                             not apply"
-                        }
-                        Method::Lbc => {
-                            "Local barycentric coordinates (Zhang et al. 2014): a cage \
-                             drawn around the subject moves what lies inside it, each \
-                             vertex only its neighbourhood; the outside stays"
-                        }
-                    });
+                    .on_hover_text(m.about());
             }
         });
         if chosen != current {
             self.choose_method(chosen);
+        }
+    }
+
+    /// Moving least squares' settings: the class of map fitted and α (applied when
+    /// the slider is released, as the weighting's are).
+    fn mls_panel(&mut self, ui: &mut Ui) {
+        let Some(doc) = &self.doc else { return };
+        let saved = doc.project().mls.unwrap_or_default();
+        let current = (
+            saved.alpha.unwrap_or(1.0),
+            saved.variant.unwrap_or_default(),
+        );
+        let (mut alpha, mut variant) = self.mls_draft.unwrap_or(current);
+        let r = ui
+            .add(
+                egui::Slider::new(&mut alpha, 0.1..=project::MAX_MLS_ALPHA)
+                    .logarithmic(true)
+                    .text("α (falloff)"),
+            )
+            .on_hover_text("A handle at distance r weighs 1/r^(2α): larger α, more local handles");
+        let mut commit = released(&r);
+        egui::ComboBox::from_label("Fit")
+            .selected_text(variant.label())
+            .show_ui(ui, |ui| {
+                for v in project::MlsVariant::ALL {
+                    commit |= ui.selectable_value(&mut variant, v, v.label()).clicked();
+                }
+            })
+            .response
+            .on_hover_text("The class of map fitted at every point: rigid keeps shapes, similarity also scales, affine also shears");
+        let draft = (alpha, variant);
+        if commit && draft != current {
+            self.mls_draft = None;
+            let _ = self.edit(Edit::Mls(project::MlsSettings {
+                alpha: Some(alpha),
+                variant: Some(variant),
+            }));
+        } else if draft != current {
+            self.mls_draft = Some(draft);
+        } else {
+            self.mls_draft = None;
         }
     }
 
@@ -637,12 +668,6 @@ impl EditorApp {
         let current = doc.settings();
         let mut draft = self.settings_draft.unwrap_or(current);
         let mut commit = false;
-        // A value typed into a slider's field applies when the field is left (Enter, Tab
-        // or a click elsewhere), not at every keystroke: typing 41000 must not re-mesh
-        // at 4, 41 and 410 on the way.
-        let released = |r: &egui::Response| {
-            r.drag_stopped() || r.lost_focus() || (r.changed() && !r.dragged() && !r.has_focus())
-        };
         let r = ui.add(egui::Slider::new(&mut draft.alpha, 0.0..=1.0).text("α (shape factor)"));
         commit |= released(&r);
         let r = ui.add(egui::Slider::new(&mut draft.degree, 5..=25).text("Basis degree"));
@@ -934,4 +959,11 @@ fn middle_name(m: Middle) -> &'static str {
         Middle::Half => "Half",
         Middle::Linear => "Linear",
     }
+}
+
+/// Whether a slider's new value is to be applied: its drag ended, or a value typed into
+/// its field was left (Enter, Tab or a click elsewhere), not at every keystroke: typing
+/// 41000 must not re-mesh at 4, 41 and 410 on the way.
+fn released(r: &egui::Response) -> bool {
+    r.drag_stopped() || r.lost_focus() || (r.changed() && !r.dragged() && !r.has_focus())
 }

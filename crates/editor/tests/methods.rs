@@ -363,3 +363,109 @@ fn painted_rigidity_survives_a_new_density() {
     assert_eq!(h.state().painted_triangles(), fresh);
     h.state().sanity_check().expect("consistent");
 }
+
+#[test]
+fn mls_is_chosen_dragged_undone_and_exported_as_the_pipeline_draws_it() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    let c2 = shot(&mut h);
+    let c2_positions = positions(&h);
+    click_label(&mut h, "MLS");
+    assert_eq!(method(&h), Method::Mls);
+    // The editor's MLS is the method's own answer for the rig's mesh and handles.
+    let doc = h.state().document().expect("doc");
+    let own = pipeline::on_handles(doc.project(), doc.rig().clone(), Some(&doc.image))
+        .expect("MLS")
+        .deformed();
+    assert_eq!(positions(&h), own);
+    let mls = shot(&mut h);
+    assert!(changed(&c2, &mls) > 0.002, "MLS draws another picture");
+
+    // A drag moves the picture at the handle with it: MLS interpolates its handles.
+    click_label(&mut h, "Select");
+    let translate = |h: &Harness<'_, EditorApp>| support::translate(&support::handles(h)[2]);
+    let before = translate(&h);
+    let now = DVec2::new(440.0, 238.0) + before;
+    let (from, to) = (at(&h, now.x, now.y), at(&h, now.x + 20.0, now.y + 10.0));
+    drag(&mut h, from, to, Modifiers::NONE);
+    let moved = translate(&h) - before;
+    assert!(
+        (moved - DVec2::new(20.0, 10.0)).length() < 2.0,
+        "moved by {moved}"
+    );
+    let doc = h.state().document().expect("doc");
+    let domain = doc.rig().domain();
+    let v = domain
+        .nearest_vertex(DVec2::new(440.0, 238.0))
+        .expect("a vertex") as usize;
+    let gap = domain.positions()[v].distance(DVec2::new(440.0, 238.0));
+    let went = doc.deformer().deformed()[v] - domain.positions()[v];
+    assert!(
+        went.distance(translate(&h)) < 0.2 * gap + 1e-9,
+        "the vertex {gap:.2} px from the handle went by {went}, the handle by {}",
+        translate(&h)
+    );
+    h.state().sanity_check().expect("consistent");
+
+    // The export is the pipeline's MLS for the saved project, and saved as MLS.
+    let exported = support::export_png(&mut h, dir.path());
+    let doc = h.state().document().expect("doc");
+    let project = doc.project_for_saving(None);
+    assert_eq!(project.method, Method::Mls);
+    assert!(project.to_json().contains(r#""method": "mls""#));
+    let warper = pipeline::prepare_warper(&doc.image, &project, None, &()).expect("MLS");
+    assert!(exported == pipeline::warp(&doc.image, &warper).expect("warp"));
+
+    // Undo the drag, then the switch: the C² picture comes back.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert_eq!(positions(&h), own, "the drag undone, MLS is where it was");
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert_eq!(method(&h), Method::C2);
+    assert_eq!(positions(&h), c2_positions);
+}
+
+#[test]
+fn mls_fit_and_alpha_are_settings_of_the_rig_and_undo() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    click_label(&mut h, "MLS");
+    let rigid = positions(&h);
+    let settings = |h: &Harness<'_, EditorApp>| {
+        h.state()
+            .document()
+            .expect("doc")
+            .project()
+            .mls
+            .unwrap_or_default()
+    };
+    assert_eq!(settings(&h), project::MlsSettings::default());
+    // The Fit menu: from rigid to affine.
+    click_label(&mut h, "Fit");
+    click_label(&mut h, "Affine");
+    assert_eq!(settings(&h).variant, Some(project::MlsVariant::Affine));
+    let affine = positions(&h);
+    assert_ne!(affine, rigid, "another fit, another warp");
+    // α, as a typed value: more local handles.
+    assert!(h.state_mut().edit(editor::Edit::Mls(project::MlsSettings {
+        alpha: Some(2.5),
+        variant: Some(project::MlsVariant::Affine),
+    })));
+    h.run();
+    assert_ne!(positions(&h), affine);
+    h.state().sanity_check().expect("consistent");
+    // Out of range is refused and changes nothing.
+    assert!(!h.state_mut().edit(editor::Edit::Mls(project::MlsSettings {
+        alpha: Some(0.0),
+        variant: None,
+    })));
+    assert_eq!(settings(&h).alpha, Some(2.5));
+    // One undo step each.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert_eq!(positions(&h), affine);
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert_eq!(positions(&h), rigid);
+}

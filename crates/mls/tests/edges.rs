@@ -219,8 +219,8 @@ fn bad_input_is_refused_with_its_reason() {
     }
     let options = MlsOptions::default();
     assert_eq!(
-        Mls::new(&[DVec2::ZERO, DVec2::NAN], &[point], &options).unwrap_err(),
-        MlsError::NonFiniteVertex { vertex: 1 }
+        Mls::new(&[DVec2::ZERO, DVec2::NAN], &[point], &options).err(),
+        Some(MlsError::NonFiniteVertex { vertex: 1 })
     );
     assert_eq!(
         Mls::new(
@@ -228,40 +228,39 @@ fn bad_input_is_refused_with_its_reason() {
             &[point, Control::Point(DVec2::new(f64::INFINITY, 0.0))],
             &options
         )
-        .unwrap_err(),
-        MlsError::NonFiniteControl { control: 1 }
+        .err(),
+        Some(MlsError::NonFiniteControl { control: 1 })
     );
     let p = DVec2::new(10.0, 10.0);
     assert_eq!(
-        Mls::new(&v, &[point, Control::Bar([p, p])], &options).unwrap_err(),
-        MlsError::ZeroLengthBar { control: 1 }
+        Mls::new(&v, &[point, Control::Bar([p, p])], &options).err(),
+        Some(MlsError::ZeroLengthBar { control: 1 })
     );
 
     let mls = Mls::new(&v, &[point, Control::Bar([p, p + DVec2::X])], &options).expect("valid");
     let mut out = [DVec2::ZERO];
     assert_eq!(
-        mls.deform(&[point], &mut out).unwrap_err(),
-        MlsError::PoseLength { posed: 1, rest: 2 }
+        mls.deform(&[point], &mut out).err(),
+        Some(MlsError::PoseLength { posed: 1, rest: 2 })
     );
     assert_eq!(
-        mls.deform(&[point, point], &mut out).unwrap_err(),
-        MlsError::PoseKind { control: 1 }
+        mls.deform(&[point, point], &mut out).err(),
+        Some(MlsError::PoseKind { control: 1 })
     );
     assert_eq!(
         mls.deform(
             &[Control::Point(DVec2::NAN), Control::Bar([p, p])],
             &mut out
         )
-        .unwrap_err(),
-        MlsError::NonFinitePosed { control: 0 }
+        .err(),
+        Some(MlsError::NonFinitePosed { control: 0 })
     );
     assert_eq!(
-        mls.deform(&[point, Control::Bar([p, p])], &mut [])
-            .unwrap_err(),
-        MlsError::OutputLength {
+        mls.deform(&[point, Control::Bar([p, p])], &mut []).err(),
+        Some(MlsError::OutputLength {
             got: 0,
             vertices: 1
-        }
+        })
     );
     // A posed bar may collapse to a point: that is a pose, not a mistake.
     mls.deform(&[point, Control::Bar([p, p])], &mut out)

@@ -5,6 +5,7 @@ pub mod arap;
 mod c2;
 pub mod cage;
 pub mod method;
+pub mod mls;
 pub mod order;
 
 use std::io::{BufReader, Read};

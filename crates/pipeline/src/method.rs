@@ -13,6 +13,7 @@
 //! The methods, each in its own file:
 //! - [`Method::C2`] (`c2.rs`): the C² weights of `weights-core`, a [`Rig`] as it is.
 //! - [`Method::Arap`] (`arap.rs`): as-rigid-as-possible manipulation, [`ArapRig`].
+//! - [`Method::Mls`] (`mls.rs`): moving least squares, [`MlsRig`].
 //! - [`Method::Lbc`] (`cage.rs`): local barycentric coordinates of a cage,
 //!   [`CageDeformer`].
 //!
@@ -33,6 +34,7 @@ use weights_core::Rig;
 use crate::Warper;
 use crate::arap::ArapRig;
 use crate::cage::CageDeformer;
+use crate::mls::MlsRig;
 
 /// How a method's result is drawn.
 pub enum Output<'a> {
@@ -259,6 +261,7 @@ pub fn beside_rig(
     Ok(match project.method {
         Method::C2 => None,
         Method::Arap => Some(Box::new(ArapRig::on_rig(project, rig, picture)?)),
+        Method::Mls => Some(Box::new(MlsRig::on_rig(project, rig)?)),
         Method::Lbc => bail!("LBC warps by a cage, not by handles"),
     })
 }

@@ -56,19 +56,22 @@ pub enum Method {
     C2,
     /// As-rigid-as-possible shape manipulation (Igarashi, Moscovich and Hughes 2005).
     Arap,
+    /// Moving least squares image deformation (Schaefer, McPhail and Warren 2006).
+    Mls,
     /// Local barycentric coordinates of a cage (Zhang et al. 2014).
     Lbc,
 }
 
 impl Method {
     /// Every method, in the order a user is offered them.
-    pub const ALL: [Method; 3] = [Method::C2, Method::Arap, Method::Lbc];
+    pub const ALL: [Method; 4] = [Method::C2, Method::Arap, Method::Mls, Method::Lbc];
 
     /// The name in rig files and on the command line.
     pub fn name(self) -> &'static str {
         match self {
             Method::C2 => "c2",
             Method::Arap => "arap",
+            Method::Mls => "mls",
             Method::Lbc => "lbc",
         }
     }
@@ -78,19 +81,44 @@ impl Method {
         match self {
             Method::C2 => "C² weights",
             Method::Arap => "ARAP",
+            Method::Mls => "MLS",
             Method::Lbc => "LBC cage",
+        }
+    }
+
+    /// What it does, in a sentence for users (the method selector's tooltip).
+    pub fn about(self) -> &'static str {
+        match self {
+            Method::C2 => {
+                "closed-form C² weights (Xian, Jin and Wang): smooth and local, with virtual \
+                 handles; the handles' rotation and scale blend too"
+            }
+            Method::Arap => {
+                "as-rigid-as-possible (Igarashi, Moscovich and Hughes 2005): shapes keep \
+                 their proportions; each pin holds a small disc around it"
+            }
+            Method::Mls => {
+                "moving least squares (Schaefer, McPhail and Warren 2006): at each point, \
+                 the map (rigid by default) that best fits the handles near it; distances \
+                 are straight lines, so a handle also pulls what lies near it across a gap"
+            }
+            Method::Lbc => {
+                "local barycentric coordinates (Zhang et al. 2014): a cage drawn around \
+                 the subject moves what lies inside it, each vertex only its \
+                 neighbourhood; the outside stays"
+            }
         }
     }
 
     /// What the artist moves to drive it.
     pub fn controls(self) -> Controls {
         match self {
-            Method::C2 | Method::Arap => Controls::Handles,
+            Method::C2 | Method::Arap | Method::Mls => Controls::Handles,
             Method::Lbc => Controls::Cage,
         }
     }
 
-    /// The names of every method, for messages: `c2, arap, lbc`.
+    /// The names of every method, for messages: `c2, arap, mls, lbc`.
     pub fn names() -> String {
         Method::ALL.map(Method::name).join(", ")
     }
@@ -189,6 +217,55 @@ pub struct ArapSettings {
     pub density: Option<usize>,
 }
 
+/// Moving least squares' settings: the weight exponent and the class of map fitted at
+/// every point.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct MlsSettings {
+    /// The weight exponent α: a handle at distance `r` pixels weighs `1 / r^{2α}` (a
+    /// bar: that, integrated along it). Larger is more local. Default 1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub alpha: Option<f64>,
+    /// The class of map fitted: rigid (the default), similarity or affine.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub variant: Option<MlsVariant>,
+}
+
+/// The largest `mls.alpha`: beyond, weights over a picture's distances leave the
+/// range of floating point.
+pub const MAX_MLS_ALPHA: f64 = 10.0;
+
+/// The class of map moving least squares fits at every point.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum MlsVariant {
+    /// Rotation and translation (the paper's §2.3).
+    #[default]
+    Rigid,
+    /// Rotation, uniform scale and translation (§2.2).
+    Similarity,
+    /// Any affine map (§2.1).
+    Affine,
+}
+
+impl MlsVariant {
+    /// Every variant, in the order a menu lists them.
+    pub const ALL: [MlsVariant; 3] = [
+        MlsVariant::Rigid,
+        MlsVariant::Similarity,
+        MlsVariant::Affine,
+    ];
+
+    /// The name a menu shows.
+    pub fn label(self) -> &'static str {
+        match self {
+            MlsVariant::Rigid => "Rigid",
+            MlsVariant::Similarity => "Similarity",
+            MlsVariant::Affine => "Affine",
+        }
+    }
+}
+
 /// The largest `arap.density`: ARAP factorises its mesh when handles change, which
 /// takes about a second at this size.
 pub const MAX_ARAP_DENSITY: usize = 200_000;
@@ -269,7 +346,13 @@ deserialize_by_name!(MetricChoice, "a metric", [
 deserialize_by_name!(Method, "a method", [
     "c2" => Method::C2,
     "arap" => Method::Arap,
+    "mls" => Method::Mls,
     "lbc" => Method::Lbc,
+]);
+deserialize_by_name!(MlsVariant, "an MLS variant", [
+    "rigid" => MlsVariant::Rigid,
+    "similarity" => MlsVariant::Similarity,
+    "affine" => MlsVariant::Affine,
 ]);
 deserialize_by_name!(Tau, "a locality weighting τ", [
     "square" => Tau::Square,
@@ -447,6 +530,9 @@ pub struct Project {
     /// ARAP's settings.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub arap: Option<ArapSettings>,
+    /// Moving least squares' settings.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mls: Option<MlsSettings>,
     /// The frame of an export or render: the picture's own (`"keep"`, the default) or
     /// grown to fit the warped picture (`"fit"`).
     #[serde(default, skip_serializing_if = "is_keep")]
@@ -477,6 +563,7 @@ impl Default for Project {
             cage: None,
             lbc: None,
             arap: None,
+            mls: None,
             canvas: Canvas::Keep,
         }
     }
@@ -801,6 +888,13 @@ impl Project {
                 }
             }
         }
+        if let Some(alpha) = self.mls.and_then(|m| m.alpha)
+            && !(alpha.is_finite() && alpha > 0.0 && alpha <= MAX_MLS_ALPHA)
+        {
+            return bad(format!(
+                "mls.alpha must be a number above 0 and at most {MAX_MLS_ALPHA}, got {alpha}"
+            ));
+        }
         Ok(())
     }
 }
@@ -877,6 +971,23 @@ mod tests {
     }
 
     #[test]
+    fn mls_settings_round_trip_and_default_to_rigid_with_alpha_one() {
+        let p = Project::from_json(
+            r#"{"version":1,"method":"mls","handles":[],"mls":{"alpha":1.5,"variant":"affine"}}"#,
+        )
+        .expect("parses");
+        assert_eq!(p.method, Method::Mls);
+        let mls = p.mls.expect("settings");
+        assert_eq!(mls.alpha, Some(1.5));
+        assert_eq!(mls.variant, Some(MlsVariant::Affine));
+        assert_eq!(Project::from_json(&p.to_json()).expect("round trip"), p);
+        assert_eq!(MlsVariant::default(), MlsVariant::Rigid);
+        let bare =
+            Project::from_json(r#"{"version":1,"method":"mls","handles":[]}"#).expect("parses");
+        assert!(bare.mls.is_none() && !bare.to_json().contains("\"mls\":"));
+    }
+
+    #[test]
     fn round_trip_is_exact() {
         let p = sample();
         let back = Project::from_json(&p.to_json()).expect("parses");
@@ -935,7 +1046,7 @@ mod tests {
             ),
             (
                 r#"{"version":1,"handles":[],"method":2}"#,
-                r#"method: invalid type: integer `2`, expected a method: "c2", "arap" or "lbc""#,
+                r#"method: invalid type: integer `2`, expected a method: "c2", "arap", "mls" or "lbc""#,
             ),
             (
                 r#"{"version":1,"handles":[{"type":"point","rest":[1,"x"]}]}"#,
@@ -1016,6 +1127,22 @@ mod tests {
             (
                 r#"{"version":1,"handles":[],"arap":{"radius":3}}"#,
                 "unknown field `radius`",
+            ),
+            (
+                r#"{"version":1,"handles":[],"mls":{"alpha":0}}"#,
+                "mls.alpha must be a number above 0 and at most 10, got 0",
+            ),
+            (
+                r#"{"version":1,"handles":[],"mls":{"alpha":11}}"#,
+                "mls.alpha must be a number above 0",
+            ),
+            (
+                r#"{"version":1,"handles":[],"mls":{"variant":"shear"}}"#,
+                r#"mls.variant: invalid value: string "shear", expected an MLS variant: "rigid", "similarity" or "affine""#,
+            ),
+            (
+                r#"{"version":1,"handles":[],"mls":{"beta":1}}"#,
+                "unknown field `beta`",
             ),
             (
                 r#"{"version":1,"handles":[],"rigidity":[{"stroke":[],"radius":2,"weight":1}]}"#,
