@@ -1,5 +1,5 @@
 //! How many virtual handles the project's own rules place, against the paper's rules,
-//! on the same meshes (see "Virtual handles: the paper's rule and ours" in the README):
+//! on the same meshes (see "Fidelity counts" in docs/methods/c2.md):
 //!
 //! 1. Algorithm 1 as written (one virtual handle a round, in the worst cell) against
 //!    the symmetric placement (tied cells together, close candidates merged), on close
