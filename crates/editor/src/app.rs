@@ -2,7 +2,6 @@
 //! and the one place where edits are applied ([`EditorApp::edit`]).
 
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Context as _, Result};
@@ -11,9 +10,11 @@ use project::{HandleSpec, Method};
 
 use crate::dialogs::{Answer, BuiltinDialog, Dialogs, FileAction, NativeDialogs, Shown};
 use crate::document::{CageKey, Document, Edit, posed};
+use crate::gpu_frame::{FrameBuilder, View};
 use crate::history::History;
 use crate::jobs::{CancelFlag, Job, Outcome, Rebuild, SolveProgress};
-use crate::scene::{GpuFrame, MeshData, SceneResources, Versioned};
+use crate::scene::SceneResources;
+use crate::show::Show;
 use crate::viewport::Viewport;
 
 /// What a primary click or drag on the canvas does.
@@ -33,48 +34,6 @@ pub enum Tool {
     Rigidity,
     /// Draw, adjust, solve and pose an LBC cage (see [`crate::cage`]).
     Cage,
-}
-
-/// Which overlays are on.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Show {
-    /// Mesh edges.
-    pub mesh: bool,
-    /// Virtual handles.
-    pub virtual_handles: bool,
-    /// Voronoi cells of all nodes.
-    pub cells: bool,
-    /// The dual (Delaunay) graph of the nodes.
-    pub dual_graph: bool,
-    /// The selected handle's weight as a heat map with isolines.
-    pub heat: bool,
-    /// Fold-overs in red.
-    pub folds: bool,
-    /// The weights under the cursor.
-    pub hover_weights: bool,
-    /// Painted rigidity, translucent.
-    pub rigidity: bool,
-    /// With the heat map of a cage vertex: its support contour at `10⁻³/n`.
-    pub contour: bool,
-    /// The panel of a solved cage's locality statistics.
-    pub locality: bool,
-}
-
-impl Default for Show {
-    fn default() -> Self {
-        Self {
-            mesh: false,
-            virtual_handles: true,
-            cells: false,
-            dual_graph: false,
-            heat: false,
-            folds: true,
-            hover_weights: true,
-            rigidity: true,
-            contour: true,
-            locality: true,
-        }
-    }
 }
 
 /// Messages the log keeps before the oldest is forgotten.
@@ -185,11 +144,9 @@ pub struct EditorApp {
     /// Where the built-in file dialog starts when the document has no file of its own
     /// (else the current folder).
     pub default_folder: Option<PathBuf>,
-    pub(crate) gpu: GpuFrame,
+    /// What the canvas hands the GPU, kept up to date with the document.
+    pub(crate) gpu: FrameBuilder,
     pub(crate) has_gpu: bool,
-    next_version: u64,
-    seen: Seen,
-    pub(crate) dual_graph: (u64, Arc<Vec<(u32, u32)>>),
     pub(crate) settings_draft: Option<crate::document::Settings>,
     /// MLS's α and fit while its slider is dragged.
     pub(crate) mls_draft: Option<(f64, project::MlsVariant)>,
@@ -200,26 +157,6 @@ pub struct EditorApp {
     wake: Option<egui::Context>,
     /// Milliseconds the last frame's logic took on the CPU.
     pub frame_ms: f64,
-}
-
-/// Versions the GPU frame was last built from.
-#[derive(Default, Clone)]
-struct Seen {
-    weights: u64,
-    pose: u64,
-    heat: Option<(usize, u64)>,
-    cells: u64,
-    /// Whether the frame showed the cage tool's view.
-    cage_view: bool,
-    /// Whether a solved cage warped it.
-    warping: bool,
-    /// The picture and solved cage the backdrop was made from (held, so that a new
-    /// one is a new allocation), so that editing an unsolved cage does not upload the
-    /// picture again.
-    backdrop: Option<(
-        Arc<image::RgbaImage>,
-        Option<Arc<pipeline::cage::CageCoordinates>>,
-    )>,
 }
 
 impl EditorApp {
@@ -296,11 +233,8 @@ impl EditorApp {
             cage: crate::cage::CageTool::default(),
             cage_vertices: pipeline::cage::DEFAULT_CAGE_VERTICES,
             default_folder: None,
-            gpu: GpuFrame::default(),
+            gpu: FrameBuilder::default(),
             has_gpu,
-            next_version: 0,
-            seen: Seen::default(),
-            dual_graph: (0, Arc::new(Vec::new())),
             settings_draft: None,
             mls_draft: None,
             job: None,
@@ -376,26 +310,7 @@ impl EditorApp {
             anyhow::bail!("a bar is being drawn with the {:?} tool", self.tool);
         }
         self.cage_sanity_check(doc)?;
-        if self.seen.weights == doc.weights_version && self.gpu.mesh.version != 0 {
-            let mesh = &self.gpu.mesh.value;
-            let (samples, what) = if !self.seen.cage_view {
-                (doc.rig().domain().len(), "the rig")
-            } else if self.seen.warping {
-                let solved = doc.cage_solution().map(|s| s.domain.positions().len());
-                (solved.unwrap_or(0), "the cage's mesh")
-            } else {
-                (0, "no mesh (a cage being drawn)")
-            };
-            if mesh.rest.len() != samples || mesh.rows.len() != samples + 1 {
-                anyhow::bail!(
-                    "the GPU mesh has {} vertices, {what} {samples}",
-                    mesh.rest.len()
-                );
-            }
-            if self.seen.cage_view && self.gpu.backdrop.is_none() {
-                anyhow::bail!("the cage's view without the picture at rest under it");
-            }
-        }
+        self.gpu.sanity_check(doc)?;
         if self.log.len() > LOG_LIMIT {
             anyhow::bail!("the message log outgrew its limit");
         }
@@ -1073,8 +988,9 @@ impl EditorApp {
                     }),
                     Rebuild::Edit { .. } => None,
                 };
+                let mut kept = Ok(());
                 if let Some(old) = &self.doc {
-                    doc.keep_solutions_of(old);
+                    kept = doc.keep_solutions_of(old);
                     doc.project_path.clone_from(&old.project_path);
                     doc.weights_version = old.weights_version + 1;
                     doc.pose_version = old.pose_version + 1;
@@ -1088,6 +1004,9 @@ impl EditorApp {
                             self.history.redo(current);
                         }
                     }
+                }
+                if let Err(e) = kept {
+                    self.error(&e.context("the solved cage does not fit the rebuilt picture"));
                 }
                 let stats = doc.rig().stats();
                 let ms = doc.last_update_ms;
@@ -1370,167 +1289,26 @@ impl EditorApp {
         };
         let frame = pipeline::Frame::new(w, h, &deformed, canvas)?;
         self.update_gpu_frame();
-        Ok(self.gpu.draw_offscreen(gpu, frame)?)
+        Ok(self.gpu.frame.draw_offscreen(gpu, frame)?)
     }
 
-    /// Brings the GPU frame up to date with the document: weights after a structural
-    /// change, transforms after a pose change, overlay values when asked for. This is
-    /// the CPU side of what a frame uploads; the canvas calls it every frame.
+    /// Brings the GPU frame up to date with the document as the view shows it (see
+    /// [`FrameBuilder::update`]); the canvas calls it every frame.
     pub fn update_gpu_frame(&mut self) {
         let cage_view = self.cage_view();
-        let warping = self.cage_warping();
-        let focus = self.cage.focus();
-        let Some(doc) = &self.doc else { return };
-        // The cage's mesh with its coordinates, when it warps the picture.
-        let cage = doc.cage_solution().filter(|_| warping).cloned();
-        let counter = &mut self.next_version;
-        let mut bump = || {
-            *counter += 1;
-            *counter
-        };
-        let gpu = &mut self.gpu;
-        let seen = &mut self.seen;
-        let weights = doc.weights_version;
-        let image_is_new = gpu.image.version == 0 || !Arc::ptr_eq(&gpu.image.value, &doc.image);
-        if image_is_new {
-            gpu.image = Versioned {
-                version: bump(),
-                value: doc.image.clone(),
-            };
-        }
-        let weights_changed = image_is_new
-            || weights != seen.weights
-            || cage_view != seen.cage_view
-            || warping != seen.warping;
-        if weights_changed && cage_view {
-            let size = [doc.image.width(), doc.image.height()];
-            let mesh = match &cage {
-                Some(solution) => crate::cage::mesh_data(solution, size),
-                // No cage to warp by: the picture at rest alone.
-                None => MeshData {
-                    rows: vec![0],
-                    source_size: size,
-                    ..MeshData::default()
-                },
-            };
-            gpu.mesh = Versioned {
-                version: bump(),
-                value: Arc::new(mesh),
-            };
-            let same = seen.backdrop.as_ref().is_some_and(|(image, solution)| {
-                Arc::ptr_eq(image, &doc.image)
-                    && match (solution, &cage) {
-                        (Some(a), Some(b)) => Arc::ptr_eq(a, b),
-                        (None, None) => true,
-                        _ => false,
-                    }
-            });
-            if gpu.backdrop.is_none() || !same {
-                let backdrop = match &cage {
-                    Some(solution) => Arc::new(crate::cage::outside_of(&doc.image, solution)),
-                    None => doc.image.clone(),
-                };
-                gpu.backdrop = Some(Versioned {
-                    version: bump(),
-                    value: backdrop,
-                });
-                seen.backdrop = Some((doc.image.clone(), cage.clone()));
-            }
-            seen.heat = None;
-            seen.cells = 0;
-        } else if weights_changed {
-            gpu.backdrop = None;
-            seen.backdrop = None;
-            let rig = doc.rig();
-            let (rows, nodes, weights) = rig.weight_table();
-            let mesh = MeshData {
-                rest: rig
-                    .domain()
-                    .positions()
-                    .iter()
-                    .map(|p| p.as_vec2())
-                    .collect(),
-                rows,
-                nodes,
-                weights,
-                triangles: doc.draw_order(),
-                source_size: [doc.image.width(), doc.image.height()],
-            };
-            gpu.mesh = Versioned {
-                version: bump(),
-                value: Arc::new(mesh),
-            };
-            seen.heat = None;
-            seen.cells = 0;
-        }
-        if weights_changed || doc.pose_version != seen.pose {
-            let affines = match (cage_view, &cage) {
-                (true, Some(_)) => pipeline::cage::pose_transforms(&doc.cage_pose()),
-                (true, None) => Vec::new(),
-                (false, _) => doc.rig().node_affines(),
-            };
-            gpu.pose = Versioned {
-                version: bump(),
-                value: Arc::new(affines),
-            };
-            let positions = match doc.deformer().output() {
-                _ if cage_view => Vec::new(),
-                pipeline::Output::Skinned(_) => Vec::new(),
-                pipeline::Output::Positions(p) => p.iter().map(|p| p.as_vec2()).collect(),
-            };
-            gpu.positions = Versioned {
-                version: bump(),
-                value: Arc::new(positions),
-            };
-        }
-        let shown = if cage_view {
-            focus.filter(|_| cage.is_some())
-        } else {
-            self.selected
-        };
-        let heat_key = shown.filter(|_| self.show.heat).map(|s| (s, weights));
-        if let Some((shown, _)) = heat_key
-            && heat_key != seen.heat
-        {
-            let values = if cage_view {
-                doc.cage_influence(shown).unwrap_or_default()
+        let view = View {
+            cage_view,
+            warping: self.cage_warping(),
+            shown: if cage_view {
+                self.cage.focus()
             } else {
-                doc.influence(shown)
-            };
-            gpu.heat = Versioned {
-                version: bump(),
-                value: Arc::new(values),
-            };
-            seen.heat = heat_key;
+                self.selected
+            },
+            show: self.show,
+        };
+        if let Some(doc) = &self.doc {
+            self.gpu.update(doc, &view);
         }
-        if self.show.cells && !cage_view && seen.cells != weights {
-            let rig = doc.rig();
-            // A sample that no node reaches (a rig without nodes, or a piece of the
-            // shape without a handle) has no cell: grey.
-            let colors = rig
-                .cells()
-                .iter()
-                .map(|&k| {
-                    rig.nodes()
-                        .get(k as usize)
-                        .map_or(NO_CELL, |node| cell_color(node.vertex))
-                })
-                .collect();
-            gpu.cells = Versioned {
-                version: bump(),
-                value: Arc::new(colors),
-            };
-            seen.cells = weights;
-        }
-        // Keyed by the GPU mesh's version, which no other document shares.
-        let mesh_version = gpu.mesh.version;
-        if self.show.dual_graph && !cage_view && self.dual_graph.0 != mesh_version {
-            self.dual_graph = (mesh_version, Arc::new(doc.rig().dual_graph()));
-        }
-        seen.weights = weights;
-        seen.pose = doc.pose_version;
-        seen.cage_view = cage_view;
-        seen.warping = warping;
     }
 }
 
@@ -1626,17 +1404,6 @@ pub(crate) fn without_virtuals(project: &project::Project) -> project::Project {
     }
 }
 
-/// The colour of samples in no node's cell.
-const NO_CELL: [u8; 4] = [128, 128, 128, 255];
-
-/// A stable, well-spread colour for a node (keyed by its sample, so it survives
-/// renumbering).
-pub(crate) fn cell_color(key: u32) -> [u8; 4] {
-    let hue = (key.wrapping_mul(2_654_435_761) >> 8) as f32 / (1u32 << 24) as f32;
-    let rgb = egui::ecolor::Hsva::new(hue, 0.75, 0.95, 1.0).to_srgb();
-    [rgb[0], rgb[1], rgb[2], 255]
-}
-
 /// Sets each point handle's rotation to the one that best turns the directions to its
 /// neighbours (all other handles, nearer ones weighing more) from rest to now: the
 /// pseudo-edge heuristic of bounded biharmonic weights.
@@ -1719,13 +1486,5 @@ mod tests {
                 .iter()
                 .all(|h| matches!(h, HandleSpec::Point { rotate, .. } if rotate.abs() < 1e-12))
         );
-    }
-
-    #[test]
-    fn cell_colours_are_opaque_and_differ() {
-        let a = cell_color(1);
-        let b = cell_color(2);
-        assert_eq!(a[3], 255);
-        assert_ne!(a, b);
     }
 }

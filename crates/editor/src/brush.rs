@@ -191,7 +191,7 @@ impl EditorApp {
         if strokes.is_empty() && self.brush_stroke.is_none() {
             return;
         }
-        let mesh = self.gpu.mesh.version;
+        let mesh = self.gpu.frame.mesh.version;
         let fresh = self
             .painted
             .key

@@ -19,12 +19,10 @@ use std::sync::Arc;
 
 use egui::{Color32, Key, Modifiers, PointerButton, Pos2, Rect, Shape, Stroke, StrokeKind, Ui};
 use glam::DVec2;
-use pipeline::cage::CageCoordinates;
 use project::{Method, Project, Tau};
 
 use crate::app::{EditorApp, Tool};
 use crate::document::{CageKey, Edit};
-use crate::scene::MeshData;
 
 /// How close the pointer must be to grab a cage vertex or edge, screen points.
 const GRAB: f32 = 9.0;
@@ -160,34 +158,6 @@ pub fn contour(triangles: &[[u32; 3]], values: &[f32], level: f32) -> Vec<Contou
             out.push([p, q]);
         }
     }
-    out
-}
-
-/// The solved cage's mesh as the shader skins it: every vertex's compact row of
-/// `(cage vertex, weight)` pairs, so that node transforms with no linear part and the
-/// posed cage vertices as translations give `x' = Σ wᵢ cᵢ'`.
-pub(crate) fn mesh_data(solution: &CageCoordinates, source_size: [u32; 2]) -> MeshData {
-    let (rows, nodes, weights) = pipeline::cage::skinning_table(&solution.weights);
-    MeshData {
-        rest: solution
-            .domain
-            .positions()
-            .iter()
-            .map(|p| p.as_vec2())
-            .collect(),
-        rows,
-        nodes,
-        weights,
-        triangles: solution.domain.triangles().to_vec(),
-        source_size,
-    }
-}
-
-/// The picture as LBC leaves it outside the cage: pixels inside the rest cage cleared
-/// (the warped inside is drawn over it), as the export draws it.
-pub(crate) fn outside_of(image: &image::RgbaImage, solution: &CageCoordinates) -> image::RgbaImage {
-    let mut out = image.clone();
-    pipeline::cage::clear_inside(&mut out, &solution.domain);
     out
 }
 

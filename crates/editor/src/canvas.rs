@@ -107,7 +107,7 @@ impl EditorApp {
             painter.add(egui_wgpu::Callback::new_paint_callback(
                 rect,
                 MeshCallback {
-                    frame: self.gpu.clone(),
+                    frame: self.gpu.frame.clone(),
                     params,
                 },
             ));
@@ -513,7 +513,7 @@ impl EditorApp {
         let v = &self.viewport;
         let c2 = doc.method() == Method::C2;
         if self.show.dual_graph && c2 {
-            for &(a, b) in self.dual_graph.1.iter() {
+            for &(a, b) in self.gpu.dual_graph.1.iter() {
                 let (a, b) = (a as usize, b as usize);
                 if a < rig.nodes().len() && b < rig.nodes().len() {
                     painter.line_segment(

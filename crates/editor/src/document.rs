@@ -16,7 +16,7 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use glam::DVec2;
 use image::RgbaImage;
-use pipeline::cage::{CageCoordinates, CageMesh};
+use pipeline::cage::{CageCoordinates, CageDeformer, CageMesh};
 use pipeline::{ArapRig, Controls, Deformer, Follow, Method};
 use project::{
     CageSpec, HandleSpec, LbcSettings, MetricChoice, Middle, Placement, Project, RigidityStroke,
@@ -215,9 +215,6 @@ pub struct Document {
     method: Option<(u64, Box<dyn Deformer>)>,
     /// Solved cages, the most recent last (at most [`SOLUTIONS_KEPT`]).
     solutions: Vec<(CageKey, Arc<CageCoordinates>)>,
-    /// The solved cage's mesh deformed by the cage's pose, and the (pose, weights)
-    /// versions it was computed for.
-    cage_deformed: Option<((u64, u64), Vec<DVec2>)>,
 }
 
 impl Document {
@@ -268,7 +265,6 @@ impl Document {
             mesh_version: 1,
             method: None,
             solutions: Vec::new(),
-            cage_deformed: None,
         }
         .with_method()
     }
@@ -285,9 +281,8 @@ impl Document {
     /// when first chosen or with new settings); C² is the rig itself; a cage method is
     /// the solved cage's ([`Document::cage_solution`]).
     fn sync_method(&mut self) -> Result<()> {
-        if self.project.method.controls() != Controls::Handles {
-            self.method = None;
-            return Ok(());
+        if self.project.method.controls() == Controls::Cage {
+            return self.sync_cage();
         }
         if let Some((mesh, deformer)) = &mut self.method
             && *mesh == self.mesh_version
@@ -299,6 +294,33 @@ impl Document {
         self.method = pipeline::beside_rig(&self.project, &self.rig, Some(&self.image))?
             .map(|deformer| (self.mesh_version, deformer));
         Ok(())
+    }
+
+    /// The cage method's deformer: the rig file's cage posed by its solved coordinates
+    /// (kept while the solution stays the same; none until the cage is solved).
+    fn sync_cage(&mut self) -> Result<()> {
+        let Some(solution) = self.cage_solution().cloned() else {
+            self.method = None;
+            return Ok(());
+        };
+        if let Some((_, deformer)) = &mut self.method
+            && deformer
+                .as_any()
+                .downcast_ref::<CageDeformer>()
+                .is_some_and(|cage| Arc::ptr_eq(cage.solution(), &solution))
+            && deformer.follow(&self.project)? == Follow::Followed
+        {
+            return Ok(());
+        }
+        let deformer = CageDeformer::new(solution, self.cage_pose())?;
+        self.method = Some((self.mesh_version, Box::new(deformer)));
+        Ok(())
+    }
+
+    /// The cage method's deformer, when the rig file's cage is solved and LBC chosen.
+    pub fn cage_deformer(&self) -> Option<&CageDeformer> {
+        let (_, deformer) = self.method.as_ref()?;
+        deformer.as_any().downcast_ref::<CageDeformer>()
     }
 
     /// Bumped whenever the picture is meshed anew.
@@ -378,7 +400,7 @@ impl Document {
 
     /// Whether the picture is warped by a solved cage: LBC chosen and its cage solved.
     pub fn cage_warps(&self) -> bool {
-        self.project.method == Method::Lbc && self.cage_solution().is_some()
+        self.cage_deformer().is_some()
     }
 
     /// Keeps coordinates solved for `key` (the oldest kept are forgotten). If `key` is
@@ -398,18 +420,24 @@ impl Document {
         if self.solutions.len() >= SOLUTIONS_KEPT {
             self.solutions.remove(0);
         }
-        if CageKey::of(&self.project).as_ref() == Some(&key) {
+        let current = CageKey::of(&self.project).as_ref() == Some(&key);
+        self.solutions.push((key, solution));
+        if current {
             self.weights_version += 1;
             self.pose_version += 1;
+            self.sync_method()?;
         }
-        self.solutions.push((key, solution));
         Ok(())
     }
 
     /// Takes over the solved cages of `other` (the same picture, rebuilt): solutions
     /// depend only on the cage, not on the picture's mesh.
-    pub(crate) fn keep_solutions_of(&mut self, other: &Document) {
+    ///
+    /// # Errors
+    /// A kept solution that does not fit the rig file's cage pose.
+    pub(crate) fn keep_solutions_of(&mut self, other: &Document) -> Result<()> {
         self.solutions.clone_from(&other.solutions);
+        self.sync_method()
     }
 
     /// Solves the rig file's cage here and now (seconds; the editor does it on its
@@ -431,20 +459,10 @@ impl Document {
         self.add_solution(key, solution)
     }
 
-    /// Every vertex of the solved cage's mesh where the cage's pose takes it (cached
-    /// per pose); `None` unless the cage is solved.
-    pub fn cage_deformed(&mut self) -> Option<&[DVec2]> {
-        let version = (self.pose_version, self.weights_version);
-        if self
-            .cage_deformed
-            .as_ref()
-            .is_none_or(|(v, _)| *v != version)
-        {
-            let solution = self.cage_solution()?;
-            let deformed = solution.weights.deform(&self.cage_pose()).ok()?;
-            self.cage_deformed = Some((version, deformed));
-        }
-        self.cage_deformed.as_ref().map(|(_, d)| d.as_slice())
+    /// Every vertex of the solved cage's mesh where the cage's pose takes it; `None`
+    /// unless LBC is chosen and its cage solved.
+    pub fn cage_deformed(&self) -> Option<&[DVec2]> {
+        self.cage_deformer().map(CageDeformer::positions)
     }
 
     /// Cage vertex `i`'s coordinate function at every vertex of the solved cage's mesh
@@ -874,21 +892,38 @@ impl Document {
     fn method_sanity_check(&self) -> Result<()> {
         let method = self.project.method;
         let Some((mesh, deformer)) = &self.method else {
-            // The rig is the deformer (C²), or the method has no handles.
-            if method.controls() == Controls::Handles && Deformer::method(&self.rig) != method {
+            // The rig is the deformer (C²), or the cage is not solved yet.
+            let ok = match method.controls() {
+                Controls::Handles => Deformer::method(&self.rig) == method,
+                Controls::Cage => self.cage_solution().is_none(),
+            };
+            if !ok {
                 bail!("method {} has no deformer", method.name());
             }
             return Ok(());
         };
-        if method.controls() != Controls::Handles || deformer.method() != method {
+        if deformer.method() != method {
             bail!(
                 "method {} with a deformer of {}",
                 method.name(),
                 deformer.method().name()
             );
         }
-        if *mesh != self.mesh_version || deformer.rest() != self.rig.domain().positions() {
-            bail!("the {} deformer was set up on another mesh", method.name());
+        match method.controls() {
+            Controls::Handles => {
+                if *mesh != self.mesh_version || deformer.rest() != self.rig.domain().positions() {
+                    bail!("the {} deformer was set up on another mesh", method.name());
+                }
+            }
+            Controls::Cage => {
+                let solved = self.cage_solution();
+                if self
+                    .cage_deformer()
+                    .is_none_or(|cage| solved.is_none_or(|s| !Arc::ptr_eq(cage.solution(), s)))
+                {
+                    bail!("the cage deformer is not the rig file's solved cage");
+                }
+            }
         }
         let deformed = deformer.deformed();
         if let Some(v) = deformed.iter().position(|p| !p.is_finite()) {
@@ -916,8 +951,12 @@ impl Document {
     pub fn check_reopens(&self) -> Result<()> {
         let text = self.project_for_saving(None).to_json();
         let saved = Project::from_json(&text).context("the saved rig file does not load")?;
-        let fresh = Document::with_image(self.image.clone(), self.image_path.clone(), saved)
+        let mut fresh = Document::with_image(self.image.clone(), self.image_path.clone(), saved)
             .context("the saved rig file does not build")?;
+        // Solved cages are not saved (`c2warp render` solves again, to the same
+        // coordinates): the reopened document finds this one's for its cage, if the
+        // saved cage, τ and density are the same.
+        fresh.keep_solutions_of(self)?;
         let (a, b) = (self.rig.domain(), fresh.rig.domain());
         if a.positions() != b.positions() || a.triangles() != b.triangles() {
             bail!(

@@ -14,21 +14,24 @@ mod cage;
 mod canvas;
 mod dialogs;
 mod document;
+mod gpu_frame;
 mod history;
 mod jobs;
 mod panels;
 mod scene;
+mod show;
 mod viewport;
 
 use std::path::PathBuf;
 
-pub use app::{EditorApp, Message, Pending, Show, Tool};
+pub use app::{EditorApp, Message, Pending, Tool};
 pub use brush::{Brush, erase};
 pub use cage::{CageState, CageTool, contour, crossing_edges};
 pub use dialogs::{Answer, Dialogs, FileAction, IMAGES, NativeDialogs, desktop_has_dialogs};
 pub use document::{CageKey, Document, Edit, Settings, posed, solve_cage};
 pub use panels::SHORTCUTS;
 pub use scene::SceneResources;
+pub use show::Show;
 pub use viewport::Viewport;
 
 /// Opens the editor window on `path` (a picture, or a `.json` project) or on the

@@ -244,6 +244,11 @@ impl CageDeformer {
     pub fn pose(&self) -> &[DVec2] {
         &self.pose
     }
+
+    /// Every vertex of the solved cage's mesh where the pose takes it.
+    pub fn positions(&self) -> &[DVec2] {
+        &self.positions
+    }
 }
 
 impl Skinning for CageDeformer {
@@ -467,26 +472,6 @@ pub fn pose_transforms(pose: &[DVec2]) -> Vec<render::Affine> {
     pose.iter()
         .map(|p| [0.0, 0.0, 0.0, 0.0, p.x as f32, p.y as f32])
         .collect()
-}
-
-/// Makes transparent every pixel the mesh of a cage's inside covers at rest, by the
-/// rasteriser's own rule (pixel centres, top-left fill rule): the picture outside the
-/// cage, as [`CageDeformer`] keeps it. The warped inside is drawn over it, so at rest
-/// every cleared pixel is drawn again from itself and the picture comes back exactly.
-pub fn clear_inside(image: &mut image::RgbaImage, domain: &lbc::Domain) {
-    let mut picture = render::Picture::Rgba8(std::mem::take(image));
-    let rest: Vec<glam::Vec2> = domain.positions().iter().map(|p| p.as_vec2()).collect();
-    // The mesh comes from a validated cage, so it draws; if it did not, nothing is
-    // cleared.
-    let _ = render::clear_covered(
-        &mut picture,
-        &render::WarpMesh {
-            rest: &rest,
-            deformed: &rest,
-            triangles: domain.triangles(),
-        },
-    );
-    *image = picture.into_rgba8();
 }
 
 /// A cage around `image`'s visible shape (every pixel with alpha > 0, in every piece;

@@ -678,6 +678,36 @@ pub fn warp_gpu(image: &RgbaImage, warper: &Warper) -> Result<RgbaImage> {
     })
 }
 
+/// What `deformer` draws behind its warped mesh, on `image` in the picture's own frame:
+/// nothing (`None`, transparent), or `image` with every pixel its rest mesh covers
+/// cleared by the rasteriser's own rule (pixel centres, top-left fill rule), so that at
+/// rest every cleared pixel is drawn again from itself. The editor's view draws it
+/// under the mesh, as the exports do.
+///
+/// # Errors
+/// A rest mesh the rasteriser refuses (an index out of range).
+pub fn backdrop_of(
+    image: &image::RgbaImage,
+    deformer: &dyn Deformer,
+) -> Result<Option<image::RgbaImage>> {
+    match deformer.backdrop() {
+        Backdrop::Transparent => Ok(None),
+        Backdrop::PictureOutsideMesh => {
+            let rest: Vec<Vec2> = deformer.rest().iter().map(|p| p.as_vec2()).collect();
+            let mut picture = Picture::Rgba8(image.clone());
+            render::clear_covered(
+                &mut picture,
+                &render::WarpMesh {
+                    rest: &rest,
+                    deformed: &rest,
+                    triangles: deformer.triangles(),
+                },
+            )?;
+            Ok(Some(picture.into_rgba8()))
+        }
+    }
+}
+
 /// The picture warped by the current pose on the CPU, at its full resolution and in
 /// its own depth, over the method's backdrop, in the warper's frame (the picture's
 /// own, or grown to fit the warp: see [`Frame`]): a 16-bit picture gives a 16-bit

@@ -1,0 +1,308 @@
+//! The CPU side of what the canvas draws: the [`GpuFrame`] brought up to date with the
+//! document each frame, part by part, each part with a new version only when it
+//! changed (the paint callback in [`crate::scene`] uploads what has a new version).
+//!
+//! The mesh is whatever the shown method draws, through the method seam: the handle
+//! methods draw the picture's mesh skinned by the C² rig (its weights also feed the
+//! heat map and cells), with the positions a method solves for laid over it
+//! ([`pipeline::Output::Positions`]); a cage method draws its own mesh skinned by its
+//! own table, over its backdrop ([`pipeline::backdrop_of`]). While a cage is drawn or
+//! not yet solved, the picture is shown at rest with no mesh.
+
+use std::sync::Arc;
+
+use anyhow::{Result, bail};
+use glam::DVec2;
+use pipeline::{Deformer, Output};
+
+use crate::document::Document;
+use crate::scene::{GpuFrame, MeshData, Versioned};
+use crate::show::Show;
+
+/// What the view shows, as the app decides it this frame.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct View {
+    /// The cage's view: the cage tool, or LBC chosen.
+    pub cage_view: bool,
+    /// A solved cage warps the picture (no new polygon being drawn).
+    pub warping: bool,
+    /// The handle or cage vertex whose weights the heat map shows.
+    pub shown: Option<usize>,
+    /// Which overlays are on.
+    pub show: Show,
+}
+
+/// The frame with the versions it was built from.
+#[derive(Clone, Default)]
+pub(crate) struct FrameBuilder {
+    /// What the GPU draws.
+    pub frame: GpuFrame,
+    next_version: u64,
+    seen: Seen,
+    /// The dual graph's edges, keyed by the GPU mesh's version.
+    pub dual_graph: (u64, Arc<Vec<(u32, u32)>>),
+}
+
+/// Versions (and keys) the frame was last built from.
+#[derive(Default, Clone)]
+struct Seen {
+    weights: u64,
+    pose: u64,
+    heat: Option<(usize, u64)>,
+    cells: u64,
+    /// Whether the frame showed the cage tool's view.
+    cage_view: bool,
+    /// Whether a solved cage warped it.
+    warping: bool,
+    /// The picture and rest mesh the backdrop was made for.
+    backdrop: Option<(Arc<image::RgbaImage>, Vec<DVec2>)>,
+}
+
+impl FrameBuilder {
+    fn bump(&mut self) -> u64 {
+        self.next_version += 1;
+        self.next_version
+    }
+
+    /// Brings the frame up to date with `doc` as `view` shows it: the mesh after a
+    /// structural change, transforms or positions after a pose change, overlay values
+    /// when asked for.
+    pub fn update(&mut self, doc: &Document, view: &View) {
+        // The cage method's deformer, when it warps the view.
+        let cage = doc
+            .cage_deformer()
+            .filter(|_| view.cage_view && view.warping)
+            .map(|cage| cage as &dyn Deformer);
+        let weights = doc.weights_version;
+        let image_is_new =
+            self.frame.image.version == 0 || !Arc::ptr_eq(&self.frame.image.value, &doc.image);
+        if image_is_new {
+            let version = self.bump();
+            self.frame.image = Versioned {
+                version,
+                value: doc.image.clone(),
+            };
+        }
+        let mesh_changed = image_is_new
+            || weights != self.seen.weights
+            || view.cage_view != self.seen.cage_view
+            || view.warping != self.seen.warping;
+        if mesh_changed {
+            self.update_mesh(doc, view.cage_view, cage);
+        }
+        if mesh_changed || doc.pose_version != self.seen.pose {
+            self.update_pose(doc, view.cage_view, cage);
+        }
+        self.update_overlays(doc, view);
+        self.seen.weights = weights;
+        self.seen.pose = doc.pose_version;
+        self.seen.cage_view = view.cage_view;
+        self.seen.warping = view.warping;
+    }
+
+    /// The mesh with its weight rows and triangles in drawing order; in the cage's
+    /// view, the backdrop under it.
+    fn update_mesh(&mut self, doc: &Document, cage_view: bool, cage: Option<&dyn Deformer>) {
+        let size = [doc.image.width(), doc.image.height()];
+        let mesh = match (cage_view, cage) {
+            (true, Some(cage)) => skinned_mesh(cage, cage.triangles().to_vec(), size),
+            // No cage to warp by: the picture at rest alone.
+            (true, None) => MeshData {
+                rows: vec![0],
+                source_size: size,
+                ..MeshData::default()
+            },
+            (false, _) => skinned_mesh(doc.rig(), doc.draw_order(), size),
+        };
+        let version = self.bump();
+        self.frame.mesh = Versioned {
+            version,
+            value: Arc::new(mesh),
+        };
+        self.seen.heat = None;
+        self.seen.cells = 0;
+        if !cage_view {
+            self.frame.backdrop = None;
+            self.seen.backdrop = None;
+            return;
+        }
+        let rest = cage.map(|c| c.rest().to_vec()).unwrap_or_default();
+        let same = self
+            .seen
+            .backdrop
+            .as_ref()
+            .is_some_and(|(image, seen)| Arc::ptr_eq(image, &doc.image) && *seen == rest);
+        if self.frame.backdrop.is_some() && same {
+            return;
+        }
+        let backdrop = cage
+            .and_then(|cage| pipeline::backdrop_of(&doc.image, cage).ok().flatten())
+            .map_or_else(|| doc.image.clone(), Arc::new);
+        let version = self.bump();
+        self.frame.backdrop = Some(Versioned {
+            version,
+            value: backdrop,
+        });
+        self.seen.backdrop = Some((doc.image.clone(), rest));
+    }
+
+    /// The node transforms, and the positions a method solves for.
+    fn update_pose(&mut self, doc: &Document, cage_view: bool, cage: Option<&dyn Deformer>) {
+        let (affines, positions) = match (cage_view, cage) {
+            (true, Some(cage)) => (transforms(cage), Vec::new()),
+            (true, None) => (Vec::new(), Vec::new()),
+            (false, _) => {
+                let positions = match doc.deformer().output() {
+                    Output::Skinned(_) => Vec::new(),
+                    Output::Positions(p) => p.iter().map(|p| p.as_vec2()).collect(),
+                };
+                (doc.rig().node_affines(), positions)
+            }
+        };
+        let version = self.bump();
+        self.frame.pose = Versioned {
+            version,
+            value: Arc::new(affines),
+        };
+        let version = self.bump();
+        self.frame.positions = Versioned {
+            version,
+            value: Arc::new(positions),
+        };
+    }
+
+    /// The heat map of the shown handle or cage vertex, the cells, the dual graph: each
+    /// when on and out of date.
+    fn update_overlays(&mut self, doc: &Document, view: &View) {
+        let weights = doc.weights_version;
+        let heat_key = view.shown.filter(|_| view.show.heat).map(|s| (s, weights));
+        if let Some((shown, _)) = heat_key
+            && heat_key != self.seen.heat
+        {
+            let values = if view.cage_view {
+                doc.cage_influence(shown).unwrap_or_default()
+            } else {
+                doc.influence(shown)
+            };
+            let version = self.bump();
+            self.frame.heat = Versioned {
+                version,
+                value: Arc::new(values),
+            };
+            self.seen.heat = heat_key;
+        }
+        if view.show.cells && !view.cage_view && self.seen.cells != weights {
+            let rig = doc.rig();
+            // A sample that no node reaches (a rig without nodes, or a piece of the
+            // shape without a handle) has no cell: grey.
+            let colors = rig
+                .cells()
+                .iter()
+                .map(|&k| {
+                    rig.nodes()
+                        .get(k as usize)
+                        .map_or(NO_CELL, |node| cell_color(node.vertex))
+                })
+                .collect();
+            let version = self.bump();
+            self.frame.cells = Versioned {
+                version,
+                value: Arc::new(colors),
+            };
+            self.seen.cells = weights;
+        }
+        // Keyed by the GPU mesh's version, which no other document shares.
+        let mesh_version = self.frame.mesh.version;
+        if view.show.dual_graph && !view.cage_view && self.dual_graph.0 != mesh_version {
+            self.dual_graph = (mesh_version, Arc::new(doc.rig().dual_graph()));
+        }
+    }
+
+    /// The frame's part of the editor's invariants: a mesh built for the document's
+    /// current weights has one vertex per vertex of what it shows, and the cage's
+    /// view has the picture under it.
+    pub fn sanity_check(&self, doc: &Document) -> Result<()> {
+        if self.seen.weights != doc.weights_version || self.frame.mesh.version == 0 {
+            return Ok(());
+        }
+        let mesh = &self.frame.mesh.value;
+        let (samples, what) = if !self.seen.cage_view {
+            (doc.rig().domain().len(), "the rig")
+        } else if self.seen.warping {
+            let solved = doc.cage_deformer().map(|c| c.rest().len());
+            (solved.unwrap_or(0), "the cage's mesh")
+        } else {
+            (0, "no mesh (a cage being drawn)")
+        };
+        if mesh.rest.len() != samples || mesh.rows.len() != samples + 1 {
+            bail!(
+                "the GPU mesh has {} vertices, {what} {samples}",
+                mesh.rest.len()
+            );
+        }
+        if self.seen.cage_view && self.frame.backdrop.is_none() {
+            bail!("the cage's view without the picture at rest under it");
+        }
+        Ok(())
+    }
+}
+
+/// `deformer`'s rest mesh skinned by its own table, with `triangles` in drawing order.
+fn skinned_mesh(
+    deformer: &dyn Deformer,
+    triangles: Vec<[u32; 3]>,
+    source_size: [u32; 2],
+) -> MeshData {
+    let table = match deformer.output() {
+        Output::Skinned(skin) => skin.table(),
+        // A method that solves for positions draws the rest mesh, moved per vertex.
+        Output::Positions(_) => pipeline::SkinTable {
+            rows: vec![0; deformer.rest().len() + 1],
+            nodes: Vec::new(),
+            weights: Vec::new(),
+        },
+    };
+    MeshData {
+        rest: deformer.rest().iter().map(|p| p.as_vec2()).collect(),
+        rows: table.rows,
+        nodes: table.nodes,
+        weights: table.weights,
+        triangles,
+        source_size,
+    }
+}
+
+/// The node transforms of a skinned method (none for one that solves positions).
+fn transforms(deformer: &dyn Deformer) -> Vec<render::Affine> {
+    match deformer.output() {
+        Output::Skinned(skin) => skin.transforms(),
+        Output::Positions(_) => Vec::new(),
+    }
+}
+
+/// The colour of samples in no node's cell.
+const NO_CELL: [u8; 4] = [128, 128, 128, 255];
+
+/// A stable, well-spread colour for a node (keyed by its sample, so it survives
+/// renumbering).
+pub(crate) fn cell_color(key: u32) -> [u8; 4] {
+    let hue = (key.wrapping_mul(2_654_435_761) >> 8) as f32 / (1u32 << 24) as f32;
+    let rgb = egui::ecolor::Hsva::new(hue, 0.75, 0.95, 1.0).to_srgb();
+    [rgb[0], rgb[1], rgb[2], 255]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cell_colours_are_opaque_and_differ() {
+        let colors: Vec<[u8; 4]> = (0..64).map(cell_color).collect();
+        assert!(colors.iter().all(|c| c[3] == 255));
+        for (i, a) in colors.iter().enumerate() {
+            for b in &colors[i + 1..] {
+                assert_ne!(a, b);
+            }
+        }
+    }
+}
