@@ -8,6 +8,7 @@ use anyhow::{Context as _, Result};
 use glam::DVec2;
 use project::{HandleSpec, Method};
 
+use crate::brush::Brush;
 use crate::dialogs::{Answer, BuiltinDialog, Dialogs, FileAction, NativeDialogs, Shown};
 use crate::document::{CageKey, Document, Edit, posed};
 use crate::gpu_frame::{FrameBuilder, View};
@@ -15,6 +16,7 @@ use crate::history::History;
 use crate::jobs::{CancelFlag, Job, Outcome, Rebuild, SolveProgress};
 use crate::scene::SceneResources;
 use crate::show::Show;
+use crate::tool::{CanvasTool, Host};
 use crate::viewport::Viewport;
 
 /// What a primary click or drag on the canvas does.
@@ -132,10 +134,8 @@ pub struct EditorApp {
     /// Use the built-in file dialog (the desktop has none, or the user prefers it).
     pub builtin_dialogs: bool,
     pub(crate) file_dialog: Option<BuiltinDialog>,
-    /// The rigidity brush's radius and weight.
-    pub brush: crate::brush::Brush,
-    pub(crate) brush_stroke: Option<crate::brush::BrushStroke>,
-    pub(crate) painted: crate::brush::PaintedCache,
+    /// The rigidity brush: its radius and weight, the stroke under way.
+    pub brush: Brush,
     /// The cage tool's state.
     pub(crate) cage: crate::cage::CageTool,
     /// Mesh vertices inside a new cage, unless the project names a count (the side
@@ -227,9 +227,7 @@ impl EditorApp {
             large_mesh: 100_000,
             builtin_dialogs: false,
             file_dialog: None,
-            brush: crate::brush::Brush::default(),
-            brush_stroke: None,
-            painted: crate::brush::PaintedCache::default(),
+            brush: Brush::default(),
             cage: crate::cage::CageTool::default(),
             cage_vertices: pipeline::cage::DEFAULT_CAGE_VERTICES,
             default_folder: None,
@@ -576,7 +574,7 @@ impl EditorApp {
             self.finish_drag();
             self.tool = Tool::Cage;
             self.bar_start = None;
-            self.brush_stroke = None;
+            self.brush.cancel();
         }
     }
 
@@ -1309,6 +1307,52 @@ impl EditorApp {
         if let Some(doc) = &self.doc {
             self.gpu.update(doc, &view);
         }
+    }
+}
+
+impl Host for EditorApp {
+    fn document(&self) -> Option<&Document> {
+        self.doc.as_ref()
+    }
+
+    fn document_mut(&mut self) -> Option<&mut Document> {
+        self.doc.as_mut()
+    }
+
+    fn viewport(&self) -> &Viewport {
+        &self.viewport
+    }
+
+    fn shows(&self) -> Show {
+        self.show
+    }
+
+    fn edit(&mut self, edit: Edit) -> bool {
+        EditorApp::edit(self, edit)
+    }
+
+    fn info(&mut self, text: &str) {
+        EditorApp::info(self, text);
+    }
+
+    fn mesh_version(&self) -> u64 {
+        self.gpu.frame.mesh.version
+    }
+}
+
+impl EditorApp {
+    /// Runs `f` on the rigidity brush with the app as its host (the brush is lent out
+    /// for the call, so it and the host can both be changed).
+    pub(crate) fn with_brush<R>(&mut self, f: impl FnOnce(&mut Brush, &mut dyn Host) -> R) -> R {
+        let mut brush = std::mem::take(&mut self.brush);
+        let out = f(&mut brush, self);
+        self.brush = brush;
+        out
+    }
+
+    /// The triangles the painted-rigidity overlay drew last (their corners).
+    pub fn painted_triangles(&self) -> Vec<[u32; 3]> {
+        self.brush.painted_triangles()
     }
 }
 

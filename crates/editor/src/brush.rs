@@ -5,21 +5,24 @@
 
 use std::sync::Arc;
 
-use egui::{Color32, Mesh, PointerButton, Pos2, Shape, Ui};
+use egui::{Color32, Mesh, PointerButton, Pos2, Response, Shape, Ui};
 use glam::DVec2;
 use pipeline::arap::polyline_distance_squared;
 use project::{Method, RigidityStroke};
 
-use crate::app::EditorApp;
 use crate::document::Edit;
+use crate::tool::{CanvasTool, Host};
 
-/// The brush's settings.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// The rigidity brush: its settings, the stroke under way, and the painted triangles
+/// it last drew.
+#[derive(Clone)]
 pub struct Brush {
     /// Radius in picture pixels.
     pub radius: f64,
     /// The weight painted (the paper paints 10000; 1 is unpainted).
     pub weight: f64,
+    stroke: Option<BrushStroke>,
+    painted: PaintedCache,
 }
 
 impl Default for Brush {
@@ -27,13 +30,15 @@ impl Default for Brush {
         Self {
             radius: 20.0,
             weight: 10_000.0,
+            stroke: None,
+            painted: PaintedCache::default(),
         }
     }
 }
 
 /// A stroke being painted (or erased), in rest pixels.
 #[derive(Clone, Debug, Default)]
-pub(crate) struct BrushStroke {
+struct BrushStroke {
     erase: bool,
     /// The stroke in rest pixels, as it is stored.
     points: Vec<[f64; 2]>,
@@ -44,7 +49,7 @@ pub(crate) struct BrushStroke {
 /// The painted triangles, by the (GPU mesh version, strokes) they were found for: the
 /// GPU mesh's version is new for every mesh of every document.
 #[derive(Clone, Default)]
-pub(crate) struct PaintedCache {
+struct PaintedCache {
     key: Option<(u64, Vec<RigidityStroke>)>,
     /// Each painted triangle's corners with its weight.
     triangles: Arc<Vec<([u32; 3], f64)>>,
@@ -83,10 +88,10 @@ pub fn erase(strokes: &[RigidityStroke], eraser: &[[f64; 2]], radius: f64) -> Ve
     out
 }
 
-impl EditorApp {
+impl CanvasTool for Brush {
     /// Paints or erases (with Alt) while the primary button is down on the canvas, and
     /// commits the stroke when it is released. Space or the middle button still pan.
-    pub(crate) fn brush_input(&mut self, ui: &Ui, response: &egui::Response) {
+    fn input(&mut self, host: &mut dyn Host, ui: &Ui, response: &Response) {
         let (pressed, down, released, latest, alt, space) = ui.input(|i| {
             (
                 i.pointer.primary_pressed(),
@@ -102,31 +107,79 @@ impl EditorApp {
             && response.contains_pointer()
             && !response.drag_started_by(PointerButton::Middle)
         {
-            self.brush_stroke = Some(BrushStroke {
+            self.stroke = Some(BrushStroke {
                 erase: alt,
                 ..BrushStroke::default()
             });
         }
         if (down || released)
-            && let (Some(pos), Some(_)) = (latest, &self.brush_stroke)
+            && let (Some(pos), Some(_)) = (latest, &self.stroke)
         {
-            self.brush_point(pos);
+            self.add_point(host, pos);
         }
-        if released && let Some(stroke) = self.brush_stroke.take() {
-            self.commit_stroke(stroke);
+        if released && let Some(stroke) = self.stroke.take() {
+            self.commit(host, stroke);
         }
     }
 
+    /// The painted triangles (when that overlay is on), translucent, where the pose
+    /// puts them, with the stroke under way; while the brush is in use, its outline
+    /// around the pointer.
+    fn paint(
+        &mut self,
+        host: &mut dyn Host,
+        painter: &egui::Painter,
+        pointer: Option<Pos2>,
+        active: bool,
+    ) {
+        if host.shows().rigidity {
+            self.paint_rigidity(host, painter);
+        }
+        if active && let Some(p) = pointer {
+            let erase = painter.ctx().input(|i| i.modifiers.alt);
+            self.paint_outline(host, painter, p, erase);
+        }
+    }
+
+    fn panel(&mut self, host: &mut dyn Host, ui: &mut Ui) {
+        ui.add(
+            egui::Slider::new(&mut self.radius, 1.0..=200.0)
+                .logarithmic(true)
+                .text("Brush radius (px)"),
+        );
+        ui.add(
+            egui::Slider::new(&mut self.weight, 2.0..=100_000.0)
+                .logarithmic(true)
+                .text("Stiffness"),
+        )
+        .on_hover_text("The paper paints 10000; unpainted triangles have 1");
+        if host
+            .document()
+            .is_some_and(|doc| !doc.project().rigidity.is_empty())
+            && ui.button("Clear rigidity").clicked()
+        {
+            let _ = host.edit(Edit::Rigidity(Vec::new()));
+        }
+    }
+
+    fn cancel(&mut self) {
+        self.stroke = None;
+    }
+}
+
+impl Brush {
     /// Adds the rest point under screen point `pos` to the stroke, at most every
     /// quarter radius.
-    fn brush_point(&mut self, pos: Pos2) {
-        let at = self.viewport.to_image(pos);
-        let Some(doc) = self.doc.as_mut() else { return };
+    fn add_point(&mut self, host: &mut dyn Host, pos: Pos2) {
+        let at = host.viewport().to_image(pos);
+        let Some(doc) = host.document_mut() else {
+            return;
+        };
         let Some((rest, _, _)) = doc.unwarp(at) else {
             return;
         };
-        let spacing = self.brush.radius * 0.25;
-        let Some(stroke) = &mut self.brush_stroke else {
+        let spacing = self.radius * 0.25;
+        let Some(stroke) = &mut self.stroke else {
             return;
         };
         if stroke
@@ -139,20 +192,20 @@ impl EditorApp {
         }
     }
 
-    fn commit_stroke(&mut self, stroke: BrushStroke) {
-        let Some(doc) = &self.doc else { return };
+    fn commit(&mut self, host: &mut dyn Host, stroke: BrushStroke) {
+        let Some(doc) = host.document() else { return };
         if stroke.points.is_empty() {
             return;
         }
         let current = doc.project().rigidity.clone();
         let strokes = if stroke.erase {
-            erase(&current, &stroke.points, self.brush.radius)
+            erase(&current, &stroke.points, self.radius)
         } else {
             let mut strokes = current.clone();
             strokes.push(RigidityStroke {
                 stroke: stroke.points,
-                radius: self.brush.radius,
-                weight: self.brush.weight,
+                radius: self.radius,
+                weight: self.weight,
             });
             strokes
         };
@@ -160,15 +213,15 @@ impl EditorApp {
             return;
         }
         let method = doc.method();
-        if self.edit(Edit::Rigidity(strokes)) && method != Method::Arap {
-            self.info("rigidity is painted for ARAP: choose ARAP under Method to see its effect");
+        if host.edit(Edit::Rigidity(strokes)) && method != Method::Arap {
+            host.info("rigidity is painted for ARAP: choose ARAP under Method to see its effect");
         }
     }
 
-    /// The brush's outline around the pointer while the rigidity tool hovers the
-    /// canvas: white, light blue for the eraser (Alt), over a dark line.
-    pub(crate) fn paint_brush_outline(&self, painter: &egui::Painter, pointer: Pos2, erase: bool) {
-        let radius = self.brush.radius as f32 * self.viewport.zoom;
+    /// The brush's outline around the pointer: white, light blue for the eraser (Alt),
+    /// over a dark line.
+    fn paint_outline(&self, host: &dyn Host, painter: &egui::Painter, pointer: Pos2, erase: bool) {
+        let radius = self.radius as f32 * host.viewport().zoom;
         painter.circle_stroke(pointer, radius, egui::Stroke::new(3.0, Color32::BLACK));
         let light = if erase {
             Color32::from_rgb(120, 200, 255)
@@ -185,13 +238,16 @@ impl EditorApp {
 
     /// Draws the painted triangles, translucent, where the pose puts them (and the
     /// stroke being painted).
-    pub(crate) fn paint_rigidity(&mut self, painter: &egui::Painter) {
-        let Some(doc) = self.doc.as_mut() else { return };
+    fn paint_rigidity(&mut self, host: &mut dyn Host, painter: &egui::Painter) {
+        let mesh = host.mesh_version();
+        let viewport = *host.viewport();
+        let Some(doc) = host.document_mut() else {
+            return;
+        };
         let strokes = &doc.project().rigidity;
-        if strokes.is_empty() && self.brush_stroke.is_none() {
+        if strokes.is_empty() && self.stroke.is_none() {
             return;
         }
-        let mesh = self.gpu.frame.mesh.version;
         let fresh = self
             .painted
             .key
@@ -248,7 +304,7 @@ impl EditorApp {
             };
             let base = mesh.vertices.len() as u32;
             for &&p in &corners {
-                mesh.colored_vertex(self.viewport.to_screen(p), color);
+                mesh.colored_vertex(viewport.to_screen(p), color);
             }
             mesh.add_triangle(base, base + 1, base + 2);
         }
@@ -261,21 +317,21 @@ impl EditorApp {
             for &[a, b] in outline.iter() {
                 if let (Some(&p), Some(&q)) = (deformed.get(a as usize), deformed.get(b as usize)) {
                     painter.line_segment(
-                        [self.viewport.to_screen(p), self.viewport.to_screen(q)],
+                        [viewport.to_screen(p), viewport.to_screen(q)],
                         egui::Stroke::new(width, color),
                     );
                 }
             }
         }
-        if let Some(stroke) = &self.brush_stroke {
+        if let Some(stroke) = &self.stroke {
             let color = if stroke.erase {
                 Color32::from_white_alpha(90)
             } else {
                 Color32::from_rgba_unmultiplied(255, 140, 0, 90)
             };
-            let radius = self.brush.radius as f32 * self.viewport.zoom;
+            let radius = self.radius as f32 * viewport.zoom;
             for &p in &stroke.posed {
-                painter.circle_filled(self.viewport.to_screen(p), radius, color);
+                painter.circle_filled(viewport.to_screen(p), radius, color);
             }
         }
     }

@@ -11,6 +11,7 @@ use weights_core::NodeKind;
 use crate::app::{EditorApp, Grip, HandleDrag, Tool};
 use crate::document::posed;
 use crate::scene::MeshCallback;
+use crate::tool::CanvasTool;
 
 /// Radius of a point handle's dot, screen points.
 const DOT: f32 = 6.0;
@@ -124,15 +125,10 @@ impl EditorApp {
             let pointer = ui.input(|i| i.pointer.latest_pos());
             self.paint_cage(&painter, pointer);
         } else {
-            if self.show.rigidity {
-                self.paint_rigidity(&painter);
-            }
             let (pointer, alt) = ui.input(|i| (i.pointer.latest_pos(), i.modifiers.alt));
-            if self.tool == Tool::Rigidity
-                && let Some(p) = pointer.filter(|p| rect.contains(*p))
-            {
-                self.paint_brush_outline(&painter, p, alt);
-            }
+            let brushing = self.tool == Tool::Rigidity;
+            let hover = pointer.filter(|p| rect.contains(*p));
+            self.with_brush(|brush, host| brush.paint(host, &painter, hover, brushing));
             // Alt over a point handle shows the ring a drag turns it by.
             let turning = match &self.drag {
                 Some(drag) if drag.grip == Grip::Rotate => Some(drag.index),
@@ -278,7 +274,7 @@ impl EditorApp {
             self.bar_input(ui, response);
         }
         if self.tool == Tool::Rigidity {
-            self.brush_input(ui, response);
+            self.with_brush(|brush, host| brush.input(host, ui, response));
         }
         if self.tool == Tool::Cage {
             self.cage_input(ui, response);

@@ -20,6 +20,7 @@ mod jobs;
 mod panels;
 mod scene;
 mod show;
+mod tool;
 mod viewport;
 
 use std::path::PathBuf;

@@ -10,6 +10,7 @@ use project::{Method, MetricChoice, Middle, Placement};
 use crate::app::{EditorApp, Pending, Tool};
 use crate::dialogs::FileAction;
 use crate::document::Edit;
+use crate::tool::CanvasTool;
 
 /// Every shortcut, as the help window lists them.
 pub const SHORTCUTS: &[(&str, &str)] = &[
@@ -273,7 +274,7 @@ impl EditorApp {
         if pressed(none, Key::Escape) {
             self.selected = None;
             self.bar_start = None;
-            self.brush_stroke = None;
+            self.brush.cancel();
             self.pending = None;
         }
     }
@@ -488,23 +489,7 @@ impl EditorApp {
             }
         });
         if self.tool == Tool::Rigidity {
-            ui.add(
-                egui::Slider::new(&mut self.brush.radius, 1.0..=200.0)
-                    .logarithmic(true)
-                    .text("Brush radius (px)"),
-            );
-            ui.add(
-                egui::Slider::new(&mut self.brush.weight, 2.0..=100_000.0)
-                    .logarithmic(true)
-                    .text("Stiffness"),
-            )
-            .on_hover_text("The paper paints 10000; unpainted triangles have 1");
-            if let Some(doc) = &self.doc
-                && !doc.project().rigidity.is_empty()
-                && ui.button("Clear rigidity").clicked()
-            {
-                let _ = self.edit(Edit::Rigidity(Vec::new()));
-            }
+            self.with_brush(|brush, host| brush.panel(host, ui));
         }
         ui.checkbox(&mut self.auto_rotate, "Auto-rotate points")
             .on_hover_text("Point handles turn with their neighbours' motion");

@@ -89,7 +89,13 @@ fn solved_body(dir: &std::path::Path) -> Harness<'static, EditorApp> {
 fn solve_with_enter(h: &mut Harness<'_, EditorApp>) {
     h.key_press(Key::Enter);
     h.step();
-    assert!(h.state().is_busy(), "the solve runs on the worker");
+    // The solve runs on the worker; a small one may be done by the end of the frame
+    // that started it, so only a frame that neither waits nor has it done is wrong.
+    assert!(
+        h.state().is_busy() || h.state().cage_state() == CageState::Posed,
+        "Enter solves the cage: {:?}",
+        h.state().message
+    );
     settle(h);
     assert_eq!(
         h.state().cage_state(),
