@@ -1,0 +1,171 @@
+//! The document's invariants, and the check that its saved rig file gives back what
+//! it shows (the editor's tests and the monkey run both).
+
+use std::sync::Arc;
+
+use anyhow::{Context, Result, bail};
+use pipeline::{Controls, Deformer, Follow};
+use project::Project;
+
+use super::Document;
+
+impl Document {
+    /// Checks the document's invariants: the rig file is valid for the picture, the
+    /// rig has exactly its handles, nodes sit on samples, weights are non-negative and
+    /// sum to one wherever a node reaches, and the pose deforms every sample to a
+    /// finite point. Used by tests after every step of a session.
+    ///
+    /// # Errors
+    /// The first broken invariant, in words.
+    pub fn sanity_check(&self) -> Result<()> {
+        let (width, height) = self.image.dimensions();
+        self.project
+            .validate(Some((width, height)))
+            .context("the rig file")?;
+        if !self.project.virtual_handles.is_empty() {
+            bail!("virtual handles belong to the rig while editing, not to the rig file");
+        }
+        let expected = pipeline::handles(&self.project);
+        if self.rig.handles() != expected.as_slice() {
+            bail!(
+                "the rig's {} handles are not the rig file's {}",
+                self.rig.handles().len(),
+                expected.len()
+            );
+        }
+        let samples = self.rig.domain().len();
+        let nodes = self.rig.nodes();
+        if let Some(node) = nodes.iter().find(|n| n.vertex as usize >= samples) {
+            bail!("a node sits on sample {} of {samples}", node.vertex);
+        }
+        // Every sample on small pictures; a spread of them on large ones.
+        let stride = (samples / 4000).max(1);
+        for v in (0..samples).step_by(stride) {
+            let mut sum = 0.0;
+            let mut any = false;
+            for (k, w) in self.rig.weights(v) {
+                if k >= nodes.len() || !w.is_finite() || w < 0.0 {
+                    bail!("sample {v} has weight {w} on node {k} of {}", nodes.len());
+                }
+                sum += w;
+                any = true;
+            }
+            if any && (sum - 1.0).abs() > 1e-9 {
+                bail!("the weights of sample {v} sum to {sum}");
+            }
+        }
+        if let Some(v) = self.rig.deform().iter().position(|p| !p.is_finite()) {
+            bail!("sample {v} deforms to a non-finite point");
+        }
+        self.method_sanity_check()?;
+        if self.weights_version == 0 || self.pose_version == 0 {
+            bail!("versions start at 1");
+        }
+        self.cage_sanity_check()
+    }
+
+    /// The method's deformer is in step with the rig file: set up on this mesh for the
+    /// method chosen, and following the rig file again changes nothing.
+    fn method_sanity_check(&self) -> Result<()> {
+        let method = self.project.method;
+        let Some((mesh, deformer)) = &self.method else {
+            // The rig is the deformer (C²), or the cage is not solved yet.
+            let ok = match method.controls() {
+                Controls::Handles => Deformer::method(&self.rig) == method,
+                Controls::Cage => self.cage_solution().is_none(),
+            };
+            if !ok {
+                bail!("method {} has no deformer", method.name());
+            }
+            return Ok(());
+        };
+        if deformer.method() != method {
+            bail!(
+                "method {} with a deformer of {}",
+                method.name(),
+                deformer.method().name()
+            );
+        }
+        match method.controls() {
+            Controls::Handles => {
+                if *mesh != self.mesh_version || deformer.rest() != self.rig.domain().positions() {
+                    bail!("the {} deformer was set up on another mesh", method.name());
+                }
+            }
+            Controls::Cage => {
+                let solved = self.cage_solution();
+                if self
+                    .cage_deformer()
+                    .is_none_or(|cage| solved.is_none_or(|s| !Arc::ptr_eq(cage.solution(), s)))
+                {
+                    bail!("the cage deformer is not the rig file's solved cage");
+                }
+            }
+        }
+        let deformed = deformer.deformed();
+        if let Some(v) = deformed.iter().position(|p| !p.is_finite()) {
+            bail!("{} sends sample {v} to a non-finite point", method.label());
+        }
+        let mut again = deformer.clone_box();
+        if again.follow(&self.project)? != Follow::Followed || again.deformed() != deformed {
+            bail!(
+                "the {} deformer is out of step with the rig file",
+                method.label()
+            );
+        }
+        Ok(())
+    }
+
+    /// Checks that the rig file this document saves gives back what the document
+    /// shows: reopened (through the JSON text, as a file would be), it builds the same
+    /// mesh, handles, virtual handles and weights bit for bit, and the method puts every
+    /// vertex in the same place. This is what an export, a reopened project and `c2warp
+    /// render` of the saved file draw, so they are the picture on screen. Used by tests
+    /// (the monkey runs it at random points of its walks).
+    ///
+    /// # Errors
+    /// The first difference, in words.
+    pub fn check_reopens(&self) -> Result<()> {
+        let text = self.project_for_saving(None).to_json();
+        let saved = Project::from_json(&text).context("the saved rig file does not load")?;
+        let mut fresh = Document::with_image(self.image.clone(), self.image_path.clone(), saved)
+            .context("the saved rig file does not build")?;
+        // Solved cages are not saved (`c2warp render` solves again, to the same
+        // coordinates): the reopened document finds this one's for its cage, if the
+        // saved cage, τ and density are the same.
+        fresh.keep_solutions_of(self)?;
+        let (a, b) = (self.rig.domain(), fresh.rig.domain());
+        if a.positions() != b.positions() || a.triangles() != b.triangles() {
+            bail!(
+                "reopened, the picture meshes to {} vertices and {} triangles, not {} and {}",
+                b.len(),
+                b.triangles().len(),
+                a.len(),
+                a.triangles().len()
+            );
+        }
+        if self.rig.handles() != fresh.rig.handles() {
+            bail!("reopened, the rig has other handles");
+        }
+        if self.rig.virtual_vertices() != fresh.rig.virtual_vertices() {
+            bail!(
+                "reopened, the rig has {} virtual handles, not {}",
+                fresh.rig.virtual_vertices().len(),
+                self.rig.virtual_vertices().len()
+            );
+        }
+        self.rig
+            .same_weights_as(&fresh.rig)
+            .map_err(|e| anyhow::anyhow!("reopened, the weights differ: {e}"))?;
+        if self.deformer().deformed() != fresh.deformer().deformed() {
+            bail!(
+                "reopened, {} puts the vertices elsewhere",
+                self.project.method.label()
+            );
+        }
+        if self.draw_order() != fresh.draw_order() {
+            bail!("reopened, the triangles are drawn in another order");
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,411 @@
+use super::*;
+
+fn point(x: f64, y: f64) -> HandleSpec {
+    HandleSpec::Point {
+        rest: [x, y],
+        translate: [0.0; 2],
+        rotate: 0.0,
+        scale: 1.0,
+        depth: 0,
+    }
+}
+
+fn document() -> Document {
+    let image = RgbaImage::from_pixel(64, 48, image::Rgba([200, 100, 50, 255]));
+    let project = Project {
+        density: Some(2000),
+        handles: vec![point(10.0, 10.0), point(50.0, 30.0)],
+        ..Project::default()
+    };
+    Document::new(image, None, project).expect("a simple document")
+}
+
+#[test]
+fn a_rejected_edit_changes_nothing() {
+    let mut doc = document();
+    let before = doc.project().clone();
+    let version = doc.weights_version;
+    assert!(
+        doc.apply(Edit::Add(point(10.0, 10.0))).is_err(),
+        "coincident"
+    );
+    assert!(doc.apply(Edit::Add(point(f64::NAN, 3.0))).is_err(), "NaN");
+    assert!(
+        doc.apply(Edit::Add(point(500.0, 3.0))).is_err(),
+        "off the picture"
+    );
+    assert!(doc.apply(Edit::Remove(7)).is_err());
+    assert!(
+        doc.apply(Edit::Pose(0, point(11.0, 10.0))).is_err(),
+        "moves rest"
+    );
+    let bar = HandleSpec::Bar {
+        rest: [[20.0, 20.0], [20.0, 20.0]],
+        pose: None,
+        depth: 0,
+    };
+    assert!(doc.apply(Edit::Add(bar)).is_err(), "zero-length bar");
+    let close = doc.rig().domain().mean_edge_length();
+    assert!(
+        doc.apply(Edit::Add(point(10.0 + close, 10.0))).is_err(),
+        "too close"
+    );
+    assert_eq!(doc.project(), &before);
+    assert_eq!(doc.weights_version, version);
+    assert_eq!(doc.rig().handles().len(), 2);
+}
+
+/// Handle 0 of [`document`] posed.
+fn first_posed(translate: [f64; 2], rotate: f64, scale: f64) -> Edit {
+    Edit::Pose(
+        0,
+        HandleSpec::Point {
+            rest: [10.0, 10.0],
+            translate,
+            rotate,
+            scale,
+            depth: 0,
+        },
+    )
+}
+
+#[test]
+fn pose_edits_keep_weights_and_insertions_update_them() {
+    let mut doc = document();
+    let w = doc.weights_version;
+    doc.apply(first_posed([5.0, 0.0], 0.2, 1.1)).expect("pose");
+    assert_eq!(doc.weights_version, w, "a pose leaves the weights");
+    // The handle's node sits on the vertex nearest its rest position and goes where
+    // the handle's similarity about (10, 10) takes it.
+    let vertex = doc.rig().nodes()[0].vertex as usize;
+    let rest = doc.rig().domain().positions()[vertex];
+    let expected = weights_core::Similarity {
+        translation: DVec2::new(5.0, 0.0),
+        rotation: 0.2,
+        scale: 1.1,
+    }
+    .apply(DVec2::new(10.0, 10.0), rest);
+    let at = doc.node_position(0);
+    assert!((at - expected).length() < 1e-9, "{at} vs {expected}");
+    doc.apply(Edit::Add(point(30.0, 40.0))).expect("insert");
+    assert!(doc.weights_version > w);
+    assert_eq!(doc.rig().handles().len(), 3);
+    doc.apply(Edit::ResetPose).expect("reset");
+    let at = doc.node_position(0);
+    assert!((at - rest).length() < 1e-9);
+    doc.apply(Edit::Clear).expect("clear");
+    assert!(doc.project().handles.is_empty());
+    assert_eq!(
+        doc.rig().stats().virtual_nodes,
+        0,
+        "no virtual handles without handles"
+    );
+}
+
+#[test]
+fn a_handle_inserted_under_a_similarity_takes_it_and_nothing_moves() {
+    // Every handle moved by one similarity (a rigid motion for ARAP, which keeps
+    // sizes): the picture is that similarity, a new handle must start with it, and
+    // inserting it must move nothing.
+    for (method, scale) in [(Method::C2, 1.3), (Method::Arap, 1.0)] {
+        let mut doc = document();
+        doc.apply(Edit::Method(method)).expect("method");
+        let motion = weights_core::Similarity {
+            translation: DVec2::new(3.0, -2.0),
+            rotation: 0.4,
+            scale,
+        };
+        let centre = DVec2::new(30.0, 20.0);
+        for (i, rest) in [DVec2::new(10.0, 10.0), DVec2::new(50.0, 30.0)]
+            .into_iter()
+            .enumerate()
+        {
+            let at = motion.apply(centre, rest);
+            let pose = HandleSpec::Point {
+                rest: rest.to_array(),
+                translate: (at - rest).to_array(),
+                rotate: 0.4,
+                scale,
+                depth: 0,
+            };
+            doc.apply(Edit::Pose(i, pose)).expect("pose");
+        }
+        let before = doc.deformed().to_vec();
+        let rest = DVec2::new(30.0, 38.0);
+        let at = motion.apply(centre, rest);
+        let (rotate, scale_found) = doc.local_pose(rest, at);
+        assert!((rotate - 0.4).abs() < 1e-9, "{method:?}: {rotate}");
+        assert!(
+            (scale_found - scale).abs() < 1e-9,
+            "{method:?}: {scale_found}"
+        );
+        let new = HandleSpec::Point {
+            rest: rest.to_array(),
+            translate: (at - rest).to_array(),
+            rotate,
+            scale: scale_found,
+            depth: 0,
+        };
+        doc.apply(Edit::Add(new)).expect("insert");
+        let jump = before
+            .iter()
+            .zip(doc.deformed())
+            .map(|(a, b)| a.distance(*b))
+            .fold(0.0, f64::max);
+        assert!(jump < 1e-6, "{method:?}: the picture jumped by {jump}");
+    }
+}
+
+#[test]
+fn a_new_handle_fits_the_pose_around_it_not_one_triangle() {
+    // A picture sheared around the new handle: the pose there is no similarity, and
+    // the fitted one is the least-squares similarity of the vertices within reach,
+    // which for a symmetric neighbourhood of a shear x' = x + k·y is a turn of
+    // atan(−k/2) and a scale of √(1 + k²/4).
+    let mut doc = document();
+    let k = 0.3;
+    doc.apply(Edit::Settings(Settings {
+        density: 8000,
+        ..doc.settings()
+    }))
+    .expect("finer");
+    let rest = DVec2::new(32.0, 24.0);
+    let reach = doc
+        .rig()
+        .nodes()
+        .iter()
+        .map(|n| doc.rig().domain().positions()[n.vertex as usize].distance(rest))
+        .fold(f64::INFINITY, f64::min);
+    // Shear the deformed picture directly (the cache the fit reads).
+    let shear: Vec<DVec2> = doc
+        .rig()
+        .domain()
+        .positions()
+        .iter()
+        .map(|p| DVec2::new(p.x + k * (p.y - rest.y), p.y))
+        .collect();
+    let version = (doc.pose_version, doc.weights_version);
+    doc.deformed = Some((version, shear));
+    let (rotate, scale) = doc.local_pose(rest, rest);
+    assert!(reach > 5.0, "{reach}");
+    assert!((rotate - (-k / 2.0).atan()).abs() < 0.02, "{rotate}");
+    assert!((scale - (1.0 + k * k / 4.0).sqrt()).abs() < 0.02, "{scale}");
+}
+
+#[test]
+fn unwarp_inverts_the_pose() {
+    let mut doc = document();
+    doc.apply(first_posed([4.0, 3.0], 0.0, 1.0)).expect("pose");
+    let rest = DVec2::new(20.0, 15.0);
+    let now = doc
+        .rig()
+        .deform_point(&doc.rig().deform(), rest)
+        .expect("inside");
+    let (back, _, scale) = doc.unwarp(now).expect("on the picture");
+    assert!((back - rest).length() < 1e-6, "{back} vs {rest}");
+    assert!((scale - 1.0).abs() < 0.2);
+    assert!(doc.unwarp(DVec2::new(-50.0, -50.0)).is_none());
+}
+
+#[test]
+fn settings_rebuild_and_influence_partitions_unity() {
+    let mut doc = document();
+    let mut settings = doc.settings();
+    settings.alpha = 0.5;
+    settings.metric = MetricChoice::Intrinsic;
+    doc.apply(Edit::Settings(settings)).expect("rebuild");
+    assert_eq!(doc.rig().options().alpha, 0.5);
+    settings.placement = Placement::Symmetric;
+    doc.apply(Edit::Settings(settings)).expect("rebuild");
+    assert_eq!(
+        doc.rig().options().placement,
+        weights_core::Placement::Symmetric
+    );
+    assert_eq!(doc.project().placement, Placement::Symmetric);
+    settings.density = 1000;
+    doc.apply(Edit::Settings(settings)).expect("re-mesh");
+    assert!(doc.rig().domain().len() < 1500);
+    let a = doc.influence(0);
+    let b = doc.influence(1);
+    for (x, y) in a.iter().zip(&b) {
+        assert!((x + y - 1.0).abs() < 1e-4, "{x} + {y}");
+    }
+}
+
+#[test]
+fn undo_to_a_snapshot_restores_the_virtual_handles() {
+    let mut doc = document();
+    let before = doc.snapshot();
+    let virtuals = doc.rig().virtual_vertices();
+    doc.apply(Edit::Add(point(14.0, 14.0)))
+        .expect("a close handle");
+    assert_ne!(
+        doc.rig().virtual_vertices(),
+        virtuals,
+        "virtual handles added"
+    );
+    doc.undo_to(before.clone()).expect("undo");
+    assert_eq!(doc.rig().virtual_vertices(), virtuals);
+    assert_eq!(doc.snapshot(), before);
+}
+
+/// Which handle placed each virtual handle survives an undo, a redo and a save, so
+/// removing that handle afterwards still takes its virtual handles along.
+#[test]
+fn removal_after_redo_or_reload_takes_the_virtual_handles_along() {
+    let mut doc = document();
+    let before = doc.rig().virtual_vertices();
+    let undo = doc.snapshot();
+    doc.apply(Edit::Add(point(14.0, 14.0)))
+        .expect("a close handle");
+    let redo = doc.snapshot();
+    assert!(
+        redo.virtual_placed_for.contains(&Some(2)),
+        "the new handle placed virtual handles: {:?}",
+        redo.virtual_placed_for
+    );
+    assert_eq!(redo.virtual_placed_for.len(), redo.virtual_handles.len());
+
+    doc.undo_to(undo).expect("undo");
+    doc.undo_to(redo.clone()).expect("redo");
+    assert_eq!(doc.snapshot(), redo, "redo restores the owners too");
+    let mut reloaded =
+        Document::new((*doc.image).clone(), None, doc.project_for_saving(None)).expect("reload");
+    for doc in [&mut doc, &mut reloaded] {
+        doc.apply(Edit::Remove(2)).expect("remove");
+        assert_eq!(
+            doc.rig().virtual_vertices(),
+            before,
+            "the removed handle's virtual handles go with it"
+        );
+    }
+}
+
+/// A rectangle on [`document`]'s picture.
+fn cage(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<[f64; 2]> {
+    vec![[x0, y0], [x1, y0], [x1, y1], [x0, y1]]
+}
+
+#[test]
+fn a_cage_is_solved_once_per_rest_cage_and_found_again_after_an_undo() {
+    let mut doc = document();
+    let rest = cage(8.0, 8.0, 56.0, 40.0);
+    doc.apply(Edit::Cage {
+        rest: rest.clone(),
+        vertices: 120,
+    })
+    .expect("a cage");
+    assert_eq!(doc.method(), Method::Lbc);
+    assert_eq!(doc.project().lbc.and_then(|l| l.density), Some(120));
+    assert!(doc.cage_solution().is_none(), "not solved until asked");
+    doc.solve_cage(&mut |_| true).expect("solved");
+    let solved = doc.cage_solution().expect("solved").clone();
+    doc.sanity_check().expect("consistent");
+
+    // A pose moves the cage's mesh and keeps the coordinates.
+    let (weights, pose_version) = (doc.weights_version, doc.pose_version);
+    let mut pose = rest.clone();
+    pose[2] = [60.0, 46.0];
+    doc.apply(Edit::CagePose(pose.clone())).expect("posed");
+    assert!(Arc::ptr_eq(doc.cage_solution().expect("kept"), &solved));
+    assert_eq!(doc.weights_version, weights);
+    assert!(doc.pose_version > pose_version);
+    let corner = solved.domain.cage_vertices()[2] as usize;
+    let moved = doc.cage_deformed().expect("solved")[corner];
+    assert!((moved - DVec2::new(60.0, 46.0)).length() < 1e-9, "{moved}");
+    let posed = doc.snapshot();
+
+    // Another rest cage needs a solve; the pose goes back to rest.
+    doc.apply(Edit::Cage {
+        rest: cage(4.0, 4.0, 30.0, 30.0),
+        vertices: 500,
+    })
+    .expect("another cage");
+    assert!(doc.cage_solution().is_none());
+    assert_eq!(doc.cage().and_then(|c| c.pose.clone()), None);
+    assert_eq!(
+        doc.project().lbc.and_then(|l| l.density),
+        Some(120),
+        "the project's count stays"
+    );
+    // Back to the solved cage: its coordinates are found, not solved again.
+    doc.undo_to(posed.clone()).expect("undo");
+    assert!(Arc::ptr_eq(doc.cage_solution().expect("found"), &solved));
+    assert_eq!(doc.snapshot(), posed);
+    doc.sanity_check().expect("consistent");
+}
+
+#[test]
+fn bad_cage_edits_change_nothing() {
+    let mut doc = document();
+    assert!(
+        doc.apply(Edit::Method(Method::Lbc)).is_err(),
+        "LBC needs a cage"
+    );
+    assert!(doc.apply(Edit::CagePose(cage(0.0, 0.0, 1.0, 1.0))).is_err());
+    let off = Edit::Cage {
+        rest: cage(8.0, 8.0, 90.0, 40.0),
+        vertices: 100,
+    };
+    assert!(doc.apply(off).is_err(), "off the picture");
+    let two = Edit::Cage {
+        rest: vec![[1.0, 1.0], [5.0, 5.0]],
+        vertices: 100,
+    };
+    assert!(doc.apply(two).is_err(), "two vertices");
+    assert!(doc.cage().is_none());
+    let rest = cage(8.0, 8.0, 56.0, 40.0);
+    doc.apply(Edit::Cage {
+        rest: rest.clone(),
+        vertices: 100,
+    })
+    .expect("a cage");
+    let before = doc.project().clone();
+    assert!(doc.apply(Edit::CagePose(vec![[1.0, 1.0]])).is_err());
+    assert!(
+        doc.apply(Edit::CagePose(vec![[f64::NAN, 1.0]; 4])).is_err(),
+        "NaN"
+    );
+    assert_eq!(doc.project(), &before);
+    // A crossing cage is kept (to be fixed) but cannot be solved.
+    let bow = vec![[8.0, 8.0], [56.0, 8.0], [8.0, 40.0], [56.0, 40.0]];
+    doc.apply(Edit::Cage {
+        rest: bow,
+        vertices: 100,
+    })
+    .expect("kept");
+    let err = doc.solve_cage(&mut |_| true).expect_err("crossing");
+    assert!(err.to_string().contains("intersect"), "{err}");
+    // Clearing the cage goes back to C².
+    doc.apply(Edit::ClearCage).expect("cleared");
+    assert_eq!(doc.method(), Method::C2);
+    assert!(doc.cage().is_none());
+    doc.sanity_check().expect("consistent");
+}
+
+#[test]
+fn segment_distances() {
+    let p = |x, y| DVec2::new(x, y);
+    assert_eq!(segment_distance([p(0.0, 0.0); 2], [p(3.0, 4.0); 2]), 5.0);
+    assert_eq!(
+        segment_distance([p(0.0, 1.0), p(4.0, 1.0)], [p(2.0, 3.0); 2]),
+        2.0
+    );
+    assert_eq!(
+        segment_distance([p(0.0, 0.0), p(2.0, 2.0)], [p(0.0, 2.0), p(2.0, 0.0)]),
+        0.0
+    );
+}
+
+#[test]
+fn saved_projects_name_the_picture_relative_to_the_file() {
+    let mut doc = document();
+    doc.image_path = Some(PathBuf::from("/tmp/pictures/cat.png"));
+    let saved = doc.project_for_saving(Some(Path::new("/tmp/pictures/cat.json")));
+    assert_eq!(saved.image.as_deref(), Some(Path::new("cat.png")));
+    let saved = doc.project_for_saving(Some(Path::new("/elsewhere/cat.json")));
+    assert_eq!(
+        saved.image.as_deref(),
+        Some(Path::new("/tmp/pictures/cat.png"))
+    );
+}
