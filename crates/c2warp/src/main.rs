@@ -168,7 +168,7 @@ enum Input {
         image: image::RgbaImage,
         density: Option<usize>,
     },
-    Mesh(mesh::Mesh),
+    Mesh(pipeline::Mesh),
 }
 
 impl Input {

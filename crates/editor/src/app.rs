@@ -1013,7 +1013,11 @@ impl EditorApp {
                     .doc
                     .as_ref()
                     .is_none_or(|old| old.settings().density != doc.settings().density);
-                let short = remeshed.then(|| mesh_shortfall(&doc)).flatten();
+                let short = remeshed
+                    .then(|| {
+                        pipeline::density_shortfall(doc.rig().domain(), doc.settings().density)
+                    })
+                    .flatten();
                 self.doc = Some(doc);
                 if self.selected.is_some_and(|s| s >= handles) {
                     self.selected = None;
@@ -1354,34 +1358,6 @@ impl EditorApp {
     pub fn painted_triangles(&self) -> Vec<[u32; 3]> {
         self.brush.painted_triangles()
     }
-}
-
-/// Why a new mesh has far fewer vertices than the density asked for, if it has: the
-/// mesh holds at most [`mesh::MAX_VERTICES_PER_PIXEL`] vertices a pixel of the shape.
-fn mesh_shortfall(doc: &Document) -> Option<String> {
-    let asked = doc.settings().density;
-    let domain = doc.rig().domain();
-    let got = domain.len();
-    if got as f64 >= 0.7 * asked as f64 {
-        return None;
-    }
-    let positions = domain.positions();
-    let area: f64 = domain
-        .triangles()
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|v| positions[v as usize]);
-            0.5 * (b - a).perp_dot(c - a).abs()
-        })
-        .sum();
-    // Only the cap explains it; otherwise the mesh is as close as meshes come.
-    (mesh::MAX_VERTICES_PER_PIXEL * area < asked as f64).then(|| {
-        format!(
-            " (asked for {asked}: the picture's visible shape, {area:.0} px², holds at most \
-             {} vertices a pixel)",
-            mesh::MAX_VERTICES_PER_PIXEL
-        )
-    })
 }
 
 /// A path's file name, for messages.

@@ -14,11 +14,12 @@ use std::path::Path;
 use anyhow::{Context, Result, anyhow, bail};
 use glam::{DVec2, Vec2};
 use image::RgbaImage;
-use mesh::{Constraints, DomainOptions, Mesh, MeshError, MeshOptions};
+use mesh::{Constraints, DomainOptions, MeshError, MeshOptions};
 use project::{Canvas, HandleSpec, MetricChoice, Middle, Project};
 use render::Picture;
 
 pub use arap::{ArapOptions, ArapRig, ArapTimes};
+pub use mesh::Mesh;
 pub use method::{
     Backdrop, Controls, Deformer, Follow, Listener, Method, Output, SkinTable, Skinning,
     SolveProgress, Source, WeightsListing, beside_rig, on_handles, setup,
@@ -675,6 +676,33 @@ pub fn warp_gpu(image: &RgbaImage, warper: &Warper) -> Result<RgbaImage> {
             }
             out
         }
+    })
+}
+
+/// Why a picture's mesh has far fewer vertices than the density `asked` for, if it
+/// has, as a clause for a message: the mesh holds at most
+/// [`mesh::MAX_VERTICES_PER_PIXEL`] vertices a pixel of the shape.
+pub fn density_shortfall(domain: &weights_core::Domain, asked: usize) -> Option<String> {
+    let got = domain.len();
+    if got as f64 >= 0.7 * asked as f64 {
+        return None;
+    }
+    let positions = domain.positions();
+    let area: f64 = domain
+        .triangles()
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|v| positions[v as usize]);
+            0.5 * (b - a).perp_dot(c - a).abs()
+        })
+        .sum();
+    // Only the cap explains it; otherwise the mesh is as close as meshes come.
+    (mesh::MAX_VERTICES_PER_PIXEL * area < asked as f64).then(|| {
+        format!(
+            " (asked for {asked}: the picture's visible shape, {area:.0} px², holds at most \
+             {} vertices a pixel)",
+            mesh::MAX_VERTICES_PER_PIXEL
+        )
     })
 }
 
