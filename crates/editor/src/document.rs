@@ -348,8 +348,9 @@ impl Document {
         if new != self.settings() {
             return true;
         }
-        if project.method == Method::Arap
-            && (self.project.method != Method::Arap || project.rigidity != self.project.rigidity)
+        let rigidity = project.method.reads_rigidity();
+        if rigidity
+            && (!self.project.method.reads_rigidity() || project.rigidity != self.project.rigidity)
         {
             return true;
         }
@@ -404,8 +405,13 @@ impl Document {
                 }
             }
             Edit::Settings(settings) => settings.write_to(&mut project),
-            Edit::Method(Method::Lbc) if project.cage.is_none() => {
-                bail!("LBC warps by a cage: draw one first with the cage tool (K)")
+            Edit::Method(method)
+                if method.controls() == Controls::Cage && project.cage.is_none() =>
+            {
+                bail!(
+                    "{} warps by a cage: draw one first with the cage tool (K)",
+                    method.name().to_uppercase()
+                )
             }
             Edit::Method(method) => project.method = method,
             Edit::Rigidity(strokes) => project.rigidity = strokes,
@@ -417,13 +423,15 @@ impl Document {
                     });
                 }
                 project.cage = Some(CageSpec { rest, pose: None });
-                project.method = Method::Lbc;
+                if project.method.controls() != Controls::Cage {
+                    project.method = Method::for_controls(Controls::Cage);
+                }
                 self.check_cage(&project)?;
             }
             Edit::ClearCage => {
                 project.cage = None;
-                if project.method == Method::Lbc {
-                    project.method = Method::C2;
+                if project.method.controls() == Controls::Cage {
+                    project.method = Method::for_controls(Controls::Handles);
                 }
             }
             Edit::CagePose(pose) => {

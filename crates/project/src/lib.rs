@@ -118,6 +118,26 @@ impl Method {
         }
     }
 
+    /// The method a rig switches to when it gets `controls` of that kind and has none
+    /// chosen for them: C² for handles, LBC for a cage.
+    pub fn for_controls(controls: Controls) -> Method {
+        match controls {
+            Controls::Handles => Method::C2,
+            Controls::Cage => Method::Lbc,
+        }
+    }
+
+    /// Whether the method reads the painted rigidity (`"rigidity"`): ARAP.
+    pub fn reads_rigidity(self) -> bool {
+        matches!(self, Method::Arap)
+    }
+
+    /// Whether the method weighs the picture by the C² rig's nodes, so the virtual
+    /// handles and their dual graph mean something for it: C² itself.
+    pub fn uses_virtual_handles(self) -> bool {
+        matches!(self, Method::C2)
+    }
+
     /// The names of every method, for messages: `c2, arap, mls, lbc`.
     pub fn names() -> String {
         Method::ALL.map(Method::name).join(", ")

@@ -7,7 +7,7 @@ use std::sync::Arc;
 use anyhow::{Context, Result, bail};
 use glam::DVec2;
 use pipeline::cage::{CageCoordinates, CageDeformer, CageMesh};
-use pipeline::{Follow, Method};
+use pipeline::{Controls, Follow, Method};
 use project::{CageSpec, LbcSettings, Project, Tau};
 
 use super::Document;
@@ -62,7 +62,7 @@ pub fn solve_cage(
     progress: &mut dyn FnMut(&lbc::Progress) -> bool,
 ) -> Result<Arc<CageCoordinates>> {
     let project = Project {
-        method: Method::Lbc,
+        method: Method::for_controls(Controls::Cage),
         cage: Some(CageSpec {
             rest: key.rest.clone(),
             pose: None,
@@ -247,8 +247,8 @@ impl Document {
     /// the current one's rows are coordinates, and the pose deforms its mesh to finite
     /// points.
     pub(super) fn cage_sanity_check(&self) -> Result<()> {
-        if self.project.method == Method::Lbc && self.project.cage.is_none() {
-            bail!("LBC without a cage");
+        if self.project.method.controls() == Controls::Cage && self.project.cage.is_none() {
+            bail!("{} without a cage", self.project.method.label());
         }
         if self.solutions.len() > SOLUTIONS_KEPT {
             bail!("{} solved cages kept", self.solutions.len());
