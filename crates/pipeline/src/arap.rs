@@ -537,28 +537,9 @@ impl Deformer for ArapRig {
         let pinned_vertices = self.pinned();
         let scale = self.picture.mean_edge_length() * 10.0;
         let mut sequence = Sequence::new();
-        let mut random = || sequence.next();
         let mut update = Vec::new();
         for _ in 0..poses.max(1) {
-            let posed: Vec<Handle> = handles
-                .iter()
-                .map(|h| match *h {
-                    Handle::Point {
-                        rest,
-                        mut transform,
-                    } => {
-                        transform.translation += DVec2::new(random(), random()) * scale;
-                        Handle::Point { rest, transform }
-                    }
-                    Handle::Bar { rest, pose } => {
-                        let d = DVec2::new(random(), random()) * scale;
-                        Handle::Bar {
-                            rest,
-                            pose: [pose[0] + d, pose[1] + d],
-                        }
-                    }
-                })
-                .collect();
+            let posed = sequence.jiggle(&handles, scale);
             self.set_handles(&posed)?;
             update.push(self.times.update_ms);
         }

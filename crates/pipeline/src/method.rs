@@ -308,4 +308,33 @@ impl Sequence {
     pub(crate) fn next(&mut self) -> f64 {
         (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64 - 0.5
     }
+
+    /// A random pose for benchmarks: every handle moved by its own random offset of up
+    /// to `scale / 2` per axis (a point's translation, a bar's two ends alike).
+    pub(crate) fn jiggle(
+        &mut self,
+        handles: &[weights_core::Handle],
+        scale: f64,
+    ) -> Vec<weights_core::Handle> {
+        use weights_core::Handle;
+        handles
+            .iter()
+            .map(|h| {
+                let d = DVec2::new(self.next(), self.next()) * scale;
+                match *h {
+                    Handle::Point {
+                        rest,
+                        mut transform,
+                    } => {
+                        transform.translation += d;
+                        Handle::Point { rest, transform }
+                    }
+                    Handle::Bar { rest, pose } => Handle::Bar {
+                        rest,
+                        pose: [pose[0] + d, pose[1] + d],
+                    },
+                }
+            })
+            .collect()
+    }
 }

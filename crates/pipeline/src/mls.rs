@@ -180,26 +180,7 @@ impl Deformer for MlsRig {
         let mut sequence = Sequence::new();
         let mut pose = Vec::new();
         for _ in 0..poses.max(1) {
-            let posed: Vec<Handle> = handles
-                .iter()
-                .map(|h| match *h {
-                    Handle::Point {
-                        rest,
-                        mut transform,
-                    } => {
-                        transform.translation +=
-                            DVec2::new(sequence.next(), sequence.next()) * scale;
-                        Handle::Point { rest, transform }
-                    }
-                    Handle::Bar { rest, pose } => {
-                        let d = DVec2::new(sequence.next(), sequence.next()) * scale;
-                        Handle::Bar {
-                            rest,
-                            pose: [pose[0] + d, pose[1] + d],
-                        }
-                    }
-                })
-                .collect();
+            let posed = sequence.jiggle(&handles, scale);
             self.set(&posed, self.options)?;
             pose.push(self.pose_ms);
         }
