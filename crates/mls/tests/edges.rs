@@ -219,7 +219,7 @@ fn bad_input_is_refused_with_its_reason() {
     }
     let options = MlsOptions::default();
     assert_eq!(
-        Mls::new(&[DVec2::ZERO, DVec2::NAN], &[point], &options).unwrap_err(),
+        Mls::new(&[DVec2::ZERO, DVec2::NAN], &[point], &options).expect_err("refused"),
         MlsError::NonFiniteVertex { vertex: 1 }
     );
     assert_eq!(
@@ -228,23 +228,23 @@ fn bad_input_is_refused_with_its_reason() {
             &[point, Control::Point(DVec2::new(f64::INFINITY, 0.0))],
             &options
         )
-        .unwrap_err(),
+        .expect_err("refused"),
         MlsError::NonFiniteControl { control: 1 }
     );
     let p = DVec2::new(10.0, 10.0);
     assert_eq!(
-        Mls::new(&v, &[point, Control::Bar([p, p])], &options).unwrap_err(),
+        Mls::new(&v, &[point, Control::Bar([p, p])], &options).expect_err("refused"),
         MlsError::ZeroLengthBar { control: 1 }
     );
 
     let mls = Mls::new(&v, &[point, Control::Bar([p, p + DVec2::X])], &options).expect("valid");
     let mut out = [DVec2::ZERO];
     assert_eq!(
-        mls.deform(&[point], &mut out).unwrap_err(),
+        mls.deform(&[point], &mut out).expect_err("refused"),
         MlsError::PoseLength { posed: 1, rest: 2 }
     );
     assert_eq!(
-        mls.deform(&[point, point], &mut out).unwrap_err(),
+        mls.deform(&[point, point], &mut out).expect_err("refused"),
         MlsError::PoseKind { control: 1 }
     );
     assert_eq!(
@@ -252,12 +252,12 @@ fn bad_input_is_refused_with_its_reason() {
             &[Control::Point(DVec2::NAN), Control::Bar([p, p])],
             &mut out
         )
-        .unwrap_err(),
+        .expect_err("refused"),
         MlsError::NonFinitePosed { control: 0 }
     );
     assert_eq!(
         mls.deform(&[point, Control::Bar([p, p])], &mut [])
-            .unwrap_err(),
+            .expect_err("refused"),
         MlsError::OutputLength {
             got: 0,
             vertices: 1
