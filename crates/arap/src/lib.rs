@@ -91,6 +91,7 @@ mod update;
 
 pub use compile::Compiled;
 pub use error::ArapError;
+pub use geometry::Similarity;
 pub use registration::Registration;
-pub use ring::{Similarity, ring_constraints, similarity_constraints};
+pub use ring::{ring_constraints, similarity_constraints};
 pub use update::Deformation;

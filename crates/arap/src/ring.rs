@@ -2,49 +2,11 @@
 //! a position, so a handle's rotation and scale are given to the method by pinning
 //! its neighbours too.
 
-use glam::{DMat2, DVec2};
+use geometry::Similarity;
+use glam::DVec2;
 
 use crate::error::ArapError;
 use crate::registration::Registration;
-
-/// A similarity about a centre `c`: a point `x` goes to
-/// `c + translation + scale · R(rotation) · (x − c)`. Rotation is in radians,
-/// counter-clockwise in a y-up frame (clockwise on screen in image coordinates).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Similarity {
-    /// Where the centre moves by.
-    pub translation: DVec2,
-    /// Rotation in radians.
-    pub rotation: f64,
-    /// Uniform scale (1 = none).
-    pub scale: f64,
-}
-
-impl Default for Similarity {
-    fn default() -> Self {
-        Self::IDENTITY
-    }
-}
-
-impl Similarity {
-    /// No motion.
-    pub const IDENTITY: Self = Self {
-        translation: DVec2::ZERO,
-        rotation: 0.0,
-        scale: 1.0,
-    };
-
-    /// Where `x` goes when this similarity is taken about `centre`.
-    #[inline]
-    pub fn apply(&self, centre: DVec2, x: DVec2) -> DVec2 {
-        centre + self.translation + DMat2::from_angle(self.rotation) * (x - centre) * self.scale
-    }
-
-    /// Whether every component is finite.
-    pub fn is_finite(&self) -> bool {
-        self.translation.is_finite() && self.rotation.is_finite() && self.scale.is_finite()
-    }
-}
 
 /// Constraints that give a point handle on `vertex` a rotation and scale: the vertex
 /// itself and its one-ring (every vertex sharing a kept triangle with it), each sent
@@ -119,6 +81,6 @@ pub fn similarity_constraints(
     let centre = rest[vertex as usize];
     Ok(std::iter::once(vertex)
         .chain(neighbours.iter().copied().filter(|&v| v != vertex))
-        .map(|v| (v, similarity.apply(centre, rest[v as usize])))
+        .map(|v| (v, similarity.apply_rotating_first(centre, rest[v as usize])))
         .collect())
 }

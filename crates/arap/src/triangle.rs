@@ -7,6 +7,7 @@
 //! commute and multiply like complex numbers (`R90² = −I`), which keeps the
 //! assembled matrices small.
 
+use geometry::orient;
 use glam::DVec2;
 
 /// `R90 · v` with the paper's `R90 = [[0, 1], [−1, 0]]`: a quarter turn, counter-
@@ -32,7 +33,7 @@ pub(crate) fn local_coordinates(vi: DVec2, vj: DVec2, vk: DVec2) -> DVec2 {
 pub(crate) fn is_degenerate(p: [DVec2; 3]) -> bool {
     let e = [p[1] - p[0], p[2] - p[1], p[0] - p[2]];
     let longest = e.iter().map(|e| e.length_squared()).fold(0.0_f64, f64::max);
-    let twice_area = e[0].perp_dot(-e[2]).abs();
+    let twice_area = orient(p[0], p[1], p[2]).abs();
     // Written so that a NaN counts as degenerate.
     let spans_area = twice_area > 1e-12 * longest;
     !spans_area

@@ -1,5 +1,6 @@
 //! The cage: a simple polygon, validated once.
 
+use geometry::{orient, point_segment_distance, segment_distance, signed_area};
 use glam::DVec2;
 
 use crate::error::LbcError;
@@ -10,11 +11,6 @@ use crate::error::LbcError;
 #[derive(Clone, Debug, PartialEq)]
 pub struct Cage {
     vertices: Vec<DVec2>,
-}
-
-/// Sign of the turn `a → b → c` (twice the signed area of the triangle).
-pub(crate) fn orient(a: DVec2, b: DVec2, c: DVec2) -> f64 {
-    (b - a).perp_dot(c - a)
 }
 
 /// A cage whose area is at most this share of its bounding box diagonal squared is
@@ -81,7 +77,8 @@ impl Cage {
                     // Shared vertex a = d.
                     folds_back(b, a, c, tol)
                 } else {
-                    segments_touch(a, b, c, d, tol)
+                    // Crossing, or closer than `tol` anywhere.
+                    segment_distance([a, b], [c, d]) <= tol
                 };
                 if hit {
                     return Err(LbcError::SelfIntersection {
@@ -154,35 +151,8 @@ fn bounds(v: &[DVec2]) -> (DVec2, DVec2) {
     )
 }
 
-fn signed_area(v: &[DVec2]) -> f64 {
-    let n = v.len();
-    0.5 * (0..n).map(|i| v[i].perp_dot(v[(i + 1) % n])).sum::<f64>()
-}
-
-/// Distance from `p` to the segment `ab`.
-pub(crate) fn segment_distance(p: DVec2, a: DVec2, b: DVec2) -> (f64, f64) {
-    let ab = b - a;
-    let t = ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0);
-    (p.distance(a + t * ab), t)
-}
-
 /// Edges `a→b` and `b→d` meet at `b`; true if `d` turns back onto `ab` (or `a` lies on
 /// `bd`), so that they share more than `b`.
 fn folds_back(a: DVec2, b: DVec2, d: DVec2, tol: f64) -> bool {
-    segment_distance(d, a, b).0 <= tol || segment_distance(a, b, d).0 <= tol
-}
-
-/// Whether closed segments `ab` and `cd` share a point (within `tol`).
-fn segments_touch(a: DVec2, b: DVec2, c: DVec2, d: DVec2, tol: f64) -> bool {
-    let o1 = orient(a, b, c);
-    let o2 = orient(a, b, d);
-    let o3 = orient(c, d, a);
-    let o4 = orient(c, d, b);
-    if o1 * o2 < 0.0 && o3 * o4 < 0.0 {
-        return true;
-    }
-    segment_distance(c, a, b).0 <= tol
-        || segment_distance(d, a, b).0 <= tol
-        || segment_distance(a, c, d).0 <= tol
-        || segment_distance(b, c, d).0 <= tol
+    point_segment_distance(d, a, b) <= tol || point_segment_distance(a, b, d) <= tol
 }

@@ -4,7 +4,8 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use crate::error::LbcError;
-use crate::solve::{Report, project_row};
+use crate::projection::project_row;
+use crate::report::Report;
 
 /// Dense coordinates: `n` weights per mesh vertex, vertex-major.
 #[derive(Clone, Debug, PartialEq)]

@@ -1,13 +1,14 @@
 //! The discretised domain: a triangulation of the cage interior whose boundary
 //! vertices carry the Lagrange/linear boundary values.
 
+use geometry::{closest_point_on_segment, orient, point_segment_distance};
 use glam::DVec2;
 use spade::handles::FixedVertexHandle;
 use spade::{
     AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation,
 };
 
-use crate::cage::{Cage, orient, segment_distance};
+use crate::cage::Cage;
 use crate::error::LbcError;
 
 /// Where a mesh vertex lies on the cage: on edge `edge` (from cage vertex `edge` to
@@ -159,7 +160,8 @@ impl Domain {
         let c = cage.vertices();
         let inside = |p: DVec2| {
             cage.contains(p)
-                || (0..c.len()).any(|e| segment_distance(p, c[e], c[(e + 1) % c.len()]).0 <= tol)
+                || (0..c.len())
+                    .any(|e| point_segment_distance(p, c[e], c[(e + 1) % c.len()]) <= tol)
         };
         let outside = |v: usize, p: DVec2| LbcError::OutsideCage {
             vertex: v,
@@ -210,7 +212,10 @@ impl Domain {
             .iter()
             .map(|&p| {
                 (0..n)
-                    .map(|e| (e, segment_distance(p, c[e], c[(e + 1) % n])))
+                    .map(|e| {
+                        let (q, t) = closest_point_on_segment(p, c[e], c[(e + 1) % n]);
+                        (e, (q.distance(p), t))
+                    })
                     .filter(|&(_, (d, _))| d <= tol)
                     .min_by(|a, b| a.1.0.total_cmp(&b.1.0))
                     .map(|(e, (_, t))| {

@@ -5,6 +5,7 @@
 use faer::linalg::solvers::SolveCore;
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Conj, MatMut, Side};
+use geometry::orient;
 use glam::DVec2;
 
 use crate::error::LbcError;
@@ -23,7 +24,7 @@ impl Elements {
         let mut grad = Vec::with_capacity(triangles.len());
         for t in triangles {
             let p = t.map(|v| positions[v as usize]);
-            let twice = (p[1] - p[0]).perp_dot(p[2] - p[0]);
+            let twice = orient(p[0], p[1], p[2]);
             area.push(0.5 * twice);
             // ∇λ_k is the inward normal of the opposite edge over twice the area.
             grad.push(std::array::from_fn(|k| {

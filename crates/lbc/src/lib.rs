@@ -128,6 +128,8 @@ mod domain;
 mod error;
 mod fem;
 mod geodesic;
+mod projection;
+mod report;
 mod solve;
 mod stats;
 
@@ -136,5 +138,6 @@ pub use compact::{CompactWeights, Coordinates};
 pub use domain::{Domain, OnCage};
 pub use error::LbcError;
 pub use geodesic::geodesic_distances;
-pub use solve::{DEFAULT_TOLERANCE, Progress, Report, Settings, Tau, solve, solve_with_distances};
+pub use report::{Progress, Report};
+pub use solve::{DEFAULT_TOLERANCE, Settings, Tau, solve, solve_with_distances};
 pub use stats::{Locality, locality};

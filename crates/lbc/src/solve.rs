@@ -12,6 +12,8 @@ use crate::domain::Domain;
 use crate::error::LbcError;
 use crate::fem::{Elements, Factor};
 use crate::geodesic::geodesic_distances;
+use crate::projection::project_row;
+use crate::report::{Progress, Report};
 
 /// The locality weighting `τ` of eq. (11): `φ_i = τ(D_i)`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -82,47 +84,6 @@ impl Default for Settings {
 
 /// The default relative stopping threshold (see the crate docs for why).
 pub const DEFAULT_TOLERANCE: f64 = 1e-3;
-
-/// One ADMM iteration's state, for a progress display. The residuals are those of
-/// the last iteration that measured them (every fifth; infinite before the first).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Progress {
-    /// Iterations done.
-    pub iteration: usize,
-    /// `‖r_p‖_F` (eq. 26) in the solver's frame.
-    pub primal_residual: f64,
-    /// `‖r_d‖_F` (eq. 27).
-    pub dual_residual: f64,
-    /// What `primal_residual` must fall below.
-    pub primal_threshold: f64,
-    /// What `dual_residual` must fall below.
-    pub dual_threshold: f64,
-    /// The current penalty `μ`.
-    pub penalty: f64,
-}
-
-/// How a solve went.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Report {
-    /// ADMM iterations.
-    pub iterations: usize,
-    /// Whether both residuals fell below their thresholds.
-    pub converged: bool,
-    /// The last iteration's residuals and thresholds.
-    pub last: Option<Progress>,
-    /// The objective (eq. 14) of the returned coordinates, in the caller's units.
-    pub objective: f64,
-    /// Mesh vertices inside the cage (the unknown rows).
-    pub interior_vertices: usize,
-    /// Time for the geodesic distances (zero if they were given).
-    pub geodesics: Duration,
-    /// Time to assemble and factorise `GᵀG + I`.
-    pub factorisation: Duration,
-    /// Time in ADMM iterations.
-    pub admm: Duration,
-    /// Time for the final projection.
-    pub projection: Duration,
-}
 
 /// Computes the local barycentric coordinates of every mesh vertex: geodesic
 /// distances (heat method), then [`solve_with_distances`].
@@ -1000,139 +961,3 @@ const MEASURE_EVERY: usize = 5;
 const PENALTY_INTERVAL: usize = 10;
 /// …and moves the penalty when their relative sizes differ by more than this factor.
 const PENALTY_BAND: f64 = 2.0;
-
-/// The Euclidean projection of `w0` onto `{w ≥ 0, Kᵀw = b}`: `w = max(0, w0 + Kν)`
-/// with `ν` minimising the (convex, piecewise quadratic) dual
-/// `½‖max(0, w0 + Kν)‖² − b·ν`, by Newton's method with backtracking. Partition of
-/// unity is then made exact by dividing by the sum (a change of the order of
-/// rounding).
-///
-/// With `support`, entries outside it are held at zero; the result is `None` (or,
-/// without `support`, `Err` with the best row found) when the constraints cannot be
-/// met to `10⁻¹²`.
-pub(crate) fn project_row(
-    w0: &[f64],
-    k: &[DVec3],
-    b: DVec3,
-    support: Option<&[bool]>,
-) -> ProjectResult {
-    let free = |i: usize| support.is_none_or(|s| s[i]);
-    let eval = |nu: DVec3| -> (f64, DVec3, DMat3) {
-        let mut q = -b.dot(nu);
-        let mut grad = -b;
-        let mut hess = DMat3::from_diagonal(DVec3::splat(1e-12));
-        for (i, (w, ki)) in w0.iter().zip(k).enumerate() {
-            if !free(i) {
-                continue;
-            }
-            let v = w + ki.dot(nu);
-            if v > 0.0 {
-                q += 0.5 * v * v;
-                grad += v * *ki;
-                hess += DMat3::from_cols(*ki * ki.x, *ki * ki.y, *ki * ki.z);
-            }
-        }
-        (q, grad, hess)
-    };
-    let mut nu = DVec3::ZERO;
-    let (mut q, mut grad, mut hess) = eval(nu);
-    for _ in 0..200 {
-        if grad.length() <= 1e-15 {
-            break;
-        }
-        let step = -(hess.inverse() * grad);
-        let slope = grad.dot(step);
-        let mut t = 1.0;
-        let mut moved = false;
-        while t > 1e-12 {
-            let candidate = nu + t * step;
-            let (qc, gc, hc) = eval(candidate);
-            if qc <= q + 1e-4 * t * slope {
-                nu = candidate;
-                (q, grad, hess) = (qc, gc, hc);
-                moved = true;
-                break;
-            }
-            t *= 0.5;
-        }
-        if !moved {
-            break;
-        }
-    }
-    let mut w: Vec<f64> = w0
-        .iter()
-        .zip(k)
-        .enumerate()
-        .map(|(i, (w, ki))| {
-            if free(i) {
-                (w + ki.dot(nu)).max(0.0)
-            } else {
-                0.0
-            }
-        })
-        .collect();
-    // Polish: on the support found, the projection is the equality-constrained one,
-    // in closed form. It meets the constraints to rounding even where Newton's line
-    // search stalled short of its tolerance (a kink of the piecewise-quadratic dual).
-    let polished = polish(w0, k, b, &w);
-    let polished_ok = polished.is_some();
-    if let Some(p) = polished {
-        w = p;
-    }
-    let sum: f64 = w.iter().sum();
-    if sum > 0.0 && !polished_ok {
-        w.iter_mut().for_each(|x| *x /= sum);
-    }
-    let met = (polished_ok || grad.length() <= 1e-12) && sum > 0.0;
-    match (met, support) {
-        (true, _) => Ok(w),
-        (false, Some(_)) => Err(None),
-        (false, None) => Err(Some(w)),
-    }
-}
-
-/// The projection of `w0` onto `{w : Σ w_i k_i = b}` with `w_i = 0` off a support
-/// `S`, starting from the positive entries of `w`: `w0_S + K_S λ` with
-/// `(K_Sᵀ K_S) λ = b − K_Sᵀ w0_S`. `None` if no support reached that way carries the
-/// constraints with non-negative weights.
-fn polish(w0: &[f64], k: &[DVec3], b: DVec3, w: &[f64]) -> Option<Vec<f64>> {
-    let mut support: Vec<usize> = (0..w.len()).filter(|&i| w[i] > 0.0).collect();
-    // An entry that comes out negative leaves the support, and the rest is solved
-    // again (a few rounds of an active-set method, from Newton's nearly right guess).
-    for _ in 0..w.len() {
-        if support.len() < 3 {
-            return None;
-        }
-        let mut gram = DMat3::ZERO;
-        let mut residual = b;
-        for &i in &support {
-            let ki = k[i];
-            gram += DMat3::from_cols(ki * ki.x, ki * ki.y, ki * ki.z);
-            residual -= w0[i] * ki;
-        }
-        if gram.determinant().abs() < 1e-14 {
-            return None;
-        }
-        let lambda = gram.inverse() * residual;
-        let values: Vec<(usize, f64)> = support
-            .iter()
-            .map(|&i| (i, w0[i] + k[i].dot(lambda)))
-            .collect();
-        if values.iter().all(|&(_, v)| v >= 0.0) {
-            let mut out = vec![0.0; w.len()];
-            for (i, v) in values {
-                out[i] = v;
-            }
-            return Some(out);
-        }
-        support = values
-            .iter()
-            .filter(|&&(_, v)| v > 0.0)
-            .map(|&(i, _)| i)
-            .collect();
-    }
-    None
-}
-
-/// A projected row, or (failing) the best row found without a support restriction.
-pub(crate) type ProjectResult = Result<Vec<f64>, Option<Vec<f64>>>;

@@ -2,6 +2,8 @@
 //! each coordinate function leaves (nearly) untouched, and how many control points
 //! reach each part of it.
 
+use geometry::orient;
+
 use crate::compact::Coordinates;
 use crate::domain::Domain;
 
@@ -53,7 +55,7 @@ pub fn locality(domain: &Domain, coordinates: &Coordinates, t: &[f64]) -> Locali
     let mut p = vec![0.0; t.len()];
     for tri in domain.triangles() {
         let [a, b, c] = tri.map(|v| positions[v as usize]);
-        let area = 0.5 * (b - a).perp_dot(c - a).abs();
+        let area = 0.5 * orient(a, b, c).abs();
         total += area;
         for &v in tri {
             vertex_area[v as usize] += area / 3.0;

@@ -1,9 +1,10 @@
 //! From an image's alpha channel to the polygons of its visible shape.
 
+use geometry::signed_area;
 use glam::DVec2;
 
 use crate::cover;
-use crate::geometry::{RingBands, ring_signed_area};
+use crate::segments::RingBands;
 use crate::simplify::simplify_rings;
 use crate::trace::{TracedRing, trace};
 use crate::{MeshError, MeshOptions};
@@ -41,12 +42,8 @@ pub struct Polygon {
 impl Polygon {
     /// Area in px²: the outer ring's area minus the holes' (orientation ignored).
     pub fn area(&self) -> f64 {
-        ring_signed_area(&self.outer).abs()
-            - self
-                .holes
-                .iter()
-                .map(|h| ring_signed_area(h).abs())
-                .sum::<f64>()
+        signed_area(&self.outer).abs()
+            - self.holes.iter().map(|h| signed_area(h).abs()).sum::<f64>()
     }
 
     /// All rings: the outer one first, then the holes.
@@ -361,10 +358,7 @@ impl Outline {
         let ncomp = sizes.len();
         let mut outers: Vec<Vec<usize>> = vec![Vec::new(); ncomp];
         let mut holes: Vec<Vec<usize>> = vec![Vec::new(); ncomp];
-        let areas: Vec<f64> = simplified
-            .iter()
-            .map(|r| ring_signed_area(&to_f(r)))
-            .collect();
+        let areas: Vec<f64> = simplified.iter().map(|r| signed_area(&to_f(r))).collect();
         for (i, r) in traced.iter().enumerate() {
             let (x, y) = r.fg_pixel;
             let l = labels[y * w + x];
@@ -773,7 +767,7 @@ mod tests {
                         from = to;
                         next += 1;
                     } else {
-                        let d = crate::geometry::dist2_point_segment(at(p), at(from), at(to));
+                        let d = geometry::point_segment_distance_squared(at(p), at(from), at(to));
                         assert!(
                             d.sqrt() <= tol + 1e-9,
                             "{p:?} is {} from {from:?}-{to:?}",

@@ -18,6 +18,7 @@
 use std::cmp::Reverse;
 use std::collections::{BinaryHeap, HashMap, VecDeque};
 
+use geometry::{lattice, orient, segments_touch, signed_area};
 use glam::DVec2;
 
 use crate::domain::{dilate, label_components, make_well_composed};
@@ -82,7 +83,7 @@ pub fn enclosing_ring(
     let outer = trace(&mask, w, h)
         .into_iter()
         .map(|r| r.pts)
-        .max_by_key(|pts| signed_area2(pts))
+        .max_by_key(|pts| lattice::twice_signed_area(pts))
         .ok_or(MeshError::EmptyDomain)?;
     let ring: Vec<DVec2> = outer
         .iter()
@@ -90,17 +91,6 @@ pub fn enclosing_ring(
         .collect();
     let ring = Reducer::new(ring, DVec2::new(fw, fh)).reduce(vertices);
     Ok(Enclosure { ring, pieces })
-}
-
-/// Twice the signed area of an integer ring (positive for outer outlines).
-fn signed_area2(pts: &[[i64; 2]]) -> i64 {
-    let n = pts.len();
-    (0..n)
-        .map(|i| {
-            let (a, b) = (pts[i], pts[(i + 1) % n]);
-            a[0] * b[1] - a[1] * b[0]
-        })
-        .sum()
 }
 
 /// A gap between two pieces: its length in pixels and the two pixels where the searches
@@ -211,9 +201,7 @@ enum Step {
 impl Reducer {
     fn new(points: Vec<DVec2>, size: DVec2) -> Self {
         let n = points.len();
-        let area: f64 = (0..n)
-            .map(|i| points[i].perp_dot(points[(i + 1) % n]))
-            .sum();
+        let orientation = signed_area(&points).signum();
         let prev = (0..n).map(|i| (i + n - 1) % n).collect();
         let next: Vec<usize> = (0..n).map(|i| (i + 1) % n).collect();
         let mut grid = EdgeGrid::new(size, n);
@@ -226,7 +214,7 @@ impl Reducer {
             next,
             alive: vec![true; n],
             stamp: vec![0; n],
-            orientation: area.signum(),
+            orientation,
             size,
             grid,
             left: n,
@@ -258,7 +246,7 @@ impl Reducer {
                     self.points[i],
                     self.points[self.next[i]],
                 );
-                Some((0.5 * (b - a).perp_dot(c - a).abs(), b))
+                Some((0.5 * orient(a, b, c).abs(), b))
             }
             Step::Extend => {
                 let j = self.next[i];
@@ -287,7 +275,7 @@ impl Reducer {
                 if !e.is_finite() || e.cmplt(DVec2::ZERO).any() || e.cmpgt(self.size).any() {
                     return None;
                 }
-                Some((0.5 * (e - b).perp_dot(c - b).abs(), e))
+                Some((0.5 * orient(b, e, c).abs(), e))
             }
         }
     }
@@ -314,7 +302,7 @@ impl Reducer {
                 // Shares the end `at`: only an overlap along the same line counts.
                 let other = if s == at { t } else { s };
                 let (u, v) = if p == at { (p, q) } else { (q, p) };
-                return (v - u).perp_dot(other - u) == 0.0 && (v - u).dot(other - u) > 0.0;
+                return orient(u, v, other) == 0.0 && (v - u).dot(other - u) > 0.0;
             }
             segments_touch(p, q, s, t)
         })
@@ -423,25 +411,6 @@ impl Reducer {
     }
 }
 
-/// Whether the closed segments `ab` and `cd` share a point.
-fn segments_touch(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> bool {
-    let orient = |p: DVec2, q: DVec2, r: DVec2| (q - p).perp_dot(r - p);
-    let on = |p: DVec2, q: DVec2, r: DVec2| {
-        orient(p, q, r) == 0.0
-            && r.x >= p.x.min(q.x)
-            && r.x <= p.x.max(q.x)
-            && r.y >= p.y.min(q.y)
-            && r.y <= p.y.max(q.y)
-    };
-    let (o1, o2, o3, o4) = (
-        orient(a, b, c),
-        orient(a, b, d),
-        orient(c, d, a),
-        orient(c, d, b),
-    );
-    (o1 * o2 < 0.0 && o3 * o4 < 0.0) || on(a, b, c) || on(a, b, d) || on(c, d, a) || on(c, d, b)
-}
-
 /// The ring's edges by the grid cells their bounding boxes cover, so a new edge is
 /// tested against the edges near it only. Entries go stale when an edge is put in
 /// anew (its version moves on) and are skipped, never removed.
@@ -510,6 +479,7 @@ impl EdgeGrid {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use geometry::point_segment_distance;
 
     /// Whether every corner of every visible pixel lies inside `ring` or on it.
     fn encloses(image: &image::RgbaImage, ring: &[DVec2]) -> Result<(), (u32, u32)> {
@@ -518,9 +488,7 @@ mod tests {
             let mut inside = false;
             for i in 0..n {
                 let (a, b) = (ring[i], ring[(i + 1) % n]);
-                let ab = b - a;
-                let t = ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0);
-                if (a + t * ab).distance(p) < 1e-9 {
+                if point_segment_distance(p, a, b) < 1e-9 {
                     return true;
                 }
                 if (a.y > p.y) != (b.y > p.y) && a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x) > p.x
@@ -613,12 +581,7 @@ mod tests {
         });
         let e = enclosing_ring(&image, 16, 2.0).expect("a ring");
         assert_eq!(encloses(&image, &e.ring), Ok(()));
-        let n = e.ring.len();
-        let area = 0.5
-            * (0..n)
-                .map(|i| e.ring[i].perp_dot(e.ring[(i + 1) % n]))
-                .sum::<f64>()
-                .abs();
+        let area = signed_area(&e.ring).abs();
         // The U covers 80² − 30·60 = 4600 px²; its hull 6400.
         assert!(area < 5600.0, "area {area}");
     }

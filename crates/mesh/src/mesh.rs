@@ -1,9 +1,9 @@
 //! The triangle mesh type and its point queries and edits.
 
+use geometry::orient;
 use glam::DVec2;
 
 use crate::MeshError;
-use crate::geometry::orient;
 
 /// Distance (pixels) within which [`Mesh::insert_point`] reuses an existing vertex, or
 /// splits an edge rather than a triangle.

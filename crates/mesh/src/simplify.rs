@@ -1,10 +1,10 @@
 //! Douglas–Peucker simplification of traced outlines that keeps them simple and disjoint.
 
+use geometry::lattice::{self, Point as P};
+use geometry::{douglas_peucker, farthest_from_chord, signed_area};
 use glam::DVec2;
 
-use crate::geometry::{SegmentGrid, dist2_point_segment};
-
-type P = [i64; 2];
+use crate::segments::SegmentGrid;
 
 fn to_f(p: P) -> DVec2 {
     DVec2::new(p[0] as f64, p[1] as f64)
@@ -27,10 +27,15 @@ fn to_f(p: P) -> DVec2 {
 /// simplified segment cannot shave off a sliver along it (pixels there lie only half a
 /// pixel from the outline).
 pub(crate) fn simplify_rings(rings: &[Vec<P>], tols: &[f64], size: P) -> Vec<Vec<P>> {
+    let float: Vec<Vec<DVec2>> = rings
+        .iter()
+        .map(|r| r.iter().map(|&p| to_f(p)).collect())
+        .collect();
     let mut keep: Vec<Vec<bool>> = rings
         .iter()
+        .zip(&float)
         .zip(tols)
-        .map(|(r, &tol)| douglas_peucker(r, tol, size))
+        .map(|((r, f), &tol)| simplify_ring(r, f, tol, size))
         .collect();
     // Resolve conflicts; each round keeps at least one more original vertex, so this ends.
     loop {
@@ -40,14 +45,13 @@ pub(crate) fn simplify_rings(rings: &[Vec<P>], tols: &[f64], size: P) -> Vec<Vec
         }
         let mut progress = false;
         for (r, i, j) in conflicts {
-            if let Some(k) = farthest_between(&rings[r], i, j)
+            if let Some((k, _)) = farthest_from_chord(&float[r], i, j)
                 && !keep[r][k]
             {
                 keep[r][k] = true;
                 progress = true;
                 // The two new segments must follow the outline within the tolerance too.
-                let tol2 = tols[r] * tols[r];
-                refine(&rings[r], &mut keep[r], vec![(i, k), (k, j)], tol2);
+                douglas_peucker(&float[r], &mut keep[r], vec![(i, k), (k, j)], tols[r]);
             }
         }
         if !progress {
@@ -67,65 +71,20 @@ pub(crate) fn simplify_rings(rings: &[Vec<P>], tols: &[f64], size: P) -> Vec<Vec
         .collect()
 }
 
-/// Index of the vertex strictly between `i` and `j` (cyclically) farthest from the segment
-/// `ring[i] ring[j]`, or `None` when they are neighbours.
-fn farthest_between(ring: &[P], i: usize, j: usize) -> Option<usize> {
-    let n = ring.len();
-    let (a, b) = (to_f(ring[i]), to_f(ring[j]));
-    let mut best = None;
-    let mut best_d = -1.0;
-    let mut k = (i + 1) % n;
-    while k != j {
-        let d = dist2_point_segment(to_f(ring[k]), a, b);
-        if d > best_d {
-            best_d = d;
-            best = Some(k);
-        }
-        k = (k + 1) % n;
-    }
-    best
-}
-
-/// Douglas–Peucker on the spans `(i, j)` of a closed ring (from vertex `i` to vertex `j`,
-/// cyclically; `i == j` is the whole ring): keeps, recursively, the vertex of a span
-/// farthest from its chord while that is more than `√tol2` away.
-fn refine(ring: &[P], keep: &mut [bool], mut spans: Vec<(usize, usize)>, tol2: f64) {
-    let n = ring.len();
-    while let Some((i, j)) = spans.pop() {
-        let (a, b) = (to_f(ring[i]), to_f(ring[j]));
-        let mut best = None;
-        let mut best_d = tol2;
-        let mut k = (i + 1) % n;
-        while k != j {
-            let d = dist2_point_segment(to_f(ring[k]), a, b);
-            if d > best_d {
-                best_d = d;
-                best = Some(k);
-            }
-            k = (k + 1) % n;
-        }
-        if let Some(k) = best {
-            keep[k] = true;
-            spans.push((i, k));
-            spans.push((k, j));
-        }
-    }
-}
-
-/// Douglas–Peucker on a closed ring, keeping the vertices on the border of the image
-/// `[0, size[0]] × [0, size[1]]`; returns which vertices to keep (at least 3, with the
-/// sign of the area preserved, or all of them).
-fn douglas_peucker(ring: &[P], tol: f64, size: P) -> Vec<bool> {
+/// Douglas–Peucker on a closed ring (`float` is `ring` in `f64`), keeping the vertices on
+/// the border of the image `[0, size[0]] × [0, size[1]]`; returns which vertices to keep
+/// (at least 3, with the sign of the area preserved, or all of them).
+fn simplify_ring(ring: &[P], float: &[DVec2], tol: f64, size: P) -> Vec<bool> {
     let n = ring.len();
     if n <= 4 || tol <= 0.0 {
         return vec![true; n];
     }
-    let p0 = to_f(ring[0]);
+    let p0 = float[0];
     let far = (1..n)
         .max_by(|&a, &b| {
-            to_f(ring[a])
+            float[a]
                 .distance_squared(p0)
-                .total_cmp(&to_f(ring[b]).distance_squared(p0))
+                .total_cmp(&float[b].distance_squared(p0))
         })
         .unwrap_or(n / 2);
     let mut keep: Vec<bool> = ring
@@ -141,48 +100,19 @@ fn douglas_peucker(ring: &[P], tol: f64, size: P) -> Vec<bool> {
         spans.push((prev, k % n));
         prev = k;
     }
-    refine(ring, &mut keep, spans, tol * tol);
-    let kept: Vec<DVec2> = ring
+    douglas_peucker(float, &mut keep, spans, tol);
+    let kept: Vec<DVec2> = float
         .iter()
         .zip(&keep)
         .filter(|(_, k)| **k)
-        .map(|(p, _)| to_f(*p))
+        .map(|(p, _)| *p)
         .collect();
-    let before =
-        crate::geometry::ring_signed_area(&ring.iter().map(|&p| to_f(p)).collect::<Vec<_>>());
-    let after = crate::geometry::ring_signed_area(&kept);
+    let before = signed_area(float);
+    let after = signed_area(&kept);
     if kept.len() < 3 || after == 0.0 || after.signum() != before.signum() {
         return vec![true; n];
     }
     keep
-}
-
-fn orient_i(a: P, b: P, c: P) -> i128 {
-    let (abx, aby) = (i128::from(b[0] - a[0]), i128::from(b[1] - a[1]));
-    let (acx, acy) = (i128::from(c[0] - a[0]), i128::from(c[1] - a[1]));
-    abx * acy - aby * acx
-}
-
-fn on_segment(a: P, b: P, p: P) -> bool {
-    p[0] >= a[0].min(b[0])
-        && p[0] <= a[0].max(b[0])
-        && p[1] >= a[1].min(b[1])
-        && p[1] <= a[1].max(b[1])
-}
-
-/// Whether closed segments `a b` and `c d` share any point (exact integer arithmetic).
-fn segments_touch(a: P, b: P, c: P, d: P) -> bool {
-    let d1 = orient_i(c, d, a).signum();
-    let d2 = orient_i(c, d, b).signum();
-    let d3 = orient_i(a, b, c).signum();
-    let d4 = orient_i(a, b, d).signum();
-    if d1 * d2 < 0 && d3 * d4 < 0 {
-        return true;
-    }
-    (d1 == 0 && on_segment(c, d, a))
-        || (d2 == 0 && on_segment(c, d, b))
-        || (d3 == 0 && on_segment(a, b, c))
-        || (d4 == 0 && on_segment(a, b, d))
 }
 
 /// Simplified segments `(ring, from, to)` (original indices) that touch a segment they
@@ -224,11 +154,11 @@ fn find_conflicts(rings: &[Vec<P>], keep: &[Vec<bool>]) -> Vec<(usize, usize, us
                 let (c, d) = (rings[t.ring][t.i], rings[t.ring][t.j]);
                 let conflict = if s.ring == t.ring && (s.pos + 1) % s.count == t.pos {
                     // t follows s: they share b == c; conflict if t folds back onto s.
-                    orient_i(a, b, d) == 0 && dot(a, b, c, d) < 0
+                    lattice::orient(a, b, d) == 0 && dot(a, b, c, d) < 0
                 } else if s.ring == t.ring && (t.pos + 1) % t.count == s.pos {
-                    orient_i(c, d, b) == 0 && dot(c, d, a, b) < 0
+                    lattice::orient(c, d, b) == 0 && dot(c, d, a, b) < 0
                 } else {
-                    segments_touch(a, b, c, d)
+                    lattice::segments_touch(a, b, c, d)
                 };
                 if conflict {
                     bad[si] = true;
@@ -295,14 +225,6 @@ mod tests {
         // On the image border the vertices stay.
         let kept = simplify_rings(&[ring], &[2.0], [50, 200]);
         assert!(inside(&kept[0], pixel));
-    }
-
-    #[test]
-    fn touching_detection() {
-        assert!(segments_touch([0, 0], [4, 4], [0, 4], [4, 0]));
-        assert!(segments_touch([0, 0], [4, 0], [2, 0], [2, 3]));
-        assert!(!segments_touch([0, 0], [4, 0], [0, 1], [4, 1]));
-        assert!(segments_touch([0, 0], [4, 0], [3, 0], [6, 0]));
     }
 
     #[test]

@@ -94,15 +94,8 @@ pub(crate) fn trace(mask: &[bool], w: usize, h: usize) -> Vec<TracedRing> {
 mod tests {
     use super::*;
 
-    fn area(pts: &[[i64; 2]]) -> i64 {
-        let n = pts.len();
-        (0..n)
-            .map(|i| {
-                let (a, b) = (pts[i], pts[(i + 1) % n]);
-                a[0] * b[1] - a[1] * b[0]
-            })
-            .sum::<i64>()
-            / 2
+    fn area(pts: &[[i64; 2]]) -> i128 {
+        geometry::lattice::twice_signed_area(pts) / 2
     }
 
     #[test]
@@ -117,7 +110,7 @@ mod tests {
         }
         let rings = trace(&mask, w, h);
         assert_eq!(rings.len(), 2);
-        let mut areas: Vec<i64> = rings.iter().map(|r| area(&r.pts)).collect();
+        let mut areas: Vec<i128> = rings.iter().map(|r| area(&r.pts)).collect();
         areas.sort();
         assert_eq!(areas, vec![-1, 25]);
         for r in &rings {

@@ -4,6 +4,7 @@
 use std::collections::HashMap;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
+use geometry::{orient, point_segment_distance_squared, signed_area};
 use glam::DVec2;
 use spade::handles::{FixedVertexHandle, VertexHandle};
 use spade::{
@@ -11,10 +12,7 @@ use spade::{
     Triangulation,
 };
 
-use crate::geometry::{
-    RingBands, SegmentGrid, dist2_point_segment, exactly_collinear, lerp, ring_signed_area,
-    segment_hits,
-};
+use crate::segments::{RingBands, SegmentGrid, exactly_collinear, lerp, segment_hits};
 use crate::{Domain, DomainOptions, Mesh, MeshError, domain_for_density};
 
 type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
@@ -176,7 +174,7 @@ pub fn triangulate(
                     ring.len()
                 )));
             }
-            if ring_signed_area(ring) == 0.0 {
+            if signed_area(ring) == 0.0 {
                 return Err(MeshError::InvalidDomain(format!(
                     "{} has zero area",
                     name()
@@ -463,7 +461,7 @@ impl Seeds {
                 }
                 splits.clear();
                 for &p in &on_boundary {
-                    if dist2_point_segment(p, a, b) <= tol * tol {
+                    if point_segment_distance_squared(p, a, b) <= tol * tol {
                         if p != a && p != b {
                             splits.push(((p - a).dot(b - a) / len2, p));
                         }
@@ -511,8 +509,8 @@ impl Seeds {
         }
         let on_same_segment = |p: DVec2, q: DVec2| {
             busy_segments.iter().any(|&[a, b]| {
-                dist2_point_segment(p, a, b) <= tol * tol
-                    && dist2_point_segment(q, a, b) <= tol * tol
+                point_segment_distance_squared(p, a, b) <= tol * tol
+                    && point_segment_distance_squared(q, a, b) <= tol * tol
             })
         };
 
@@ -666,9 +664,9 @@ fn build_mesh(
         let t2 = tol * tol;
         boundary_grid.any_near(m, tol, |i| {
             let [p, q] = boundary_grid.segments()[i];
-            dist2_point_segment(m, p, q) <= t2
-                && dist2_point_segment(a, p, q) <= t2
-                && dist2_point_segment(b, p, q) <= t2
+            point_segment_distance_squared(m, p, q) <= t2
+                && point_segment_distance_squared(a, p, q) <= t2
+                && point_segment_distance_squared(b, p, q) <= t2
         })
     };
     const UNSEEN: u8 = 0;
@@ -814,7 +812,7 @@ fn is_convex(ring: &[DVec2]) -> bool {
     let n = ring.len();
     let (mut pos, mut neg) = (false, false);
     for i in 0..n {
-        let o = crate::geometry::orient(ring[i], ring[(i + 1) % n], ring[(i + 2) % n]);
+        let o = orient(ring[i], ring[(i + 1) % n], ring[(i + 2) % n]);
         pos |= o > 0.0;
         neg |= o < 0.0;
     }

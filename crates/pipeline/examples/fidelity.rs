@@ -15,6 +15,7 @@
 //! cargo run --release -p pipeline --example fidelity [density]
 //! ```
 
+use geometry::point_segment_distance;
 use glam::DVec2;
 use pipeline::{DEFAULT_IMAGE, prepare};
 use project::Project;
@@ -43,17 +44,10 @@ fn segment(h: &Handle) -> [DVec2; 2] {
     }
 }
 
-/// Distance between two segments (points are segments of length 0).
+/// Distance between two segments (points are segments of length 0), from their ends
+/// alone: segments that cross count as apart.
 fn segment_distance(a: [DVec2; 2], b: [DVec2; 2]) -> f64 {
-    let to_segment = |p: DVec2, s: [DVec2; 2]| {
-        let d = s[1] - s[0];
-        let t = if d.length_squared() > 0.0 {
-            ((p - s[0]).dot(d) / d.length_squared()).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        (s[0] + d * t - p).length()
-    };
+    let to_segment = |p: DVec2, s: [DVec2; 2]| point_segment_distance(p, s[0], s[1]);
     [
         to_segment(a[0], b),
         to_segment(a[1], b),

@@ -26,6 +26,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
+use geometry::point_segment_distance;
 use glam::DVec2;
 use project::{Project, RigidityStroke};
 use serde::Serialize;
@@ -34,6 +35,10 @@ use weights_core::{Domain, Handle, Metric, Rig, Similarity};
 use crate::method::{
     Deformer, Follow, Method, Output, Sequence, WeightsListing, json, median, quantile,
 };
+
+/// How far a brush stroke reaches: the squared distance from a point to the stroke's
+/// polyline.
+pub use geometry::polyline_distance_squared;
 
 /// ARAP's own mesh when the rig file names no `arap.density`.
 pub const DEFAULT_ARAP_DENSITY: usize = 3000;
@@ -669,7 +674,7 @@ fn pins(
             }
             continue;
         }
-        let distance = |p: DVec2| segment_point_distance(segment, p);
+        let distance = |p: DVec2| point_segment_distance(p, segment[0], segment[1]);
         let positions = mesh.positions();
         for v in mesh.vertices_near_segment(segment[0], segment[1], radius) {
             claim(v, h, distance(positions[v as usize]));
@@ -695,11 +700,6 @@ fn pins(
         }
     }
     Ok(claims.into_iter().map(|(v, (_, h))| (v, h)).collect())
-}
-
-/// The distance from `p` to the segment `s` (a point when its ends coincide).
-fn segment_point_distance(s: [DVec2; 2], p: DVec2) -> f64 {
-    polyline_distance_squared(&s, p).sqrt()
 }
 
 /// The rigidity of every triangle of `mesh`: the largest weight of the strokes that
@@ -758,26 +758,6 @@ pub fn rigidity_weights(mesh: &Domain, strokes: &[RigidityStroke]) -> Vec<f64> {
         }
     }
     weights
-}
-
-/// The squared distance from `p` to the polyline through `points` (a point when it
-/// has one, infinite when it has none): how far a brush stroke reaches.
-pub fn polyline_distance_squared(points: &[DVec2], p: DVec2) -> f64 {
-    if points.len() == 1 {
-        return points[0].distance_squared(p);
-    }
-    points
-        .windows(2)
-        .map(|w| {
-            let d = w[1] - w[0];
-            let t = if d.length_squared() > 0.0 {
-                ((p - w[0]).dot(d) / d.length_squared()).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            (w[0] + d * t).distance_squared(p)
-        })
-        .fold(f64::INFINITY, f64::min)
 }
 
 fn ms(clock: Instant) -> f64 {

@@ -3,6 +3,7 @@
 
 use std::sync::OnceLock;
 
+use geometry::{orient, segment_distance};
 use glam::DVec2;
 
 use crate::error::DomainError;
@@ -488,7 +489,7 @@ impl Domain {
             for x in x0..=x1 {
                 for &v in grid.items(x, y) {
                     let p = self.positions[v as usize];
-                    if crate::nearest::segment_distance([p, p], [a, b]) <= r {
+                    if segment_distance([p, p], [a, b]) <= r {
                         out.push(v);
                     }
                 }
@@ -514,7 +515,7 @@ impl Domain {
         let scale = (self.max - self.min).length().max(1e-12);
         let tol = 1e-12 * scale * scale;
         let side = |p: DVec2, q: DVec2, r: DVec2| {
-            let c = (q - p).perp_dot(r - p);
+            let c = orient(p, q, r);
             if c > tol {
                 1
             } else if c < -tol {

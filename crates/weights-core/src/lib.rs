@@ -29,7 +29,6 @@ mod ldl;
 mod nearest;
 mod queue;
 mod rig;
-mod transform;
 mod virtual_handles;
 mod voronoi;
 mod weights;
@@ -37,10 +36,10 @@ mod weights;
 pub use basis::{Basis, MAX_DEGREE, MIN_DEGREE, MiddleControls};
 pub use domain::{Domain, Metric};
 pub use error::{DomainError, RigError};
+pub use geometry::Similarity;
 pub use rig::{
     BuildTimings, Handle, MAX_BAR_PIECES, MAX_HANDLES, MAX_POSE, MAX_SCALE, MIN_SCALE, Node,
     NodeKind, NodeRadii, Phase, Progress, Rig, RigOptions, RigStats, UpdateTimings, VirtualHandle,
     bar_samples, bar_spacing,
 };
-pub use transform::Similarity;
 pub use virtual_handles::Placement;

@@ -8,6 +8,7 @@
 //! looks at rings of cells around the segment's own until the ring is farther than
 //! the nearest segment found: everything closer lies in the cells already seen.
 
+use geometry::segment_distance;
 use glam::DVec2;
 
 /// A segment overlapping more cells than this is compared with every other directly.
@@ -15,32 +16,6 @@ const LONG: usize = 16;
 
 /// Below this many handles, every pair is compared.
 const FEW: usize = 32;
-
-/// The distance between two segments (zero when they cross).
-pub(crate) fn segment_distance(a: [DVec2; 2], b: [DVec2; 2]) -> f64 {
-    let point_seg = |p: DVec2, s: [DVec2; 2]| {
-        let d = s[1] - s[0];
-        let t = if d.length_squared() > 0.0 {
-            ((p - s[0]).dot(d) / d.length_squared()).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        (p - (s[0] + d * t)).length()
-    };
-    let (da, db) = (a[1] - a[0], b[1] - b[0]);
-    let cross = |u: DVec2, v: DVec2| u.perp_dot(v);
-    let o1 = cross(da, b[0] - a[0]);
-    let o2 = cross(da, b[1] - a[0]);
-    let o3 = cross(db, a[0] - b[0]);
-    let o4 = cross(db, a[1] - b[0]);
-    if o1 * o2 < 0.0 && o3 * o4 < 0.0 {
-        return 0.0;
-    }
-    point_seg(a[0], b)
-        .min(point_seg(a[1], b))
-        .min(point_seg(b[0], a))
-        .min(point_seg(b[1], a))
-}
 
 /// Segments filed by grid cell.
 pub(crate) struct SegmentGrid<'a> {

@@ -15,10 +15,44 @@
 
 use std::collections::BinaryHeap;
 
-use crate::voronoi::Entry;
-
 /// The most buckets a ring may have.
 const MAX_BUCKETS: usize = 1 << 12;
+
+/// A queue entry: tentative distance, the tie-break key of its node, the sample, packed
+/// into one integer so that a heap compares them in one instruction. Distances are
+/// never negative, so their IEEE bit patterns order like the numbers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub(crate) struct Entry(std::cmp::Reverse<u128>);
+
+impl Entry {
+    /// Sample `v` at tentative distance `d` (not negative), for the node whose
+    /// tie-break key is `key`.
+    #[inline]
+    pub fn new(d: f64, key: u32, v: u32) -> Self {
+        debug_assert!(d >= 0.0);
+        Self(std::cmp::Reverse(
+            (u128::from(d.to_bits()) << 64) | (u128::from(key) << 32) | u128::from(v),
+        ))
+    }
+
+    /// The tentative distance.
+    #[inline]
+    pub fn d(&self) -> f64 {
+        f64::from_bits((self.0.0 >> 64) as u64)
+    }
+
+    /// The tie-break key of the node.
+    #[inline]
+    pub fn key(&self) -> u32 {
+        (self.0.0 >> 32) as u32
+    }
+
+    /// The sample.
+    #[inline]
+    pub fn v(&self) -> u32 {
+        self.0.0 as u32
+    }
+}
 
 /// A monotone priority queue of [`Entry`]s (see the module documentation).
 #[derive(Debug, Default)]

@@ -5,14 +5,13 @@
 use std::collections::HashMap;
 use std::time::Instant;
 
+use geometry::{Similarity, segment_distance};
 use glam::{DAffine2, DVec2};
 
 use crate::basis::Basis;
 use crate::domain::{Domain, Metric};
 use crate::error::RigError;
 use crate::harmonic::{Coefficients, Solved, dual_edges, harmonic_coordinates};
-use crate::nearest::segment_distance;
-use crate::transform::Similarity;
 use crate::virtual_handles::{Placement, insert_virtual_handles};
 use crate::voronoi::{CellStats, NONE, Partition};
 use crate::weights::{Ball, Change, SampleSet, Weights, ball};

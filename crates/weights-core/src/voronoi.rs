@@ -12,7 +12,7 @@
 use glam::DVec2;
 
 use crate::domain::{Domain, Metric};
-use crate::queue::Queue;
+use crate::queue::{Entry, Queue};
 
 thread_local! {
     /// The queue of the partition's searches, kept between them.
@@ -31,37 +31,6 @@ fn with_queue<R>(domain: &Domain, f: impl FnOnce(&mut Queue) -> R) -> R {
 
 /// "No node": an unreachable sample, or a removed node.
 pub(crate) const NONE: u32 = u32::MAX;
-
-/// A queue entry: tentative distance, the tie-break key of its node, the sample, packed
-/// into one integer so that a heap compares them in one instruction. Distances are
-/// never negative, so their IEEE bit patterns order like the numbers.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
-pub(crate) struct Entry(std::cmp::Reverse<u128>);
-
-impl Entry {
-    #[inline]
-    pub fn new(d: f64, key: u32, v: u32) -> Self {
-        debug_assert!(d >= 0.0);
-        Self(std::cmp::Reverse(
-            (u128::from(d.to_bits()) << 64) | (u128::from(key) << 32) | u128::from(v),
-        ))
-    }
-
-    #[inline]
-    pub fn d(&self) -> f64 {
-        f64::from_bits((self.0.0 >> 64) as u64)
-    }
-
-    #[inline]
-    pub fn key(&self) -> u32 {
-        (self.0.0 >> 32) as u32
-    }
-
-    #[inline]
-    pub fn v(&self) -> u32 {
-        self.0.0 as u32
-    }
-}
 
 /// Keeps the items `i` of `list` with `map[i] != NONE`, in order.
 fn retain_kept<T>(list: &mut Vec<T>, map: &[u32]) {

@@ -15,8 +15,8 @@ use std::sync::atomic::Ordering::Relaxed;
 
 use crate::basis::Basis;
 use crate::domain::{Domain, Metric};
-use crate::queue::Queue;
-use crate::voronoi::{CellField, Entry, NONE, Partition};
+use crate::queue::{Entry, Queue};
+use crate::voronoi::{CellField, NONE, Partition};
 
 /// Reusable buffers for bounded Dijkstra searches, one set per thread. `dist` is all
 /// infinite between searches (each search resets what it set: the samples it returns,

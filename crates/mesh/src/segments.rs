@@ -1,32 +1,13 @@
-//! Small planar geometry helpers and two spatial indices over segments.
+//! Segment helpers of the meshing (exact collinearity, where one segment meets
+//! another) and two spatial indices over segments; the plain predicates (orientation,
+//! areas, distances) are the `geometry` crate's.
 //!
 //! * [`SegmentGrid`]: uniform grid for "which segments lie near this point" queries.
 //! * [`RingBands`]: horizontal bands for even-odd point-in-domain tests and scanline
 //!   crossings.
 
+use geometry::point_segment_distance_squared;
 use glam::DVec2;
-
-/// Twice the signed area of the triangle `a b c` (positive when `a b c` turns left in a
-/// y-up frame, i.e. the crate's triangle orientation).
-#[inline]
-pub(crate) fn orient(a: DVec2, b: DVec2, c: DVec2) -> f64 {
-    (b - a).perp_dot(c - a)
-}
-
-/// Signed area of a closed ring (shoelace formula in pixel coordinates).
-pub(crate) fn ring_signed_area(ring: &[DVec2]) -> f64 {
-    let n = ring.len();
-    if n < 3 {
-        return 0.0;
-    }
-    let mut twice = 0.0;
-    for i in 0..n {
-        let a = ring[i];
-        let b = ring[(i + 1) % n];
-        twice += a.perp_dot(b);
-    }
-    0.5 * twice
-}
 
 /// `a + (b - a) * t`: exact on axis-aligned segments (unlike `DVec2::lerp`), so points
 /// split off a straight image edge stay exactly on it.
@@ -62,19 +43,6 @@ pub(crate) fn exactly_collinear(a: DVec2, b: DVec2, p: DVec2) -> bool {
     let p2 = uy * vx;
     let e2 = uy.mul_add(vx, -p2);
     p1.is_finite() && p2.is_finite() && p1 == p2 && e1 == e2
-}
-
-/// Squared distance from `p` to the segment `a b`.
-#[inline]
-pub(crate) fn dist2_point_segment(p: DVec2, a: DVec2, b: DVec2) -> f64 {
-    let ab = b - a;
-    let len2 = ab.length_squared();
-    let t = if len2 > 0.0 {
-        ((p - a).dot(ab) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (a + ab * t - p).length_squared()
 }
 
 /// Parameters `t` in `[0, 1]` along `p q` where it meets the segment `a b` (both ends of
@@ -248,7 +216,7 @@ impl SegmentGrid {
         let r2 = r * r;
         self.any_near(p, r, |i| {
             let [a, b] = self.segs[i];
-            dist2_point_segment(p, a, b) < r2
+            point_segment_distance_squared(p, a, b) < r2
         })
     }
 
@@ -372,7 +340,7 @@ impl RingBands {
             self.band(y).is_some_and(|items| {
                 items.iter().any(|&i| {
                     let [a, b] = self.segs[i as usize];
-                    dist2_point_segment(p, a, b) <= t2
+                    point_segment_distance_squared(p, a, b) <= t2
                 })
             })
         })
@@ -387,7 +355,7 @@ impl RingBands {
         let mut inside = false;
         for &i in items {
             let [a, b] = self.segs[i as usize];
-            if dist2_point_segment(p, a, b) <= e2 {
+            if point_segment_distance_squared(p, a, b) <= e2 {
                 return true;
             }
             if (a.y > p.y) != (b.y > p.y) {
@@ -423,7 +391,6 @@ mod tests {
         let mut xs = Vec::new();
         bands.crossings(1.5, &mut xs);
         assert_eq!(xs, vec![0.0, 4.0]);
-        assert!((ring_signed_area(&ring) - 16.0).abs() < 1e-12);
     }
 
     #[test]
