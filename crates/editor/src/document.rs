@@ -14,6 +14,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
+use geometry::segment_distance;
 use glam::DVec2;
 use image::RgbaImage;
 use pipeline::cage::CageCoordinates;
@@ -752,31 +753,6 @@ impl Document {
             })
             .collect()
     }
-}
-
-/// Distance between two segments (a point is a segment with equal ends); NaN-free for
-/// finite input.
-fn segment_distance(a: [DVec2; 2], b: [DVec2; 2]) -> f64 {
-    let point_segment = |p: DVec2, [s, t]: [DVec2; 2]| {
-        let st = t - s;
-        let u = if st.length_squared() > 0.0 {
-            ((p - s).dot(st) / st.length_squared()).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        (p - (s + st * u)).length()
-    };
-    let cross = |[p, q]: [DVec2; 2], [r, s]: [DVec2; 2]| {
-        let d = |a: DVec2, b: DVec2, c: DVec2| (b - a).perp_dot(c - a);
-        d(p, q, r) * d(p, q, s) < 0.0 && d(r, s, p) * d(r, s, q) < 0.0
-    };
-    if cross(a, b) {
-        return 0.0;
-    }
-    point_segment(a[0], b)
-        .min(point_segment(a[1], b))
-        .min(point_segment(b[0], a))
-        .min(point_segment(b[1], a))
 }
 
 /// Whether two handles have the same kind and rest geometry.

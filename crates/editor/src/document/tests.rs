@@ -384,20 +384,6 @@ fn bad_cage_edits_change_nothing() {
 }
 
 #[test]
-fn segment_distances() {
-    let p = |x, y| DVec2::new(x, y);
-    assert_eq!(segment_distance([p(0.0, 0.0); 2], [p(3.0, 4.0); 2]), 5.0);
-    assert_eq!(
-        segment_distance([p(0.0, 1.0), p(4.0, 1.0)], [p(2.0, 3.0); 2]),
-        2.0
-    );
-    assert_eq!(
-        segment_distance([p(0.0, 0.0), p(2.0, 2.0)], [p(0.0, 2.0), p(2.0, 0.0)]),
-        0.0
-    );
-}
-
-#[test]
 fn saved_projects_name_the_picture_relative_to_the_file() {
     let mut doc = document();
     doc.image_path = Some(PathBuf::from("/tmp/pictures/cat.png"));
