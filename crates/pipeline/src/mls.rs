@@ -39,6 +39,8 @@ pub struct MlsRig {
     table: Arc<mls::Mls>,
     /// The vertices in the current pose.
     positions: Vec<DVec2>,
+    /// The previous pose's buffer, reused for the next.
+    spare: Vec<DVec2>,
     /// Milliseconds of the last precomputation and the last pose.
     setup_ms: f64,
     pose_ms: f64,
@@ -91,6 +93,7 @@ impl MlsRig {
             options,
             table: Arc::new(table),
             positions: Vec::new(),
+            spare: Vec::new(),
             setup_ms: ms(clock),
             pose_ms: 0.0,
         };
@@ -116,12 +119,15 @@ impl MlsRig {
         }
         let clock = Instant::now();
         let posed: Vec<mls::Control> = handles.iter().map(posed_control).collect();
-        let mut positions = vec![DVec2::ZERO; self.rest.len()];
+        // Deformed into the spare buffer, which becomes the positions only when all
+        // went well (no allocation per pose).
+        let mut positions = std::mem::take(&mut self.spare);
+        positions.resize(self.rest.len(), DVec2::ZERO);
         self.table.deform(&posed, &mut positions)?;
         if let Some(v) = positions.iter().position(|p| !p.is_finite()) {
             bail!("moving least squares sent vertex {v} to a non-finite position");
         }
-        self.positions = positions;
+        self.spare = std::mem::replace(&mut self.positions, positions);
         self.handles = handles.to_vec();
         self.pose_ms = ms(clock);
         Ok(())
