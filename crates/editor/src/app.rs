@@ -6,9 +6,10 @@ use std::time::Instant;
 
 use anyhow::{Context as _, Result};
 use glam::DVec2;
-use project::{HandleSpec, Method};
+use project::{HandleSpec, Method, Project};
 
 use crate::brush::Brush;
+use crate::cage::CageTool;
 use crate::dialogs::{Answer, BuiltinDialog, Dialogs, FileAction, NativeDialogs, Shown};
 use crate::document::{CageKey, Document, Edit, posed};
 use crate::gpu_frame::{FrameBuilder, View};
@@ -136,11 +137,9 @@ pub struct EditorApp {
     pub(crate) file_dialog: Option<BuiltinDialog>,
     /// The rigidity brush: its radius and weight, the stroke under way.
     pub brush: Brush,
-    /// The cage tool's state.
-    pub(crate) cage: crate::cage::CageTool,
-    /// Mesh vertices inside a new cage, unless the project names a count (the side
-    /// panel changes it per cage): the solve's time grows quickly with it.
-    pub cage_vertices: usize,
+    /// The cage tool: its settings (the vertices of a cage from the outline, the mesh
+    /// vertices inside a new cage), the polygon being drawn, the selection.
+    pub cage: CageTool,
     /// Where the built-in file dialog starts when the document has no file of its own
     /// (else the current folder).
     pub default_folder: Option<PathBuf>,
@@ -228,8 +227,7 @@ impl EditorApp {
             builtin_dialogs: false,
             file_dialog: None,
             brush: Brush::default(),
-            cage: crate::cage::CageTool::default(),
-            cage_vertices: pipeline::cage::DEFAULT_CAGE_VERTICES,
+            cage: CageTool::default(),
             default_folder: None,
             gpu: FrameBuilder::default(),
             has_gpu,
@@ -318,34 +316,16 @@ impl EditorApp {
         Ok(())
     }
 
-    /// The cage tool's part of [`EditorApp::sanity_check`]: its selection and drag
-    /// name vertices the cage has, and a polygon is drawn only with the cage tool.
+    /// The cage tool's part of [`EditorApp::sanity_check`]: the tool's own
+    /// ([`CageTool::sanity_check`]), and a polygon is drawn, or LBC used, only with
+    /// the cage tool.
     fn cage_sanity_check(&self, doc: &Document) -> Result<()> {
-        let count = doc.cage().map_or(0, |c| c.rest.len());
-        if let Some(&i) = self.cage.selected.iter().find(|&&i| i >= count) {
-            anyhow::bail!("cage vertex {i} is selected, but the cage has {count}");
-        }
-        let mut seen = self.cage.selected.clone();
-        seen.sort_unstable();
-        seen.dedup();
-        if seen.len() != self.cage.selected.len() {
-            anyhow::bail!("a cage vertex is selected twice");
-        }
-        if let Some(drag) = &self.cage.drag
-            && (drag.count() != count || drag.vertices().any(|i| i >= count))
-        {
-            anyhow::bail!("a drag holds cage vertices the cage of {count} does not have");
-        }
-        if self.cage.draft.is_some() && self.tool != Tool::Cage {
+        self.cage.sanity_check(doc)?;
+        if self.cage.draft().is_some() && self.tool != Tool::Cage {
             anyhow::bail!("a cage is being drawn with the {:?} tool", self.tool);
         }
         if doc.method() == Method::Lbc && self.tool != Tool::Cage {
             anyhow::bail!("LBC with the {:?} tool", self.tool);
-        }
-        if let Some(draft) = &self.cage.draft
-            && draft.iter().any(|p| !p.is_finite())
-        {
-            anyhow::bail!("a cage being drawn has a non-finite vertex");
         }
         Ok(())
     }
@@ -543,8 +523,10 @@ impl EditorApp {
             return;
         }
         if tool != Tool::Cage {
-            self.end_cage_gesture();
-            self.cage.draft = None;
+            self.with_cage(|cage, host| {
+                cage.finish_gesture(host);
+                cage.cancel();
+            });
         }
         self.tool = tool;
         self.bar_start = None;
@@ -583,7 +565,7 @@ impl EditorApp {
     /// left to act on, so the puppet tool.
     fn sync_tool_after_history(&mut self, was_lbc: bool) {
         let lbc = self.doc.as_ref().is_some_and(|d| d.method() == Method::Lbc);
-        if was_lbc && !lbc && self.tool == Tool::Cage && self.cage.draft.is_none() {
+        if was_lbc && !lbc && self.tool == Tool::Cage && self.cage.draft().is_none() {
             self.end_cage_gesture();
             self.tool = Tool::Puppet;
         }
@@ -670,11 +652,8 @@ impl EditorApp {
 
     /// Ends a handle drag: one undo step if it changed anything.
     pub(crate) fn finish_drag(&mut self) {
-        if let (Some(drag), Some(doc)) = (self.drag.take(), &self.doc)
-            && doc.project() != &without_virtuals(&drag.before)
-        {
-            self.history.push(drag.before);
-            self.dirty = true;
+        if let Some(drag) = self.drag.take() {
+            Host::record(self, drag.before);
         }
     }
 
@@ -947,10 +926,7 @@ impl EditorApp {
                 self.history.clear();
                 self.dirty = false;
                 self.selected = None;
-                self.cage = crate::cage::CageTool {
-                    outline_vertices: self.cage.outline_vertices,
-                    ..crate::cage::CageTool::default()
-                };
+                self.cage.forget_document();
                 if lbc {
                     self.tool = Tool::Cage;
                 }
@@ -1331,12 +1307,52 @@ impl Host for EditorApp {
         self.show
     }
 
+    fn shows_mut(&mut self) -> &mut Show {
+        &mut self.show
+    }
+
     fn edit(&mut self, edit: Edit) -> bool {
         EditorApp::edit(self, edit)
     }
 
+    fn busy(&self) -> bool {
+        self.is_busy()
+    }
+
+    fn preview(&mut self, project: Project) {
+        let Some(doc) = &mut self.doc else { return };
+        if let Err(e) = doc.restore(project) {
+            self.error(&e);
+        }
+    }
+
+    fn record(&mut self, before: Project) {
+        if let Some(doc) = &self.doc
+            && doc.project() != &without_virtuals(&before)
+        {
+            self.history.push(before);
+            self.dirty = true;
+        }
+    }
+
+    fn solve_cage(&mut self, key: CageKey) {
+        self.start_cage_solve(key, None);
+    }
+
+    fn panning(&self) -> bool {
+        self.panning
+    }
+
+    fn pan(&mut self) {
+        self.panning = true;
+    }
+
     fn info(&mut self, text: &str) {
         EditorApp::info(self, text);
+    }
+
+    fn error(&mut self, error: &anyhow::Error) {
+        EditorApp::error(self, error);
     }
 
     fn mesh_version(&self) -> u64 {

@@ -123,7 +123,8 @@ impl EditorApp {
         }
         if cage_view {
             let pointer = ui.input(|i| i.pointer.latest_pos());
-            self.paint_cage(&painter, pointer);
+            let active = self.tool == Tool::Cage;
+            self.with_cage(|cage, host| cage.paint(host, &painter, pointer, active));
         } else {
             let (pointer, alt) = ui.input(|i| (i.pointer.latest_pos(), i.modifiers.alt));
             let brushing = self.tool == Tool::Rigidity;
@@ -277,7 +278,7 @@ impl EditorApp {
             self.with_brush(|brush, host| brush.input(host, ui, response));
         }
         if self.tool == Tool::Cage {
-            self.cage_input(ui, response);
+            self.with_cage(|cage, host| cage.input(host, ui, response));
         }
         if response.drag_started_by(PointerButton::Middle)
             || (response.drag_started_by(PointerButton::Primary) && space)
@@ -630,10 +631,7 @@ impl EditorApp {
             return;
         };
         let text = if self.cage_view() {
-            if self.cage.drag.is_some() || self.cage.boxing.is_some() {
-                return;
-            }
-            match self.cage_hover(pos) {
+            match self.with_cage(|cage, host| cage.readout(host, pos)) {
                 Some(text) => text,
                 None => return,
             }

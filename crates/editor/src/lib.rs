@@ -11,6 +11,7 @@
 mod app;
 mod brush;
 mod cage;
+mod cage_commands;
 mod canvas;
 mod dialogs;
 mod document;

@@ -134,7 +134,9 @@ impl eframe::App for EditorApp {
                 .resizable(false)
                 .default_size(300.0)
                 .show(ui, |ui| {
-                    egui::ScrollArea::vertical().show(ui, |ui| self.locality_panel(ui));
+                    egui::ScrollArea::vertical().show(ui, |ui| {
+                        self.with_cage(|cage, host| cage.locality_panel(host, ui));
+                    });
                 });
         }
         egui::CentralPanel::default()
@@ -221,7 +223,7 @@ impl EditorApp {
             self.export();
         }
         if self.tool == Tool::Cage {
-            self.cage_keys(ctx);
+            self.with_cage(|cage, host| cage.keys(host, ctx));
         }
         let none = Modifiers::NONE;
         if pressed(none, Key::Delete) || pressed(none, Key::Backspace) {
@@ -379,7 +381,7 @@ impl EditorApp {
 
     fn edit_buttons(&mut self, ui: &mut Ui) {
         if self.doc.as_ref().is_some_and(|d| d.method() == Method::Lbc) {
-            self.cage_edit_buttons(ui);
+            self.with_cage(|cage, host| cage.edit_buttons(host, ui));
             return;
         }
         if ui
@@ -503,7 +505,7 @@ impl EditorApp {
         let lbc = self.doc.as_ref().is_some_and(|d| d.method() == Method::Lbc);
         if lbc || self.tool == Tool::Cage {
             ui.heading("Cage");
-            self.cage_panel(ui);
+            self.with_cage(|cage, host| cage.panel(host, ui));
             ui.separator();
         }
         if self.doc.as_ref().is_some_and(|d| d.method() == Method::Mls) {

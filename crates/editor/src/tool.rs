@@ -1,11 +1,14 @@
 //! The canvas tools' one interface. A tool owns its state (a stroke under way, a
 //! cache of what it draws) and sees the editor only through [`Host`]: the document,
-//! the view, the one edit path, and the status line. So a tool needs nothing of the
-//! app's other state, and the app holds its tools without the tools knowing the app.
+//! the view and its overlays, the one edit path (with a drag's preview and the undo
+//! step that ends it), the worker's jobs, and the status line. So a tool needs nothing
+//! of the app's other state, and the app holds its tools without the tools knowing
+//! the app.
 
-use egui::{Painter, Pos2, Response, Ui};
+use egui::{Context, Painter, Pos2, Response, Ui};
+use project::Project;
 
-use crate::document::{Document, Edit};
+use crate::document::{CageKey, Document, Edit};
 use crate::show::Show;
 use crate::viewport::Viewport;
 
@@ -20,11 +23,36 @@ pub(crate) trait Host {
     fn viewport(&self) -> &Viewport;
     /// Which overlays are on.
     fn shows(&self) -> Show;
+    /// The overlay switches, to turn them on or off.
+    fn shows_mut(&mut self) -> &mut Show;
     /// Applies `edit` as every edit is applied (one undo step, the rebuild it needs, a
-    /// message if it is refused); whether it was applied.
+    /// message if it is refused); whether it was applied. The host ends the gestures
+    /// it holds first; a tool, lent out while it runs, ends its own before it calls
+    /// this.
     fn edit(&mut self, edit: Edit) -> bool;
+    /// Whether a job runs on the worker (opening, re-meshing, solving): until it is
+    /// done, [`Host::edit`] refuses edits.
+    fn busy(&self) -> bool;
+    /// Shows `project` as the document while a gesture (a drag) is under way, without
+    /// an undo step: the gesture makes one when it ends, with [`Host::record`]. A
+    /// project the document cannot take is refused in the status bar.
+    fn preview(&mut self, project: Project);
+    /// Ends a gesture that began on `before` (the document's
+    /// [`Document::snapshot`] then): one undo step back to it, if the document has
+    /// changed since.
+    fn record(&mut self, before: Project);
+    /// Solves the coordinates of the cage of `key` on the worker, showing the solve's
+    /// progress (Escape cancels); the document takes them when they are in. A cage
+    /// that cannot be solved, or a job already running, is refused in the status bar.
+    fn solve_cage(&mut self, key: CageKey);
+    /// Whether the drag under way pans the view (a tool then leaves it alone).
+    fn panning(&self) -> bool;
+    /// Makes the drag just started pan the view.
+    fn pan(&mut self);
     /// A line in the status bar.
     fn info(&mut self, text: &str);
+    /// A line in the status bar, in red: why something was refused or failed.
+    fn error(&mut self, error: &anyhow::Error);
     /// The GPU mesh's version: new for every mesh of every document, so it keys what
     /// a tool caches about the mesh.
     fn mesh_version(&self) -> u64;
@@ -46,6 +74,12 @@ pub(crate) trait CanvasTool {
     );
     /// The tool's part of the side panel.
     fn panel(&mut self, host: &mut dyn Host, ui: &mut Ui);
+    /// The tool's keyboard shortcuts, while it is active and the keys are the
+    /// editor's: called before the editor's own, so a key the tool consumes does
+    /// nothing else. None by default.
+    fn keys(&mut self, host: &mut dyn Host, ctx: &Context) {
+        let _ = (host, ctx);
+    }
     /// Drops the gesture under way, if any (Escape, another tool, a new document).
     fn cancel(&mut self);
 }

@@ -78,7 +78,7 @@ fn draw_cage(h: &mut Harness<'_, EditorApp>, points: &[[f64; 2]]) {
 /// The built-in picture with the body cage drawn, at a small density, solved.
 fn solved_body(dir: &std::path::Path) -> Harness<'static, EditorApp> {
     let mut h = editor(dir);
-    h.state_mut().cage_vertices = DENSITY;
+    h.state_mut().cage.inside_vertices = DENSITY;
     draw_cage(&mut h, &BODY);
     assert_eq!(h.state().cage_state(), CageState::Rest);
     solve_with_enter(&mut h);
@@ -495,7 +495,7 @@ fn undo_to_a_posed_cage_whose_coordinates_were_forgotten_solves_it_first() {
 fn after_a_cage_from_the_outline_enter_solves_it() {
     let dir = tempfile::tempdir().expect("temp dir");
     let mut h = editor(dir.path());
-    h.state_mut().cage_vertices = DENSITY;
+    h.state_mut().cage.inside_vertices = DENSITY;
     click_label(&mut h, "LBC cage");
     // Drawing a cage is LBC's: the method shows as LBC before the cage exists.
     assert_eq!(h.state().tool, Tool::Cage);

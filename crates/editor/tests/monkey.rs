@@ -539,7 +539,7 @@ fn walk(seed: u64, actions: usize) {
         .with_max_steps(10_000);
     let mut h = build(builder, Box::new(dialogs), gpu);
     // New cages are solved on a small mesh, so a debug build solves in a second.
-    h.state_mut().cage_vertices = 120;
+    h.state_mut().cage.inside_vertices = 120;
     let mut monkey = Monkey {
         h,
         rng,
