@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use anyhow::{Context as _, Result};
 use glam::DVec2;
-use project::{HandleSpec, Method, Project};
+use project::{Controls, HandleSpec, Method, Project};
 
 use crate::brush::Brush;
 use crate::cage::CageTool;
@@ -157,6 +157,10 @@ pub struct EditorApp {
     /// Milliseconds the last frame's logic took on the CPU.
     pub frame_ms: f64,
 }
+
+mod files;
+mod host;
+mod work;
 
 impl EditorApp {
     /// The editor on `path` (a picture, or a `.json` project), or on the built-in
@@ -324,7 +328,7 @@ impl EditorApp {
         if self.cage.draft().is_some() && self.tool != Tool::Cage {
             anyhow::bail!("a cage is being drawn with the {:?} tool", self.tool);
         }
-        if doc.method() == Method::Lbc && self.tool != Tool::Cage {
+        if doc.method().controls() == Controls::Cage && self.tool != Tool::Cage {
             anyhow::bail!("LBC with the {:?} tool", self.tool);
         }
         Ok(())
@@ -401,11 +405,20 @@ impl EditorApp {
                 return true;
             }
         }
-        // Setting up ARAP (registration and factorisation) or repainting it takes a
-        // noticeable time on a large mesh: on the worker too.
-        if let (Edit::Method(Method::Arap) | Edit::Rigidity(_), Some(doc)) = (&edit, &self.doc)
+        // Setting a method up on the mesh (ARAP's factorisation, MLS's fits), or
+        // repainting the rigidity a method reads, takes a noticeable time on a large
+        // mesh: on the worker too.
+        let heavy = match &edit {
+            Edit::Method(method) => method.sets_up_on_the_mesh(),
+            Edit::Rigidity(_) => self
+                .doc
+                .as_ref()
+                .is_some_and(|d| d.method().reads_rigidity()),
+            _ => false,
+        };
+        if heavy
+            && let Some(doc) = &self.doc
             && doc.rig().domain().len() > self.large_mesh
-            && (doc.method() == Method::Arap || matches!(edit, Edit::Method(_)))
         {
             let before = doc.snapshot();
             let mut copy = doc.clone();
@@ -514,7 +527,10 @@ impl EditorApp {
     /// cage tool is LBC's: picking it with a cage kept in the project chooses LBC (one
     /// undo step); under LBC, the handle tools wait until C² or ARAP is chosen.
     pub fn set_tool(&mut self, tool: Tool) {
-        let lbc = self.doc.as_ref().is_some_and(|d| d.method() == Method::Lbc);
+        let lbc = self
+            .doc
+            .as_ref()
+            .is_some_and(|d| d.method().controls() == Controls::Cage);
         if lbc && tool != Tool::Cage {
             self.info(
                 "under LBC the cage moves the picture: choose C² weights or ARAP under Method \
@@ -535,7 +551,7 @@ impl EditorApp {
             && let Some(doc) = &self.doc
         {
             if doc.cage().is_some() {
-                if self.edit(Edit::Method(Method::Lbc)) {
+                if self.edit(Edit::Method(Method::for_controls(Controls::Cage))) {
                     self.info("LBC cage: the cage kept in the project warps the picture");
                 }
             } else {
@@ -551,7 +567,10 @@ impl EditorApp {
     /// Under LBC the cage tool is the tool (handles act under C² and ARAP): after any
     /// change that may have chosen LBC (an undo, an opened project), it is picked.
     pub(crate) fn sync_tool(&mut self) {
-        let lbc = self.doc.as_ref().is_some_and(|d| d.method() == Method::Lbc);
+        let lbc = self
+            .doc
+            .as_ref()
+            .is_some_and(|d| d.method().controls() == Controls::Cage);
         if lbc && self.tool != Tool::Cage {
             self.finish_drag();
             self.tool = Tool::Cage;
@@ -564,7 +583,10 @@ impl EditorApp {
     /// the cage tool; out of LBC with no cage being drawn, the cage tool has nothing
     /// left to act on, so the puppet tool.
     fn sync_tool_after_history(&mut self, was_lbc: bool) {
-        let lbc = self.doc.as_ref().is_some_and(|d| d.method() == Method::Lbc);
+        let lbc = self
+            .doc
+            .as_ref()
+            .is_some_and(|d| d.method().controls() == Controls::Cage);
         if was_lbc && !lbc && self.tool == Tool::Cage && self.cage.draft().is_none() {
             self.end_cage_gesture();
             self.tool = Tool::Puppet;
@@ -578,13 +600,13 @@ impl EditorApp {
         let Some(doc) = &self.doc else { return };
         if method == doc.method() {
             // Drawing a cage for LBC, and back to the method already in use.
-            if method != Method::Lbc && self.tool == Tool::Cage {
+            if method.controls() != Controls::Cage && self.tool == Tool::Cage {
                 self.set_tool(Tool::Puppet);
                 self.info(format!("{}: drawing the cage dropped", method.label()));
             }
             return;
         }
-        if method == Method::Lbc {
+        if method.controls() == Controls::Cage {
             self.set_tool(Tool::Cage);
             if !matches!(self.message.as_ref(), Some(m) if m.is_error) {
                 let has_cage = self.doc.as_ref().is_some_and(|d| d.cage().is_some());
@@ -678,7 +700,7 @@ impl EditorApp {
         };
         // A posed cage whose coordinates are no longer kept is solved first, on the
         // worker; the history moves when they are in.
-        if target.method == Method::Lbc
+        if target.method.controls() == Controls::Cage
             && target.cage.as_ref().is_some_and(|c| c.pose.is_some())
             && let Some(key) = CageKey::of(target)
             && doc.solution_for(&key).is_none()
@@ -719,7 +741,7 @@ impl EditorApp {
         };
         let Some(target) = taken else { return };
         let from = doc.project().clone();
-        let was_lbc = from.method == Method::Lbc;
+        let was_lbc = from.method.controls() == Controls::Cage;
         match doc.undo_to(target.clone()) {
             Ok(()) => {
                 let what = crate::history::describe_change(&from, doc.project());
@@ -746,508 +768,6 @@ impl EditorApp {
         }
     }
 
-    /// Opens a picture or (for `.json`) a project, asking first if there are unsaved
-    /// changes.
-    pub fn request_open(&mut self, path: PathBuf) {
-        if self.dirty {
-            self.pending = Some(Pending::Open(path));
-        } else {
-            self.open_in_background(path);
-        }
-    }
-
-    /// Opens a picture or (for `.json`) a project now, waiting for it. On failure the
-    /// current document stays and the status line says why.
-    pub fn open(&mut self, path: &Path) {
-        let outcome = open_outcome(
-            path.to_path_buf(),
-            &CancelFlag::default(),
-            &SolveProgress::default(),
-        );
-        self.finish(outcome);
-    }
-
-    /// Opens a picture or project on a worker thread (an LBC project's cage is solved
-    /// there too); the editor shows progress and takes no edits until it is in.
-    pub fn open_in_background(&mut self, path: PathBuf) {
-        let label = format!("Opening {}", file_name(&path));
-        let (cancel, progress) = (CancelFlag::default(), SolveProgress::default());
-        let (flag, steps) = (cancel.clone(), progress.clone());
-        let work = move || open_outcome(path, &flag, &steps);
-        self.start_job(label, cancel, work);
-        if let Some(job) = &mut self.job {
-            job.progress = Some(progress);
-        }
-    }
-
-    /// Solves the cage of `key` on the worker, showing its iterations and residuals;
-    /// `then`: undo (`true`) or redo once it is in.
-    pub(crate) fn start_cage_solve(&mut self, key: CageKey, then: Option<bool>) {
-        if let Some(problem) = key.problem() {
-            self.error(&anyhow::anyhow!(problem));
-            return;
-        }
-        let (cancel, progress) = (CancelFlag::default(), SolveProgress::default());
-        let (flag, steps) = (cancel.clone(), progress.clone());
-        let label = format!("Solving the cage ({} vertices inside)", key.vertices);
-        self.start_job(label, cancel, move || {
-            let clock = Instant::now();
-            let solution = crate::document::solve_cage(&key, &mut |step| {
-                steps.set(*step);
-                !flag.is_set()
-            });
-            Outcome::CageSolved {
-                key,
-                solution,
-                then,
-                ms: clock.elapsed().as_secs_f64() * 1e3,
-            }
-        });
-        if let Some(job) = &mut self.job {
-            job.progress = Some(progress);
-        }
-    }
-
-    /// The first and latest iteration of a cage's solve under way.
-    pub fn solve_progress(&self) -> Option<(lbc::Progress, lbc::Progress)> {
-        self.job.as_ref()?.progress.as_ref()?.get()
-    }
-
-    /// Starts `work` on a worker thread unless a job is running (then says so). Any
-    /// gesture in progress ends first: the document may change when the job is in.
-    fn start_job(
-        &mut self,
-        label: String,
-        cancel: CancelFlag,
-        work: impl FnOnce() -> Outcome + Send + 'static,
-    ) {
-        if let Some(job) = &self.job {
-            let running = job.label.clone();
-            self.error(&anyhow::anyhow!(
-                "{label} waits: {running}… is still running (cancel it with Escape)"
-            ));
-            return;
-        }
-        self.end_gesture();
-        self.job = Some(Job::spawn_cancellable(
-            label,
-            self.wake.clone(),
-            cancel,
-            work,
-        ));
-    }
-
-    /// Re-meshes and re-weights the picture for `settings` on a worker thread.
-    fn rebuild_in_background(&mut self, settings: crate::document::Settings) {
-        let Some(doc) = &self.doc else { return };
-        let before = doc.snapshot();
-        let mut project = doc.project().clone();
-        settings.write_to(&mut project);
-        let label = format!("Meshing at {} vertices", settings.density);
-        let work = remesh(
-            doc,
-            project,
-            Rebuild::Edit {
-                before: Box::new(before),
-            },
-        );
-        self.start_job(label, CancelFlag::default(), work);
-    }
-
-    /// Steps through the history to `target`, whose density differs from the
-    /// document's, on a worker thread. The history moves when the new mesh is in.
-    fn restore_in_background(&mut self, back: bool, target: project::Project) {
-        let Some(doc) = &self.doc else { return };
-        let density = crate::document::Settings::of(&target).density;
-        let label = format!(
-            "{} a density change: meshing at {density} vertices",
-            if back { "Undoing" } else { "Redoing" }
-        );
-        let work = remesh(doc, target, Rebuild::History { back });
-        self.start_job(label, CancelFlag::default(), work);
-    }
-
-    /// Whether a job (opening, re-meshing, exporting) is running.
-    pub fn is_busy(&self) -> bool {
-        self.job.is_some()
-    }
-
-    /// What the running job does, and for how long it has run (seconds).
-    pub fn busy_with(&self) -> Option<(&str, f64)> {
-        self.job
-            .as_ref()
-            .map(|j| (j.label.as_str(), j.started.elapsed().as_secs_f64()))
-    }
-
-    /// Gives up on the running job, if any: the document stays as it was, and an
-    /// export writes nothing (unless it was already writing).
-    pub fn cancel_job(&mut self) {
-        if let Some(job) = self.job.take() {
-            let label = job.label.clone();
-            job.cancel();
-            self.info(format!("cancelled: {label}"));
-        }
-    }
-
-    /// Takes in the running job's result if it is done.
-    pub(crate) fn poll_job(&mut self) {
-        if let Some(outcome) = self.job.as_ref().and_then(Job::poll) {
-            self.job = None;
-            self.finish(outcome);
-        }
-    }
-
-    /// Waits for the running job, if any, and takes in its result.
-    pub fn wait_for_job(&mut self) {
-        if let Some(outcome) = self.job.take().and_then(Job::wait) {
-            self.finish(outcome);
-        }
-    }
-
-    fn finish(&mut self, outcome: Outcome) {
-        self.finish_outcome(outcome);
-        self.sync_tool();
-    }
-
-    fn finish_outcome(&mut self, outcome: Outcome) {
-        match outcome {
-            Outcome::Opened {
-                path,
-                is_project,
-                document: Ok(doc),
-            } => {
-                let stats = doc.rig().stats();
-                let what = if is_project { "project" } else { "image" };
-                self.end_gesture();
-                let lbc = doc.method() == Method::Lbc;
-                let unsolved = lbc && doc.cage_solution().is_none();
-                let problem = CageKey::of(doc.project()).and_then(|k| k.problem());
-                self.doc = Some(doc);
-                self.history.clear();
-                self.dirty = false;
-                self.selected = None;
-                self.cage.forget_document();
-                if lbc {
-                    self.tool = Tool::Cage;
-                }
-                self.needs_fit = true;
-                self.settings_draft = None;
-                self.info(format!(
-                    "opened {what} {} ({} mesh vertices)",
-                    path.display(),
-                    stats.samples
-                ));
-                if unsolved {
-                    let why = problem.unwrap_or_else(|| {
-                        "the cage is not solved: press Solve (Enter) to warp".to_owned()
-                    });
-                    self.error(&anyhow::anyhow!(why));
-                }
-            }
-            Outcome::Opened {
-                path,
-                document: Err(e),
-                ..
-            } => self.error(&e.context(format!("cannot open {}", path.display()))),
-            Outcome::Rebuilt {
-                cause,
-                document: Ok(mut doc),
-            } => {
-                self.end_gesture();
-                let was_lbc = self.doc.as_ref().is_some_and(|d| d.method() == Method::Lbc);
-                let history = match &cause {
-                    Rebuild::History { back } => self.doc.as_ref().map(|old| {
-                        let what = crate::history::describe_change(old.project(), doc.project());
-                        format!("{}: {what}; ", if *back { "undone" } else { "redone" })
-                    }),
-                    Rebuild::Edit { .. } => None,
-                };
-                let mut kept = Ok(());
-                if let Some(old) = &self.doc {
-                    kept = doc.keep_solutions_of(old);
-                    doc.project_path.clone_from(&old.project_path);
-                    doc.weights_version = old.weights_version + 1;
-                    doc.pose_version = old.pose_version + 1;
-                    let current = old.snapshot();
-                    match cause {
-                        Rebuild::Edit { before } => self.history.push(*before),
-                        Rebuild::History { back: true } => {
-                            self.history.undo(current);
-                        }
-                        Rebuild::History { back: false } => {
-                            self.history.redo(current);
-                        }
-                    }
-                }
-                if let Err(e) = kept {
-                    self.error(&e.context("the solved cage does not fit the rebuilt picture"));
-                }
-                let stats = doc.rig().stats();
-                let ms = doc.last_update_ms;
-                let handles = doc.project().handles.len();
-                let remeshed = self
-                    .doc
-                    .as_ref()
-                    .is_none_or(|old| old.settings().density != doc.settings().density);
-                let short = remeshed
-                    .then(|| {
-                        pipeline::density_shortfall(doc.rig().domain(), doc.settings().density)
-                    })
-                    .flatten();
-                self.doc = Some(doc);
-                if self.selected.is_some_and(|s| s >= handles) {
-                    self.selected = None;
-                }
-                if let Some(doc) = &self.doc {
-                    self.cage
-                        .retain_valid(doc.cage().map_or(0, |c| c.rest.len()));
-                }
-                self.dirty = true;
-                self.settings_draft = None;
-                let what = if remeshed { "re-meshed" } else { "rebuilt" };
-                self.info(format!(
-                    "{}{what}: {} vertices, weights in {ms:.0} ms{}",
-                    history.unwrap_or_default(),
-                    stats.samples,
-                    short.unwrap_or_default()
-                ));
-                self.sync_tool_after_history(was_lbc);
-            }
-            Outcome::Rebuilt {
-                document: Err(e), ..
-            } => {
-                self.settings_draft = None;
-                self.error(&e.context("cannot rebuild the weights"));
-            }
-            Outcome::Exported {
-                path,
-                result: Ok(()),
-                ms,
-            } => self.info(format!("exported {} in {ms:.0} ms", path.display())),
-            Outcome::Exported { result: Err(e), .. } => self.error(&e),
-            Outcome::CageSolved {
-                key,
-                solution: Ok(solution),
-                then,
-                ms,
-            } => {
-                let Some(doc) = &mut self.doc else { return };
-                let report = solution.report.clone();
-                let vertices = solution.domain.positions().len();
-                if let Err(e) = doc.add_solution(key, solution) {
-                    self.error(&e);
-                    return;
-                }
-                self.info(format!(
-                    "solved the cage in {:.1} s: {vertices} vertices inside, {} ADMM \
-                     iterations{}; drag a vertex to warp",
-                    ms / 1e3,
-                    report.iterations,
-                    if report.converged {
-                        ""
-                    } else {
-                        " (stopped at the iteration cap, not converged)"
-                    }
-                ));
-                if let Some(back) = then {
-                    self.step_history(back);
-                }
-            }
-            Outcome::CageSolved {
-                solution: Err(e), ..
-            } => self.error(&e.context("cannot solve the cage")),
-        }
-    }
-
-    /// Asks for a file for `action` — with the desktop's dialog where there is one,
-    /// else with the built-in one — and acts on it when chosen.
-    pub fn ask_file(&mut self, action: FileAction) {
-        if self.file_dialog.is_some() {
-            return;
-        }
-        let suggested = match action {
-            FileAction::SaveProject => self.suggested_name("json"),
-            FileAction::ExportPng => self.suggested_name("warped.png"),
-            FileAction::OpenImage | FileAction::OpenProject => String::new(),
-        };
-        if !self.builtin_dialogs {
-            match self.dialogs.ask(action, &suggested) {
-                Answer::Chosen(path) => return self.file_chosen(action, path),
-                Answer::Cancelled => return,
-                Answer::Unavailable => {
-                    self.builtin_dialogs = true;
-                    self.info("the desktop offers no file dialog here: using the built-in one");
-                }
-            }
-        }
-        let folder = self.working_folder();
-        self.file_dialog = Some(BuiltinDialog::open(action, &folder, &suggested));
-    }
-
-    /// Whether the built-in file dialog is open.
-    pub fn file_dialog_open(&self) -> bool {
-        self.file_dialog.is_some()
-    }
-
-    /// Shows the built-in file dialog, if open, and acts on its answer.
-    pub(crate) fn file_dialog_ui(&mut self, ctx: &egui::Context) {
-        let Some(dialog) = &mut self.file_dialog else {
-            return;
-        };
-        let action = dialog.action;
-        match dialog.show(ctx) {
-            Shown::Open => {}
-            Shown::Cancelled => self.file_dialog = None,
-            Shown::Chosen(path) => {
-                self.file_dialog = None;
-                if action.writes() && path.exists() {
-                    // The desktop's dialogs ask before replacing a file; so does this one.
-                    self.pending = Some(Pending::Replace(action, path));
-                } else {
-                    self.file_chosen(action, path);
-                }
-            }
-        }
-    }
-
-    /// Acts on a file the user chose for `action`.
-    pub(crate) fn file_chosen(&mut self, action: FileAction, path: PathBuf) {
-        match action {
-            FileAction::OpenImage | FileAction::OpenProject => self.request_open(path),
-            FileAction::SaveProject => self.save_to(&path),
-            FileAction::ExportPng => self.export_in_background(path),
-        }
-    }
-
-    /// The folder dialogs start in: the project's or the picture's, else the current one.
-    fn working_folder(&self) -> PathBuf {
-        let from_doc = self.doc.as_ref().and_then(|d| {
-            d.project_path
-                .as_deref()
-                .or(d.image_path.as_deref())
-                .and_then(Path::parent)
-                .filter(|p| !p.as_os_str().is_empty())
-                .map(Path::to_path_buf)
-        });
-        from_doc
-            .or_else(|| self.default_folder.clone())
-            .or_else(|| std::env::current_dir().ok())
-            .unwrap_or_else(|| PathBuf::from("."))
-    }
-
-    /// Saves the project where it was last saved, or asks where.
-    pub fn save(&mut self) {
-        match self.doc.as_ref().and_then(|d| d.project_path.clone()) {
-            Some(path) => self.save_to(&path),
-            None => self.ask_file(FileAction::SaveProject),
-        }
-    }
-
-    /// Asks where to save the project, then saves it.
-    pub fn save_as(&mut self) {
-        self.ask_file(FileAction::SaveProject);
-    }
-
-    /// Writes the project to `path` atomically (a failure leaves any old file intact).
-    pub fn save_to(&mut self, path: &Path) {
-        let Some(doc) = &mut self.doc else { return };
-        let project = doc.project_for_saving(Some(path));
-        match render::write_atomic(path, project.to_json().as_bytes()) {
-            Ok(()) => {
-                doc.project_path = Some(path.to_path_buf());
-                self.dirty = false;
-                self.info(format!("saved {}", path.display()));
-            }
-            Err(e) => self.error(&anyhow::Error::from(e)),
-        }
-    }
-
-    /// Asks where to export, then writes the warped PNG.
-    pub fn export(&mut self) {
-        self.ask_file(FileAction::ExportPng);
-    }
-
-    /// Writes the warped picture at full resolution to `path` atomically, now: the
-    /// same pixels as `c2warp render` of the saved project.
-    pub fn export_to(&mut self, path: &Path) {
-        let Some(work) = self.export_work(path.to_path_buf(), CancelFlag::default()) else {
-            return;
-        };
-        self.finish(work());
-    }
-
-    /// As [`EditorApp::export_to`], on a worker thread (the editor shows progress).
-    pub fn export_in_background(&mut self, path: PathBuf) {
-        let cancel = CancelFlag::default();
-        let Some(work) = self.export_work(path.clone(), cancel.clone()) else {
-            return;
-        };
-        self.start_job(format!("Exporting {}", file_name(&path)), cancel, work);
-    }
-
-    /// The export of the current document to `path`, ready to run anywhere; it writes
-    /// nothing once `cancel` is set.
-    fn export_work(
-        &self,
-        path: PathBuf,
-        cancel: CancelFlag,
-    ) -> Option<impl FnOnce() -> Outcome + Send + 'static> {
-        let doc = self.doc.as_ref()?;
-        let project = doc.project_for_saving(None);
-        let image = doc.image.clone();
-        let deep = doc.deep.clone();
-        let cage = CageKey::of(&project)
-            .filter(|_| project.method == Method::Lbc)
-            .map(|key| (doc.solution_for(&key).cloned(), key, doc.cage_pose()));
-        Some(move || {
-            let clock = Instant::now();
-            let result = (|| -> Result<()> {
-                let warper = match cage {
-                    // The cage's coordinates already solved for it (else solved here).
-                    Some((solution, key, pose)) => {
-                        let solution = match solution {
-                            Some(solution) => solution,
-                            None => crate::document::solve_cage(&key, &mut |_| !cancel.is_set())?,
-                        };
-                        let deformer = pipeline::cage::CageDeformer::new(solution, pose)?;
-                        pipeline::Warper::in_mesh_order(Box::new(deformer), project.canvas)
-                    }
-                    None => pipeline::prepare_warper(&image, &project, None, &())?,
-                };
-                // A 16-bit picture exports with 16 bits, as `c2warp render` does.
-                let warped = match &deep {
-                    Some(deep) => pipeline::warp_picture(deep, &warper)?,
-                    None => render::Picture::Rgba8(pipeline::warp(&image, &warper)?),
-                };
-                if cancel.is_set() {
-                    anyhow::bail!("cancelled");
-                }
-                render::save_png_atomic(&path, &warped)?;
-                Ok(())
-            })()
-            .with_context(|| format!("cannot export {}", path.display()));
-            Outcome::Exported {
-                path,
-                result,
-                ms: clock.elapsed().as_secs_f64() * 1e3,
-            }
-        })
-    }
-
-    fn suggested_name(&self, extension: &str) -> String {
-        let stem = self
-            .doc
-            .as_ref()
-            .and_then(|d| d.image_path.as_ref())
-            .and_then(|p| p.file_stem())
-            .map_or_else(|| "lizard".to_owned(), |s| s.to_string_lossy().into_owned());
-        if extension.contains('.') {
-            format!("{stem}-{extension}")
-        } else {
-            format!("{stem}.{extension}")
-        }
-    }
-
     /// The canvas as the GPU draws it (no overlays), one image pixel to one output
     /// pixel, in the frame an export has (the picture's, or grown to fit the warp), on
     /// `gpu` (any adapter): to compare the view with an export.
@@ -1260,7 +780,7 @@ impl EditorApp {
         };
         let (w, h) = doc.image.dimensions();
         let canvas = doc.project().canvas;
-        let lbc = doc.method() == Method::Lbc;
+        let lbc = doc.method().controls() == Controls::Cage;
         let deformed: Vec<glam::Vec2> = match doc.cage_deformed() {
             Some(cage) if lbc => cage.iter().map(|p| p.as_vec2()).collect(),
             _ => doc.deformed().iter().map(|p| p.as_vec2()).collect(),
@@ -1287,147 +807,6 @@ impl EditorApp {
         if let Some(doc) = &self.doc {
             self.gpu.update(doc, &view);
         }
-    }
-}
-
-impl Host for EditorApp {
-    fn document(&self) -> Option<&Document> {
-        self.doc.as_ref()
-    }
-
-    fn document_mut(&mut self) -> Option<&mut Document> {
-        self.doc.as_mut()
-    }
-
-    fn viewport(&self) -> &Viewport {
-        &self.viewport
-    }
-
-    fn shows(&self) -> Show {
-        self.show
-    }
-
-    fn shows_mut(&mut self) -> &mut Show {
-        &mut self.show
-    }
-
-    fn edit(&mut self, edit: Edit) -> bool {
-        EditorApp::edit(self, edit)
-    }
-
-    fn busy(&self) -> bool {
-        self.is_busy()
-    }
-
-    fn preview(&mut self, project: Project) {
-        let Some(doc) = &mut self.doc else { return };
-        if let Err(e) = doc.restore(project) {
-            self.error(&e);
-        }
-    }
-
-    fn record(&mut self, before: Project) {
-        if let Some(doc) = &self.doc
-            && doc.project() != &without_virtuals(&before)
-        {
-            self.history.push(before);
-            self.dirty = true;
-        }
-    }
-
-    fn solve_cage(&mut self, key: CageKey) {
-        self.start_cage_solve(key, None);
-    }
-
-    fn panning(&self) -> bool {
-        self.panning
-    }
-
-    fn pan(&mut self) {
-        self.panning = true;
-    }
-
-    fn info(&mut self, text: &str) {
-        EditorApp::info(self, text);
-    }
-
-    fn error(&mut self, error: &anyhow::Error) {
-        EditorApp::error(self, error);
-    }
-
-    fn mesh_version(&self) -> u64 {
-        self.gpu.frame.mesh.version
-    }
-}
-
-impl EditorApp {
-    /// Runs `f` on the rigidity brush with the app as its host (the brush is lent out
-    /// for the call, so it and the host can both be changed).
-    pub(crate) fn with_brush<R>(&mut self, f: impl FnOnce(&mut Brush, &mut dyn Host) -> R) -> R {
-        let mut brush = std::mem::take(&mut self.brush);
-        let out = f(&mut brush, self);
-        self.brush = brush;
-        out
-    }
-
-    /// The triangles the painted-rigidity overlay drew last (their corners).
-    pub fn painted_triangles(&self) -> Vec<[u32; 3]> {
-        self.brush.painted_triangles()
-    }
-}
-
-/// A path's file name, for messages.
-fn file_name(path: &Path) -> String {
-    path.file_name().map_or_else(
-        || path.display().to_string(),
-        |n| n.to_string_lossy().into_owned(),
-    )
-}
-
-/// The re-mesh of `doc`'s picture for `project` (with its virtual handles, so a step
-/// through the history gets exactly that state's weights), ready to run anywhere.
-fn remesh(
-    doc: &Document,
-    project: project::Project,
-    cause: Rebuild,
-) -> impl FnOnce() -> Outcome + Send + 'static {
-    let image = doc.image.clone();
-    let deep = doc.deep.clone();
-    let image_path = doc.image_path.clone();
-    move || Outcome::Rebuilt {
-        cause,
-        document: Document::with_image(image, image_path, project).map(|mut d| {
-            d.deep = deep;
-            d
-        }),
-    }
-}
-
-/// Opens a picture or (for `.json`) a project; an LBC project's cage is solved (a cage
-/// that cannot be is left unsolved, for the user to fix).
-fn open_outcome(path: PathBuf, cancel: &CancelFlag, progress: &SolveProgress) -> Outcome {
-    let is_project = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("json"));
-    let document = if is_project {
-        Document::open_project(&path).map(|mut doc| {
-            let solvable = CageKey::of(doc.project()).is_some_and(|k| k.problem().is_none());
-            if doc.method() == Method::Lbc && solvable {
-                // Failing (cancelled) leaves the cage unsolved.
-                let _ = doc.solve_cage(&mut |step| {
-                    progress.set(*step);
-                    !cancel.is_set()
-                });
-            }
-            doc
-        })
-    } else {
-        Document::open_image(&path)
-    };
-    Outcome::Opened {
-        path,
-        is_project,
-        document,
     }
 }
 

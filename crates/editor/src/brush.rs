@@ -8,7 +8,7 @@ use std::sync::Arc;
 use egui::{Color32, Mesh, PointerButton, Pos2, Response, Shape, Ui};
 use glam::DVec2;
 use pipeline::arap::polyline_distance_squared;
-use project::{Method, RigidityStroke};
+use project::RigidityStroke;
 
 use crate::document::Edit;
 use crate::tool::{CanvasTool, Host};
@@ -213,7 +213,7 @@ impl Brush {
             return;
         }
         let method = doc.method();
-        if host.edit(Edit::Rigidity(strokes)) && method != Method::Arap {
+        if host.edit(Edit::Rigidity(strokes)) && !method.reads_rigidity() {
             host.info("rigidity is painted for ARAP: choose ARAP under Method to see its effect");
         }
     }

@@ -3,7 +3,7 @@
 //! run by the tool.
 
 use glam::DVec2;
-use project::Method;
+use project::Controls;
 
 use crate::app::{EditorApp, Tool};
 use crate::cage::{CageState, CageTool};
@@ -37,7 +37,11 @@ impl EditorApp {
     /// Whether the canvas shows the picture as the cage tool sees it (at rest, with a
     /// solved cage's inside warped) rather than warped by handles.
     pub(crate) fn cage_view(&self) -> bool {
-        self.tool == Tool::Cage || self.doc.as_ref().is_some_and(|d| d.method() == Method::Lbc)
+        self.tool == Tool::Cage
+            || self
+                .doc
+                .as_ref()
+                .is_some_and(|d| d.method().controls() == Controls::Cage)
     }
 
     /// Whether a solved cage warps the view: LBC with its cage solved, and no new

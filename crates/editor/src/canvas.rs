@@ -5,7 +5,7 @@ use egui::{
     Color32, CursorIcon, Key, PointerButton, Pos2, Rect, Sense, Shape, Stroke, StrokeKind, Ui, Vec2,
 };
 use glam::DVec2;
-use project::{HandleSpec, Method};
+use project::HandleSpec;
 use weights_core::NodeKind;
 
 use crate::app::{EditorApp, Grip, HandleDrag, Tool};
@@ -508,7 +508,7 @@ impl EditorApp {
         let Some(doc) = &self.doc else { return };
         let rig = doc.rig();
         let v = &self.viewport;
-        let c2 = doc.method() == Method::C2;
+        let c2 = doc.method().uses_virtual_handles();
         if self.show.dual_graph && c2 {
             for &(a, b) in self.gpu.dual_graph.1.iter() {
                 let (a, b) = (a as usize, b as usize);
@@ -579,14 +579,15 @@ impl EditorApp {
     }
 
     /// Where ARAP takes the mesh vertex under screen point `pos`, as text.
-    fn arap_readout_at(&mut self, pos: Pos2) -> Option<String> {
+    fn positions_readout_at(&mut self, pos: Pos2) -> Option<String> {
         let doc = self.doc.as_mut()?;
+        let method = doc.method().label();
         let (rest, _, _) = doc.unwarp(self.viewport.to_image(pos))?;
         let vertex = doc.rig().domain().nearest_vertex(rest)? as usize;
         let at = doc.rig().domain().positions()[vertex];
         let to = *doc.deformed().get(vertex)?;
         Some(format!(
-            "vertex {vertex} at ({:.1}, {:.1})\nARAP moves it to ({:.1}, {:.1})",
+            "vertex {vertex} at ({:.1}, {:.1})\n{method} moves it to ({:.1}, {:.1})",
             at.x, at.y, to.x, to.y
         ))
     }
@@ -638,10 +639,11 @@ impl EditorApp {
         } else if self
             .doc
             .as_ref()
-            .is_some_and(|d| d.method() == Method::Arap)
+            .is_some_and(|d| matches!(d.deformer().output(), pipeline::Output::Positions(_)))
         {
-            // ARAP has no weights: where it takes the vertex under the pointer.
-            match self.arap_readout_at(pos) {
+            // A method that solves for positions has no weights: where it takes the
+            // vertex under the pointer.
+            match self.positions_readout_at(pos) {
                 Some(text) => text,
                 None => return,
             }

@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use egui::{Key, KeyboardShortcut, Modifiers, Ui};
 use pipeline::ArapRig;
-use project::{Method, MetricChoice, Middle, Placement};
+use project::{Controls, Method, MetricChoice, Middle, Placement};
 
 use crate::app::{EditorApp, Pending, Tool};
 use crate::dialogs::FileAction;
@@ -90,6 +90,8 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ),
     ("F1", "This window"),
 ];
+
+mod windows;
 
 impl eframe::App for EditorApp {
     fn ui(&mut self, ui: &mut Ui, _frame: &mut eframe::Frame) {
@@ -380,7 +382,11 @@ impl EditorApp {
     }
 
     fn edit_buttons(&mut self, ui: &mut Ui) {
-        if self.doc.as_ref().is_some_and(|d| d.method() == Method::Lbc) {
+        if self
+            .doc
+            .as_ref()
+            .is_some_and(|d| d.method().controls() == Controls::Cage)
+        {
             self.with_cage(|cage, host| cage.edit_buttons(host, ui));
             return;
         }
@@ -405,7 +411,10 @@ impl EditorApp {
         ui.checkbox(&mut self.show.mesh, "Show mesh");
         if !cage {
             // Virtual handles and their dual graph belong to the C² weights.
-            let c2 = self.doc.as_ref().is_none_or(|d| d.method() == Method::C2);
+            let c2 = self
+                .doc
+                .as_ref()
+                .is_none_or(|d| d.method().uses_virtual_handles());
             let c2_only = "The C² weights' own: other methods have no virtual handles";
             ui.add_enabled_ui(c2, |ui| {
                 ui.checkbox(&mut self.show.virtual_handles, "Virtual handles")
@@ -436,7 +445,10 @@ impl EditorApp {
         ui.horizontal_wrapped(|ui| {
             let mut tool = self.tool;
             // Under LBC the cage moves the picture: handles wait for C² or ARAP.
-            let handles = self.doc.as_ref().is_none_or(|d| d.method() != Method::Lbc);
+            let handles = self
+                .doc
+                .as_ref()
+                .is_none_or(|d| d.method().controls() != Controls::Cage);
             let tools = [
                 (
                     Tool::Puppet,
@@ -502,7 +514,10 @@ impl EditorApp {
         ui.heading("Method");
         self.method_choice(ui);
         ui.separator();
-        let lbc = self.doc.as_ref().is_some_and(|d| d.method() == Method::Lbc);
+        let lbc = self
+            .doc
+            .as_ref()
+            .is_some_and(|d| d.method().controls() == Controls::Cage);
         if lbc || self.tool == Tool::Cage {
             ui.heading("Cage");
             self.with_cage(|cage, host| cage.panel(host, ui));
@@ -584,7 +599,7 @@ impl EditorApp {
     pub fn method_shown(&self) -> Option<Method> {
         let doc = self.doc.as_ref()?;
         Some(if self.tool == Tool::Cage {
-            Method::Lbc
+            Method::for_controls(Controls::Cage)
         } else {
             doc.method()
         })
@@ -705,232 +720,6 @@ impl EditorApp {
             self.settings_draft = Some(draft);
         }
     }
-
-    fn status_bar(&mut self, ui: &mut Ui) {
-        ui.horizontal(|ui| {
-            if let Some(doc) = &self.doc {
-                if doc.method() == Method::Lbc {
-                    let cage = doc.cage().map_or(0, |c| c.rest.len());
-                    match doc.cage_solution() {
-                        Some(solution) => ui.label(format!(
-                            "cage of {cage} vertices; {} mesh vertices inside",
-                            solution.domain.positions().len()
-                        )),
-                        None => ui.label(format!("cage of {cage} vertices, not solved")),
-                    };
-                } else {
-                    let stats = doc.rig().stats();
-                    ui.label(format!("{} vertices", stats.samples));
-                    ui.separator();
-                    ui.label(format!(
-                        "{} handles ({} nodes) + {} virtual",
-                        stats.real_handles, stats.handle_nodes, stats.virtual_nodes
-                    ));
-                    ui.separator();
-                    ui.label(format!("weights updated in {:.1} ms", doc.last_update_ms));
-                }
-                if let Some(times) = doc.arap().map(ArapRig::times) {
-                    ui.separator();
-                    ui.label(format!(
-                        "ARAP: compiled in {:.1} ms, updated in {:.2} ms",
-                        times.compile_ms, times.update_ms
-                    ))
-                    .on_hover_text(format!(
-                        "registration {:.1} ms (once per mesh); compilation when handles \
-                         are added or removed or rigidity is painted; an update every \
-                         drag frame",
-                        times.registration_ms
-                    ));
-                }
-                ui.separator();
-                ui.label(format!("frame {:.1} ms", self.frame_ms));
-                ui.separator();
-                ui.label(format!("zoom {:.0}%", self.viewport.zoom * 100.0));
-                if self.dirty {
-                    ui.separator();
-                    ui.label("unsaved");
-                }
-            }
-            if let Some((what, seconds)) = self.busy_with() {
-                ui.separator();
-                ui.spinner();
-                ui.label(format!("{what}… {seconds:.1} s"));
-                if let Some((first, last)) = self.solve_progress() {
-                    ui.add(
-                        egui::ProgressBar::new(solve_fraction(&first, &last))
-                            .desired_width(120.0)
-                            .text(format!("iteration {}", last.iteration)),
-                    )
-                    .on_hover_text(solve_text(&last));
-                    ui.label(format!(
-                        "residuals {:.1e} / {:.1e}",
-                        last.primal_residual, last.dual_residual
-                    ));
-                }
-                if ui.button("Cancel").on_hover_text("Escape").clicked() {
-                    self.cancel_job();
-                }
-            }
-            if let Some(message) = &self.message {
-                ui.separator();
-                let color = if message.is_error {
-                    ui.visuals().error_fg_color
-                } else {
-                    ui.visuals().text_color()
-                };
-                // One line, cut at the window's edge: the whole message is in the
-                // tooltip and in the messages window (a click opens it).
-                let label = egui::Label::new(egui::RichText::new(&message.text).color(color))
-                    .truncate()
-                    .sense(egui::Sense::click());
-                let text = message.text.clone();
-                if ui
-                    .add(label)
-                    .on_hover_text(format!("{text}\n\n(click for all messages)"))
-                    .clicked()
-                {
-                    self.log_open = true;
-                }
-            }
-        });
-    }
-
-    fn log_window(&mut self, ctx: &egui::Context) {
-        let mut open = self.log_open;
-        egui::Window::new("Messages")
-            .open(&mut open)
-            .default_size([560.0, 260.0])
-            .show(ctx, |ui| {
-                egui::ScrollArea::vertical()
-                    .stick_to_bottom(true)
-                    .show(ui, |ui| {
-                        for message in &self.log {
-                            let color = if message.is_error {
-                                ui.visuals().error_fg_color
-                            } else {
-                                ui.visuals().text_color()
-                            };
-                            ui.add(
-                                egui::Label::new(egui::RichText::new(&message.text).color(color))
-                                    .wrap()
-                                    .selectable(true),
-                            );
-                            ui.separator();
-                        }
-                    });
-            });
-        self.log_open = open;
-    }
-
-    fn help_window(&mut self, ctx: &egui::Context) {
-        let mut open = self.help_open;
-        // Never taller than the window: the list scrolls.
-        let height = (ctx.content_rect().height() - 80.0).max(120.0);
-        egui::Window::new("Keyboard shortcuts")
-            .open(&mut open)
-            .resizable(false)
-            .default_height(height)
-            .max_height(height)
-            .show(ctx, |ui| {
-                egui::ScrollArea::vertical()
-                    .max_height(height)
-                    .min_scrolled_height(height)
-                    .show(ui, |ui| {
-                        egui::Grid::new("shortcuts").striped(true).show(ui, |ui| {
-                            for (keys, what) in SHORTCUTS {
-                                ui.strong(*keys);
-                                ui.label(*what);
-                                ui.end_row();
-                            }
-                        });
-                    });
-            });
-        self.help_open = open;
-    }
-
-    fn pending_modal(&mut self, ctx: &egui::Context) {
-        let Some(pending) = self.pending.clone() else {
-            return;
-        };
-        let mut answer = None;
-        let (heading, question, yes) = match &pending {
-            Pending::Replace(_, path) => (
-                "Replace file?",
-                format!("{} exists. Replace it?", path.display()),
-                "Replace",
-            ),
-            Pending::Open(_) | Pending::Close => (
-                "Unsaved changes",
-                "The current project has changes that are not saved. Discard them?".to_owned(),
-                "Discard changes",
-            ),
-        };
-        egui::Modal::new(egui::Id::unique("question")).show(ctx, |ui| {
-            ui.heading(heading);
-            ui.label(question);
-            ui.horizontal(|ui| {
-                if ui.button(yes).clicked() {
-                    answer = Some(true);
-                }
-                if ui.button("Cancel").clicked() {
-                    answer = Some(false);
-                }
-            });
-        });
-        match answer {
-            Some(true) => {
-                self.pending = None;
-                match pending {
-                    Pending::Open(path) => self.open_in_background(path),
-                    Pending::Replace(action, path) => self.file_chosen(action, path),
-                    Pending::Close => {
-                        self.allow_close = true;
-                        ctx.send_viewport_cmd(egui::ViewportCommand::Close);
-                    }
-                }
-            }
-            Some(false) => self.pending = None,
-            None => {}
-        }
-    }
-}
-
-/// How far a cage's solve has come, 0 to 1: the share of the way (in orders of
-/// magnitude) from the first iteration's residuals to their thresholds, the slower of
-/// the two.
-pub(crate) fn solve_fraction(first: &lbc::Progress, last: &lbc::Progress) -> f32 {
-    let share = |r0: f64, r: f64, goal: f64| {
-        if r <= goal || r0 <= goal {
-            1.0
-        } else {
-            ((r0 / r).ln() / (r0 / goal).ln()).clamp(0.0, 1.0)
-        }
-    };
-    let primal = share(
-        first.primal_residual,
-        last.primal_residual,
-        last.primal_threshold,
-    );
-    let dual = share(first.dual_residual, last.dual_residual, last.dual_threshold);
-    if primal.is_finite() && dual.is_finite() {
-        primal.min(dual) as f32
-    } else {
-        0.0
-    }
-}
-
-/// One ADMM iteration in words.
-pub(crate) fn solve_text(p: &lbc::Progress) -> String {
-    format!(
-        "ADMM iteration {}: primal residual {:.2e} (to reach {:.2e}), dual residual {:.2e} \
-         (to reach {:.2e}), penalty {:.3}",
-        p.iteration,
-        p.primal_residual,
-        p.primal_threshold,
-        p.dual_residual,
-        p.dual_threshold,
-        p.penalty
-    )
 }
 
 fn metric_name(m: MetricChoice) -> &'static str {

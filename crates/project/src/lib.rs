@@ -132,6 +132,13 @@ impl Method {
         matches!(self, Method::Arap)
     }
 
+    /// Whether choosing the method sets a solver up on the picture's mesh (ARAP
+    /// factorises its systems, MLS precomputes its fits), which takes a noticeable time
+    /// on a large mesh.
+    pub fn sets_up_on_the_mesh(self) -> bool {
+        matches!(self, Method::Arap | Method::Mls)
+    }
+
     /// Whether the method weighs the picture by the C² rig's nodes, so the virtual
     /// handles and their dual graph mean something for it: C² itself.
     pub fn uses_virtual_handles(self) -> bool {

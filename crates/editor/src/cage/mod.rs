@@ -29,7 +29,7 @@ use std::sync::Arc;
 
 use egui::{Color32, Context, Pos2, Response, Ui};
 use glam::DVec2;
-use project::{Method, Project};
+use project::{Controls, Project};
 
 use crate::document::Document;
 use crate::tool::{CanvasTool, Host};
@@ -132,7 +132,7 @@ impl CageTool {
             return CageState::Drawing;
         }
         match doc {
-            Some(doc) if doc.method() == Method::Lbc && doc.cage().is_some() => {
+            Some(doc) if doc.method().controls() == Controls::Cage && doc.cage().is_some() => {
                 if doc.cage_solution().is_some() && !self.edit_rest {
                     CageState::Posed
                 } else {

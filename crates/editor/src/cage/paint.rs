@@ -5,7 +5,7 @@
 use std::sync::Arc;
 
 use egui::{Color32, Painter, Pos2, Rect, Shape, Stroke, StrokeKind};
-use project::Method;
+use project::Controls;
 
 use super::{
     CAGE, CAGE_REST, CONTOUR, CROSSING, CageState, CageTool, ContourSegment, EdgePoint, GRAB,
@@ -62,7 +62,8 @@ impl CageTool {
         painter: &Painter,
         pointer: Option<Pos2>,
     ) {
-        if doc.method() != Method::Lbc && doc.cage().is_some() && self.draft.is_none() {
+        if doc.method().controls() != Controls::Cage && doc.cage().is_some() && self.draft.is_none()
+        {
             // A cage kept from LBC: faint, for reference.
             let rest: Vec<Pos2> = doc.cage_rest().iter().map(|p| v.to_screen(*p)).collect();
             painter.add(Shape::closed_line(rest, Stroke::new(1.0, CAGE_REST)));

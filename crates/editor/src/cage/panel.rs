@@ -4,7 +4,7 @@
 
 use egui::Ui;
 use pipeline::cage::CageCoordinates;
-use project::{Method, Tau};
+use project::{Controls, Method, Tau};
 
 use super::{CAGE, CageState, CageTool, SELECTED};
 use crate::document::{CageKey, Edit};
@@ -34,7 +34,7 @@ impl CageTool {
         let situation = Situation {
             state,
             has_cage: doc.cage().is_some(),
-            lbc: doc.method() == Method::Lbc,
+            lbc: doc.method().controls() == Controls::Cage,
             problem: CageKey::of(doc.project()).and_then(|k| k.problem()),
             solved: solution.is_some(),
         };
@@ -111,7 +111,7 @@ impl CageTool {
                 }
                 if situation.has_cage && !situation.lbc && ui.button("Use the kept cage").clicked()
                 {
-                    let _ = self.edit(host, Edit::Method(Method::Lbc));
+                    let _ = self.edit(host, Edit::Method(Method::for_controls(Controls::Cage)));
                 }
             }
             CageState::Rest | CageState::Posed => {
@@ -225,7 +225,7 @@ impl CageTool {
         let drawing = self.draft.is_some();
         let solution = host
             .document()
-            .filter(|d| d.method() == Method::Lbc && !drawing)
+            .filter(|d| d.method().controls() == Controls::Cage && !drawing)
             .and_then(|d| d.cage_solution().cloned());
         let Some(solution) = solution else {
             ui.label(

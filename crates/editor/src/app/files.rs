@@ -1,0 +1,203 @@
+//! Files: the open, save and export dialogs (the desktop's, or the built-in one), and
+//! saving and exporting to a path.
+
+use super::*;
+
+impl EditorApp {
+    /// Asks for a file for `action` — with the desktop's dialog where there is one,
+    /// else with the built-in one — and acts on it when chosen.
+    pub fn ask_file(&mut self, action: FileAction) {
+        if self.file_dialog.is_some() {
+            return;
+        }
+        let suggested = match action {
+            FileAction::SaveProject => self.suggested_name("json"),
+            FileAction::ExportPng => self.suggested_name("warped.png"),
+            FileAction::OpenImage | FileAction::OpenProject => String::new(),
+        };
+        if !self.builtin_dialogs {
+            match self.dialogs.ask(action, &suggested) {
+                Answer::Chosen(path) => return self.file_chosen(action, path),
+                Answer::Cancelled => return,
+                Answer::Unavailable => {
+                    self.builtin_dialogs = true;
+                    self.info("the desktop offers no file dialog here: using the built-in one");
+                }
+            }
+        }
+        let folder = self.working_folder();
+        self.file_dialog = Some(BuiltinDialog::open(action, &folder, &suggested));
+    }
+
+    /// Whether the built-in file dialog is open.
+    pub fn file_dialog_open(&self) -> bool {
+        self.file_dialog.is_some()
+    }
+
+    /// Shows the built-in file dialog, if open, and acts on its answer.
+    pub(crate) fn file_dialog_ui(&mut self, ctx: &egui::Context) {
+        let Some(dialog) = &mut self.file_dialog else {
+            return;
+        };
+        let action = dialog.action;
+        match dialog.show(ctx) {
+            Shown::Open => {}
+            Shown::Cancelled => self.file_dialog = None,
+            Shown::Chosen(path) => {
+                self.file_dialog = None;
+                if action.writes() && path.exists() {
+                    // The desktop's dialogs ask before replacing a file; so does this one.
+                    self.pending = Some(Pending::Replace(action, path));
+                } else {
+                    self.file_chosen(action, path);
+                }
+            }
+        }
+    }
+
+    /// Acts on a file the user chose for `action`.
+    pub(crate) fn file_chosen(&mut self, action: FileAction, path: PathBuf) {
+        match action {
+            FileAction::OpenImage | FileAction::OpenProject => self.request_open(path),
+            FileAction::SaveProject => self.save_to(&path),
+            FileAction::ExportPng => self.export_in_background(path),
+        }
+    }
+
+    /// The folder dialogs start in: the project's or the picture's, else the current one.
+    pub(super) fn working_folder(&self) -> PathBuf {
+        let from_doc = self.doc.as_ref().and_then(|d| {
+            d.project_path
+                .as_deref()
+                .or(d.image_path.as_deref())
+                .and_then(Path::parent)
+                .filter(|p| !p.as_os_str().is_empty())
+                .map(Path::to_path_buf)
+        });
+        from_doc
+            .or_else(|| self.default_folder.clone())
+            .or_else(|| std::env::current_dir().ok())
+            .unwrap_or_else(|| PathBuf::from("."))
+    }
+
+    /// Saves the project where it was last saved, or asks where.
+    pub fn save(&mut self) {
+        match self.doc.as_ref().and_then(|d| d.project_path.clone()) {
+            Some(path) => self.save_to(&path),
+            None => self.ask_file(FileAction::SaveProject),
+        }
+    }
+
+    /// Asks where to save the project, then saves it.
+    pub fn save_as(&mut self) {
+        self.ask_file(FileAction::SaveProject);
+    }
+
+    /// Writes the project to `path` atomically (a failure leaves any old file intact).
+    pub fn save_to(&mut self, path: &Path) {
+        let Some(doc) = &mut self.doc else { return };
+        let project = doc.project_for_saving(Some(path));
+        match render::write_atomic(path, project.to_json().as_bytes()) {
+            Ok(()) => {
+                doc.project_path = Some(path.to_path_buf());
+                self.dirty = false;
+                self.info(format!("saved {}", path.display()));
+            }
+            Err(e) => self.error(&anyhow::Error::from(e)),
+        }
+    }
+
+    /// Asks where to export, then writes the warped PNG.
+    pub fn export(&mut self) {
+        self.ask_file(FileAction::ExportPng);
+    }
+
+    /// Writes the warped picture at full resolution to `path` atomically, now: the
+    /// same pixels as `c2warp render` of the saved project.
+    pub fn export_to(&mut self, path: &Path) {
+        let Some(work) = self.export_work(path.to_path_buf(), CancelFlag::default()) else {
+            return;
+        };
+        self.finish(work());
+    }
+
+    /// As [`EditorApp::export_to`], on a worker thread (the editor shows progress).
+    pub fn export_in_background(&mut self, path: PathBuf) {
+        let cancel = CancelFlag::default();
+        let Some(work) = self.export_work(path.clone(), cancel.clone()) else {
+            return;
+        };
+        self.start_job(format!("Exporting {}", file_name(&path)), cancel, work);
+    }
+
+    /// The export of the current document to `path`, ready to run anywhere; it writes
+    /// nothing once `cancel` is set.
+    pub(super) fn export_work(
+        &self,
+        path: PathBuf,
+        cancel: CancelFlag,
+    ) -> Option<impl FnOnce() -> Outcome + Send + 'static> {
+        let doc = self.doc.as_ref()?;
+        let project = doc.project_for_saving(None);
+        let image = doc.image.clone();
+        let deep = doc.deep.clone();
+        let cage = CageKey::of(&project)
+            .filter(|_| project.method.controls() == Controls::Cage)
+            .map(|key| (doc.solution_for(&key).cloned(), key, doc.cage_pose()));
+        Some(move || {
+            let clock = Instant::now();
+            let result = (|| -> Result<()> {
+                let warper = match cage {
+                    // The cage's coordinates already solved for it (else solved here).
+                    Some((solution, key, pose)) => {
+                        let solution = match solution {
+                            Some(solution) => solution,
+                            None => crate::document::solve_cage(&key, &mut |_| !cancel.is_set())?,
+                        };
+                        let deformer = pipeline::cage::CageDeformer::new(solution, pose)?;
+                        pipeline::Warper::in_mesh_order(Box::new(deformer), project.canvas)
+                    }
+                    None => pipeline::prepare_warper(&image, &project, None, &())?,
+                };
+                // A 16-bit picture exports with 16 bits, as `c2warp render` does.
+                let warped = match &deep {
+                    Some(deep) => pipeline::warp_picture(deep, &warper)?,
+                    None => render::Picture::Rgba8(pipeline::warp(&image, &warper)?),
+                };
+                if cancel.is_set() {
+                    anyhow::bail!("cancelled");
+                }
+                render::save_png_atomic(&path, &warped)?;
+                Ok(())
+            })()
+            .with_context(|| format!("cannot export {}", path.display()));
+            Outcome::Exported {
+                path,
+                result,
+                ms: clock.elapsed().as_secs_f64() * 1e3,
+            }
+        })
+    }
+
+    pub(super) fn suggested_name(&self, extension: &str) -> String {
+        let stem = self
+            .doc
+            .as_ref()
+            .and_then(|d| d.image_path.as_ref())
+            .and_then(|p| p.file_stem())
+            .map_or_else(|| "lizard".to_owned(), |s| s.to_string_lossy().into_owned());
+        if extension.contains('.') {
+            format!("{stem}-{extension}")
+        } else {
+            format!("{stem}.{extension}")
+        }
+    }
+}
+
+/// A path's file name, for messages.
+pub(super) fn file_name(path: &Path) -> String {
+    path.file_name().map_or_else(
+        || path.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    )
+}

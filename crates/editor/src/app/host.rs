@@ -1,0 +1,90 @@
+//! The app as the tools' host ([`Host`]): what a tool may use of it, and the lenders
+//! that hand a tool its host.
+
+use super::*;
+
+impl Host for EditorApp {
+    fn document(&self) -> Option<&Document> {
+        self.doc.as_ref()
+    }
+
+    fn document_mut(&mut self) -> Option<&mut Document> {
+        self.doc.as_mut()
+    }
+
+    fn viewport(&self) -> &Viewport {
+        &self.viewport
+    }
+
+    fn shows(&self) -> Show {
+        self.show
+    }
+
+    fn shows_mut(&mut self) -> &mut Show {
+        &mut self.show
+    }
+
+    fn edit(&mut self, edit: Edit) -> bool {
+        EditorApp::edit(self, edit)
+    }
+
+    fn busy(&self) -> bool {
+        self.is_busy()
+    }
+
+    fn preview(&mut self, project: Project) {
+        let Some(doc) = &mut self.doc else { return };
+        if let Err(e) = doc.restore(project) {
+            self.error(&e);
+        }
+    }
+
+    fn record(&mut self, before: Project) {
+        if let Some(doc) = &self.doc
+            && doc.project() != &without_virtuals(&before)
+        {
+            self.history.push(before);
+            self.dirty = true;
+        }
+    }
+
+    fn solve_cage(&mut self, key: CageKey) {
+        self.start_cage_solve(key, None);
+    }
+
+    fn panning(&self) -> bool {
+        self.panning
+    }
+
+    fn pan(&mut self) {
+        self.panning = true;
+    }
+
+    fn info(&mut self, text: &str) {
+        EditorApp::info(self, text);
+    }
+
+    fn error(&mut self, error: &anyhow::Error) {
+        EditorApp::error(self, error);
+    }
+
+    fn mesh_version(&self) -> u64 {
+        self.gpu.frame.mesh.version
+    }
+}
+
+impl EditorApp {
+    /// Runs `f` on the rigidity brush with the app as its host (the brush is lent out
+    /// for the call, so it and the host can both be changed).
+    pub(crate) fn with_brush<R>(&mut self, f: impl FnOnce(&mut Brush, &mut dyn Host) -> R) -> R {
+        let mut brush = std::mem::take(&mut self.brush);
+        let out = f(&mut brush, self);
+        self.brush = brush;
+        out
+    }
+
+    /// The triangles the painted-rigidity overlay drew last (their corners).
+    pub fn painted_triangles(&self) -> Vec<[u32; 3]> {
+        self.brush.painted_triangles()
+    }
+}
