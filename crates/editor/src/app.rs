@@ -390,18 +390,8 @@ impl EditorApp {
             if *settings != doc.settings() {
                 // A rebuild can take seconds (a large mesh, a fixed boundary's many
                 // nodes): on the worker, so the window keeps answering.
-                let before = doc.snapshot();
-                let mut copy = doc.clone();
-                let label = "Re-weighting".to_owned();
-                self.start_job(label, CancelFlag::default(), move || {
-                    let document = copy.apply(edit).map(|()| copy);
-                    Outcome::Rebuilt {
-                        cause: Rebuild::Edit {
-                            before: Box::new(before),
-                        },
-                        document,
-                    }
-                });
+                let copy = doc.clone();
+                self.apply_on_worker("Re-weighting".to_owned(), copy, edit);
                 return true;
             }
         }
@@ -420,22 +410,12 @@ impl EditorApp {
             && let Some(doc) = &self.doc
             && doc.rig().domain().len() > self.large_mesh
         {
-            let before = doc.snapshot();
-            let mut copy = doc.clone();
             let label = match edit {
-                Edit::Method(_) => "Setting up ARAP",
-                _ => "Repainting rigidity",
-            }
-            .to_owned();
-            self.start_job(label, CancelFlag::default(), move || {
-                let document = copy.apply(edit).map(|()| copy);
-                Outcome::Rebuilt {
-                    cause: Rebuild::Edit {
-                        before: Box::new(before),
-                    },
-                    document,
-                }
-            });
+                Edit::Method(method) => format!("Setting up {}", method.label()),
+                _ => "Repainting rigidity".to_owned(),
+            };
+            let copy = doc.clone();
+            self.apply_on_worker(label, copy, edit);
             return true;
         }
         let Some(doc) = &mut self.doc else {
@@ -471,6 +451,21 @@ impl EditorApp {
                 false
             }
         }
+    }
+
+    /// Applies `edit` to `copy` (the open document, cloned) on the worker, labelled
+    /// `label`; the history moves when the result is in.
+    fn apply_on_worker(&mut self, label: String, mut copy: Document, edit: Edit) {
+        let before = copy.snapshot();
+        self.start_job(label, CancelFlag::default(), move || {
+            let document = copy.apply(edit).map(|()| copy);
+            Outcome::Rebuilt {
+                cause: Rebuild::Edit {
+                    before: Box::new(before),
+                },
+                document,
+            }
+        });
     }
 
     /// Adds a point handle under `at` (image pixels, current pose): its rest position is
