@@ -308,7 +308,7 @@ fn cage(
         rest: ring.iter().map(|p| p.to_array()).collect(),
         pose: None,
     });
-    project.method = Method::Lbc;
+    project.method = Method::for_controls(project::Controls::Cage);
     let folder = if is_stdout(output) {
         Path::new("")
     } else {
