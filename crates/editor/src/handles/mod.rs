@@ -270,10 +270,10 @@ impl HandleTool {
 }
 
 impl CanvasTool for HandleTool {
-    /// Adds, selects, drags and deletes handles as the active tool calls for. Called
-    /// under every tool but the cage's (a handle's right-click menu and the cursor over
-    /// it serve the brush too, and a drag begun before a switch of tools goes on), the
-    /// canvas having started a pan with the middle button or Space first.
+    /// Adds, selects, drags and deletes handles as the active tool calls for. The
+    /// canvas calls it under every tool, after starting a pan with the middle button
+    /// or Space: a drag begun before a switch of tools goes on, and a handle's
+    /// right-click menu and the cursor over it serve the brush too (not the cage).
     fn input(&mut self, host: &mut dyn Host, ui: &Ui, response: &Response) {
         self.pointer_input(host, ui, response);
     }
