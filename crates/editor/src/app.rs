@@ -6,38 +6,21 @@ use std::time::Instant;
 
 use anyhow::{Context as _, Result};
 use glam::DVec2;
-use project::{Controls, HandleSpec, Method, Project};
+use project::{Controls, Method, Project};
 
 use crate::brush::Brush;
 use crate::cage::CageTool;
 use crate::dialogs::{Answer, BuiltinDialog, Dialogs, FileAction, NativeDialogs, Shown};
-use crate::document::{CageKey, Document, Edit, posed};
+use crate::document::{CageKey, Document, Edit};
 use crate::gpu_frame::{FrameBuilder, View};
+use crate::handles::HandleTool;
 use crate::history::History;
 use crate::jobs::{CancelFlag, Job, Outcome, Rebuild, SolveProgress};
 use crate::scene::SceneResources;
 use crate::show::Show;
+pub use crate::tool::Tool;
 use crate::tool::{CanvasTool, Host};
 use crate::viewport::Viewport;
-
-/// What a primary click or drag on the canvas does.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Tool {
-    /// The Puppet Warp convention: a click on the picture adds a point handle, a click
-    /// on a handle selects it, dragging a handle moves it (Alt-drag rotates, Shift-drag
-    /// scales), Alt-click on a handle deletes it, dragging empty canvas pans.
-    Puppet,
-    /// As [`Tool::Puppet`], but a click on the picture only deselects.
-    Select,
-    /// Click to add a point handle.
-    AddPoint,
-    /// Drag to add a bar handle.
-    AddBar,
-    /// Paint rigidity (ARAP); Alt-drag erases.
-    Rigidity,
-    /// Draw, adjust, solve and pose an LBC cage (see [`crate::cage`]).
-    Cage,
-}
 
 /// Messages the log keeps before the oldest is forgotten.
 pub const LOG_LIMIT: usize = 200;
@@ -62,32 +45,6 @@ pub enum Pending {
     Replace(FileAction, PathBuf),
 }
 
-/// A drag of a handle in progress.
-#[derive(Clone, Debug)]
-pub(crate) struct HandleDrag {
-    pub index: usize,
-    pub grip: Grip,
-    /// The handle when the drag began.
-    pub start: HandleSpec,
-    /// The pointer when the drag began (image pixels).
-    pub pointer: DVec2,
-    /// The document before the drag, recorded in the history if the drag changed it.
-    pub before: project::Project,
-}
-
-/// What part of a handle is being dragged, and how.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Grip {
-    /// Move the whole handle.
-    Move,
-    /// Move one end of a bar.
-    End(usize),
-    /// Rotate about the handle's centre.
-    Rotate,
-    /// Scale about the handle's centre.
-    Scale,
-}
-
 /// The editor.
 pub struct EditorApp {
     pub(crate) doc: Option<Document>,
@@ -102,11 +59,9 @@ pub struct EditorApp {
     pub tool: Tool,
     /// The selected handle.
     pub selected: Option<usize>,
-    pub(crate) drag: Option<HandleDrag>,
-    pub(crate) bar_start: Option<DVec2>,
-    pub(crate) context_point: Option<DVec2>,
-    /// The handle the right-click menu was opened on, and its index then.
-    pub(crate) context_handle: Option<(usize, HandleSpec)>,
+    /// The handle tools: a drag or a bar under way, the right-click menu's handle.
+    pub(crate) handles: HandleTool,
+    /// The drag under way pans the view.
     pub(crate) panning: bool,
     /// Overlays.
     pub show: Show,
@@ -212,10 +167,7 @@ impl EditorApp {
             view_fitted: false,
             tool: Tool::Puppet,
             selected: None,
-            drag: None,
-            bar_start: None,
-            context_point: None,
-            context_handle: None,
+            handles: HandleTool::default(),
             panning: false,
             show: Show::default(),
             hover_readout: None,
@@ -248,18 +200,7 @@ impl EditorApp {
     /// backward): where the warped picture overlaps itself, the part nearest the
     /// handle of greater depth is drawn in front. One undo step.
     pub fn change_depth(&mut self, index: usize, by: i32) {
-        let Some(handle) = self
-            .doc
-            .as_ref()
-            .and_then(|d| d.project().handles.get(index))
-        else {
-            return;
-        };
-        let depth = handle.depth().saturating_add(by);
-        let moved = handle.with_depth(depth);
-        if self.edit(Edit::Pose(index, moved)) {
-            self.info(format!("handle {} now has depth {depth}", index + 1));
-        }
+        self.with_handles(|handles, host| handles.change_depth(host, index, by));
     }
 
     /// Replaces the file dialogs (tests answer them with fixed paths).
@@ -288,10 +229,10 @@ impl EditorApp {
     /// The first broken invariant, in words.
     pub fn sanity_check(&self) -> Result<()> {
         let Some(doc) = &self.doc else {
-            if self.selected.is_some() || self.drag.is_some() {
+            if self.selected.is_some() {
                 anyhow::bail!("a selection or drag without a document");
             }
-            return Ok(());
+            return self.handles.sanity_check(None, self.tool);
         };
         doc.sanity_check()?;
         let handles = &doc.project().handles;
@@ -300,15 +241,7 @@ impl EditorApp {
         {
             anyhow::bail!("handle {s} is selected, but there are {}", handles.len());
         }
-        if let Some(drag) = &self.drag {
-            match handles.get(drag.index) {
-                Some(h) if crate::document::same_rest(h, &drag.start) => {}
-                _ => anyhow::bail!("the drag holds handle {}, which is gone", drag.index),
-            }
-        }
-        if self.bar_start.is_some() && self.tool != Tool::AddBar {
-            anyhow::bail!("a bar is being drawn with the {:?} tool", self.tool);
-        }
+        self.handles.sanity_check(Some(doc), self.tool)?;
         self.cage_sanity_check(doc)?;
         self.gpu.sanity_check(doc)?;
         if self.log.len() > LOG_LIMIT {
@@ -473,49 +406,12 @@ impl EditorApp {
     /// the pose has around it ([`Document::local_pose`]), so the warp jumps as little as
     /// the method allows.
     pub fn add_point(&mut self, at: DVec2) {
-        let Some(doc) = &mut self.doc else { return };
-        let Some((rest, _, _)) = doc.unwarp(at) else {
-            self.error(&anyhow::anyhow!("click on the picture to add a handle"));
-            return;
-        };
-        let (rotate, scale) = doc.local_pose(rest, at);
-        let handle = HandleSpec::Point {
-            rest: rest.to_array(),
-            translate: (at - rest).to_array(),
-            rotate,
-            scale,
-            depth: 0,
-        };
-        if self.edit(Edit::Add(handle))
-            && let Some(doc) = &self.doc
-        {
-            self.selected = Some(doc.project().handles.len() - 1);
-            let ms = doc.last_update_ms;
-            self.info(format!(
-                "added a point handle; weights updated in {ms:.1} ms"
-            ));
-        }
+        self.with_handles(|handles, host| handles.add_point(host, at));
     }
 
     /// Adds a bar from `a` to `b` (image pixels, current pose).
     pub fn add_bar(&mut self, a: DVec2, b: DVec2) {
-        let Some(doc) = &mut self.doc else { return };
-        let (Some((ra, _, _)), Some((rb, _, _))) = (doc.unwarp(a), doc.unwarp(b)) else {
-            self.error(&anyhow::anyhow!("a bar must start and end on the picture"));
-            return;
-        };
-        let handle = HandleSpec::Bar {
-            rest: [ra.to_array(), rb.to_array()],
-            pose: Some([a.to_array(), b.to_array()]),
-            depth: 0,
-        };
-        if self.edit(Edit::Add(handle))
-            && let Some(doc) = &self.doc
-        {
-            self.selected = Some(doc.project().handles.len() - 1);
-            let ms = doc.last_update_ms;
-            self.info(format!("added a bar handle; weights updated in {ms:.1} ms"));
-        }
+        self.with_handles(|handles, host| handles.add_bar(host, a, b));
     }
 
     /// Switches tools; a bar or a cage being drawn is dropped, a cage drag ends. The
@@ -540,7 +436,7 @@ impl EditorApp {
             });
         }
         self.tool = tool;
-        self.bar_start = None;
+        self.handles.cancel();
         if tool == Tool::Cage
             && !lbc
             && let Some(doc) = &self.doc
@@ -567,9 +463,8 @@ impl EditorApp {
             .as_ref()
             .is_some_and(|d| d.method().controls() == Controls::Cage);
         if lbc && self.tool != Tool::Cage {
-            self.finish_drag();
+            self.with_handles(|handles, host| handles.finish_gesture(host));
             self.tool = Tool::Cage;
-            self.bar_start = None;
             self.brush.cancel();
         }
     }
@@ -624,54 +519,15 @@ impl EditorApp {
 
     /// Deletes the selected handle.
     pub fn delete_selected(&mut self) {
-        if let Some(i) = self.selected
-            && self.edit(Edit::Remove(i))
-            && let Some(doc) = &self.doc
-        {
-            let ms = doc.last_update_ms;
-            self.info(format!("removed a handle; weights updated in {ms:.1} ms"));
-        }
-    }
-
-    /// Sets the pose of handle `index` during a drag (no undo step; the drag makes one
-    /// when it ends). With auto-rotation, other point handles turn with their
-    /// neighbours.
-    pub(crate) fn set_pose(&mut self, index: usize, handle: HandleSpec) {
-        let Some(doc) = &mut self.doc else { return };
-        let mut project = doc.project().clone();
-        let Some(slot) = project.handles.get_mut(index) else {
-            debug_assert!(false, "the dragged handle {index} is gone");
-            return;
-        };
-        // A drag poses its own handle; one at another rest means the index went stale.
-        let own = crate::document::same_rest(slot, &handle);
-        debug_assert!(own, "a drag may not move handle {index} at rest");
-        if !own {
-            return;
-        }
-        *slot = handle;
-        if self.auto_rotate {
-            auto_rotate(&mut project.handles);
-        }
-        if let Err(e) = doc.restore(project) {
-            self.error(&e);
-        }
+        self.with_handles(|handles, host| handles.delete_selected(host));
     }
 
     /// Ends whatever pointer gesture is in progress — a handle drag (one undo step if
-    /// it changed anything) or a bar being drawn — because the document is about to
-    /// change under it.
+    /// it changed anything), a bar being drawn, a cage drag — because the document is
+    /// about to change under it.
     pub(crate) fn end_gesture(&mut self) {
-        self.finish_drag();
+        self.with_handles(|handles, host| handles.finish_gesture(host));
         self.end_cage_gesture();
-        self.bar_start = None;
-    }
-
-    /// Ends a handle drag: one undo step if it changed anything.
-    pub(crate) fn finish_drag(&mut self) {
-        if let Some(drag) = self.drag.take() {
-            Host::record(self, drag.before);
-        }
     }
 
     /// Steps back one edit.
@@ -811,90 +667,5 @@ pub(crate) fn without_virtuals(project: &project::Project) -> project::Project {
         virtual_handles: Vec::new(),
         virtual_placed_for: Vec::new(),
         ..project.clone()
-    }
-}
-
-/// Sets each point handle's rotation to the one that best turns the directions to its
-/// neighbours (all other handles, nearer ones weighing more) from rest to now: the
-/// pseudo-edge heuristic of bounded biharmonic weights.
-pub(crate) fn auto_rotate(handles: &mut [HandleSpec]) {
-    let centres: Vec<(DVec2, DVec2)> = handles
-        .iter()
-        .map(|h| match *h {
-            HandleSpec::Point { rest, .. } => {
-                let now = posed(h)[0];
-                (DVec2::from(rest), now)
-            }
-            HandleSpec::Bar { rest, .. } => {
-                let [a, b] = posed(h);
-                (
-                    (DVec2::from(rest[0]) + DVec2::from(rest[1])) * 0.5,
-                    (a + b) * 0.5,
-                )
-            }
-        })
-        .collect();
-    for (i, h) in handles.iter_mut().enumerate() {
-        let HandleSpec::Point { rotate, .. } = h else {
-            continue;
-        };
-        let (mut dot, mut cross) = (0.0, 0.0);
-        for (j, &(rest_j, now_j)) in centres.iter().enumerate() {
-            if i == j {
-                continue;
-            }
-            let r = rest_j - centres[i].0;
-            let c = now_j - centres[i].1;
-            let w = 1.0 / r.length_squared().max(1e-9);
-            dot += w * r.dot(c);
-            cross += w * r.perp_dot(c);
-        }
-        if dot != 0.0 || cross != 0.0 {
-            *rotate = cross.atan2(dot);
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn point(rest: [f64; 2], translate: [f64; 2]) -> HandleSpec {
-        HandleSpec::Point {
-            rest,
-            translate,
-            rotate: 0.0,
-            scale: 1.0,
-            depth: 0,
-        }
-    }
-
-    #[test]
-    fn auto_rotation_follows_a_turn_of_the_neighbours() {
-        // Three handles turned by 90° about the first: the first turns by 90°.
-        let mut handles = vec![
-            point([0.0, 0.0], [0.0, 0.0]),
-            point([10.0, 0.0], [-10.0, 10.0]),
-            point([0.0, 10.0], [-10.0, -10.0]),
-        ];
-        auto_rotate(&mut handles);
-        let HandleSpec::Point { rotate, .. } = handles[0] else {
-            unreachable!()
-        };
-        assert!(
-            (rotate - std::f64::consts::FRAC_PI_2).abs() < 1e-9,
-            "{rotate}"
-        );
-        // A pure translation turns nothing.
-        let mut handles = vec![
-            point([0.0, 0.0], [5.0, 5.0]),
-            point([10.0, 0.0], [5.0, 5.0]),
-        ];
-        auto_rotate(&mut handles);
-        assert!(
-            handles
-                .iter()
-                .all(|h| matches!(h, HandleSpec::Point { rotate, .. } if rotate.abs() < 1e-12))
-        );
     }
 }

@@ -16,6 +16,7 @@ mod canvas;
 mod dialogs;
 mod document;
 mod gpu_frame;
+mod handles;
 mod history;
 mod jobs;
 mod panels;

@@ -277,7 +277,7 @@ impl EditorApp {
         }
         if pressed(none, Key::Escape) {
             self.selected = None;
-            self.bar_start = None;
+            self.handles.cancel();
             self.brush.cancel();
             self.pending = None;
         }
@@ -509,7 +509,7 @@ impl EditorApp {
             .on_hover_text("Point handles turn with their neighbours' motion");
         // The selected handle right under the tools, so it shows whatever else the
         // panel holds.
-        self.handle_section(ui);
+        self.with_handles(|handles, host| handles.panel(host, ui));
         ui.separator();
         ui.heading("Method");
         self.method_choice(ui);
@@ -535,63 +535,6 @@ impl EditorApp {
         }
         ui.heading("Show");
         self.overlay_toggles(ui);
-    }
-
-    /// The selected handle: where it is, how it is posed, its overlap depth.
-    fn handle_section(&mut self, ui: &mut Ui) {
-        let mut forward = None;
-        if let Some(i) = self.selected
-            && let Some(doc) = &self.doc
-            && let Some(h) = doc.project().handles.get(i)
-        {
-            ui.separator();
-            ui.heading(format!("Handle {}", i + 1));
-            let depth = h.depth();
-            // Wrapped, so selecting a handle never widens the panel (which would
-            // shrink the canvas and refit the view under the pointer mid-drag).
-            ui.horizontal_wrapped(|ui| {
-                ui.label(format!("depth {depth}"))
-                    .on_hover_text("Where the warped picture overlaps itself, handles of greater depth are in front");
-                if ui.button("Bring forward").clicked() {
-                    forward = Some(1);
-                }
-                if ui.button("Send backward").clicked() {
-                    forward = Some(-1);
-                }
-            });
-            match h {
-                project::HandleSpec::Point {
-                    rest,
-                    translate,
-                    rotate,
-                    scale,
-                    ..
-                } => {
-                    ui.label(format!("point at ({:.1}, {:.1})", rest[0], rest[1]));
-                    // No "-0.0" for a move that rounds to nothing.
-                    let tidy = |v: f64| if v.abs() < 0.05 { 0.0 } else { v };
-                    ui.label(format!(
-                        "moved by ({:.1}, {:.1})",
-                        tidy(translate[0]),
-                        tidy(translate[1])
-                    ));
-                    ui.label(format!(
-                        "rotated {:.1}°, scaled {:.2}×",
-                        rotate.to_degrees(),
-                        scale
-                    ));
-                }
-                project::HandleSpec::Bar { rest, .. } => {
-                    ui.label(format!(
-                        "bar from ({:.1}, {:.1}) to ({:.1}, {:.1})",
-                        rest[0][0], rest[0][1], rest[1][0], rest[1][1]
-                    ));
-                }
-            }
-        }
-        if let (Some(i), Some(by)) = (self.selected, forward) {
-            self.change_depth(i, by);
-        }
     }
 
     /// The method the method selector shows: the document's, or LBC while the cage

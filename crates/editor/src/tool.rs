@@ -12,6 +12,25 @@ use crate::document::{CageKey, Document, Edit};
 use crate::show::Show;
 use crate::viewport::Viewport;
 
+/// What a primary click or drag on the canvas does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Tool {
+    /// The Puppet Warp convention: a click on the picture adds a point handle, a click
+    /// on a handle selects it, dragging a handle moves it (Alt-drag rotates, Shift-drag
+    /// scales), Alt-click on a handle deletes it, dragging empty canvas pans.
+    Puppet,
+    /// As [`Tool::Puppet`], but a click on the picture only deselects.
+    Select,
+    /// Click to add a point handle.
+    AddPoint,
+    /// Drag to add a bar handle.
+    AddBar,
+    /// Paint rigidity (ARAP); Alt-drag erases.
+    Rigidity,
+    /// Draw, adjust, solve and pose an LBC cage (see [`crate::cage`]).
+    Cage,
+}
+
 /// What a tool may use of the editor.
 pub(crate) trait Host {
     /// The open document, if any.
@@ -56,6 +75,17 @@ pub(crate) trait Host {
     /// The GPU mesh's version: new for every mesh of every document, so it keys what
     /// a tool caches about the mesh.
     fn mesh_version(&self) -> u64;
+    /// The active tool (the handle tools are one [`CanvasTool`] that acts as it says).
+    fn tool(&self) -> Tool;
+    /// The selected handle (its panel section, its heat map, what Delete removes).
+    fn selected(&self) -> Option<usize>;
+    /// Selects handle `index`, or none.
+    fn select(&mut self, index: Option<usize>);
+    /// Whether point handles turn with their neighbours' motion while one is dragged.
+    fn auto_rotate(&self) -> bool;
+    /// The edges of the C² weights' dual graph (rig node pairs), as the GPU frame last
+    /// found them: found only while the dual graph is shown.
+    fn dual_graph(&self) -> &[(u32, u32)];
 }
 
 /// A tool of the canvas.

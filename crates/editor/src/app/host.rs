@@ -71,6 +71,26 @@ impl Host for EditorApp {
     fn mesh_version(&self) -> u64 {
         self.gpu.frame.mesh.version
     }
+
+    fn tool(&self) -> Tool {
+        self.tool
+    }
+
+    fn selected(&self) -> Option<usize> {
+        self.selected
+    }
+
+    fn select(&mut self, index: Option<usize>) {
+        self.selected = index;
+    }
+
+    fn auto_rotate(&self) -> bool {
+        self.auto_rotate
+    }
+
+    fn dual_graph(&self) -> &[(u32, u32)] {
+        &self.gpu.dual_graph.1
+    }
 }
 
 impl EditorApp {
@@ -80,6 +100,18 @@ impl EditorApp {
         let mut brush = std::mem::take(&mut self.brush);
         let out = f(&mut brush, self);
         self.brush = brush;
+        out
+    }
+
+    /// Runs `f` on the handle tools with the app as their host (the tool is lent out
+    /// for the call, so it and the host can both be changed).
+    pub(crate) fn with_handles<R>(
+        &mut self,
+        f: impl FnOnce(&mut HandleTool, &mut dyn Host) -> R,
+    ) -> R {
+        let mut handles = std::mem::take(&mut self.handles);
+        let out = f(&mut handles, self);
+        self.handles = handles;
         out
     }
 
