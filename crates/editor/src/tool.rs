@@ -27,7 +27,7 @@ pub enum Tool {
     AddBar,
     /// Paint rigidity (ARAP); Alt-drag erases.
     Rigidity,
-    /// Draw, adjust, solve and pose an LBC cage (see [`crate::cage`]).
+    /// Draw, adjust, solve and pose an LBC cage (the cage tool, `CageTool`).
     Cage,
 }
 
