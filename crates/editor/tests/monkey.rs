@@ -124,6 +124,7 @@ const LABELS: &[&str] = &[
     "Rigidity",
     "C² weights",
     "ARAP",
+    "MLS",
     "Clear rigidity",
     "Bring forward",
     "Send backward",
