@@ -128,15 +128,7 @@ impl HandleTool {
             scale,
             depth: 0,
         };
-        if self.edit(host, Edit::Add(handle))
-            && let Some(doc) = host.document()
-        {
-            let (count, ms) = (doc.project().handles.len(), doc.last_update_ms);
-            host.select(Some(count - 1));
-            host.info(&format!(
-                "added a point handle; weights updated in {ms:.1} ms"
-            ));
-        }
+        self.add_and_select(host, handle, "a point handle");
     }
 
     /// Adds a bar from `a` to `b` (image pixels, current pose) and selects it.
@@ -153,14 +145,17 @@ impl HandleTool {
             pose: Some([a.to_array(), b.to_array()]),
             depth: 0,
         };
+        self.add_and_select(host, handle, "a bar handle");
+    }
+
+    /// Adds `handle` (one undo step), selects it and says so, naming it `what`.
+    fn add_and_select(&mut self, host: &mut dyn Host, handle: HandleSpec, what: &str) {
         if self.edit(host, Edit::Add(handle))
             && let Some(doc) = host.document()
         {
             let (count, ms) = (doc.project().handles.len(), doc.last_update_ms);
             host.select(Some(count - 1));
-            host.info(&format!(
-                "added a bar handle; weights updated in {ms:.1} ms"
-            ));
+            host.info(&format!("added {what}; weights updated in {ms:.1} ms"));
         }
     }
 
