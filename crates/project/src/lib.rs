@@ -17,6 +17,12 @@ use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
+#[macro_use]
+mod names;
+pub mod animation;
+
+pub use animation::{Animation, HandlePose, Interpolation, Key, Pose, SpatialKey};
+
 /// The largest pose coordinate (pixels) or rotation (radians) a handle may have (the
 /// numeric core refuses larger ones too: blending them could overflow).
 pub const MAX_POSE: f64 = 1e9;
@@ -334,37 +340,6 @@ pub enum Placement {
     Symmetric,
 }
 
-/// Reads a unit enum from its name in a rig file; any other value is answered with
-/// the names that would do (`expected a method: "c2", "arap" or "lbc"`).
-macro_rules! deserialize_by_name {
-    ($ty:ident, $what:literal, [$($name:literal => $value:expr),+ $(,)?]) => {
-        impl<'de> Deserialize<'de> for $ty {
-            fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-                struct Names;
-                impl serde::de::Visitor<'_> for Names {
-                    type Value = $ty;
-                    fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-                        let names = [$(concat!("\"", $name, "\"")),+];
-                        let (last, rest) = names.split_last().unwrap_or((&"", &[]));
-                        if rest.is_empty() {
-                            write!(f, "{} {last}", $what)
-                        } else {
-                            write!(f, "{}: {} or {last}", $what, rest.join(", "))
-                        }
-                    }
-                    fn visit_str<E: serde::de::Error>(self, s: &str) -> Result<$ty, E> {
-                        match s {
-                            $($name => Ok($value),)+
-                            _ => Err(E::invalid_value(serde::de::Unexpected::Str(s), &self)),
-                        }
-                    }
-                }
-                d.deserialize_str(Names)
-            }
-        }
-    };
-}
-
 deserialize_by_name!(MetricChoice, "a metric", [
     "auto" => MetricChoice::Auto,
     "euclidean" => MetricChoice::Euclidean,
@@ -564,6 +539,9 @@ pub struct Project {
     /// grown to fit the warped picture (`"fit"`).
     #[serde(default, skip_serializing_if = "is_keep")]
     pub canvas: Canvas,
+    /// Key poses in time and on the canvas.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub animation: Option<Animation>,
 }
 
 fn is_c2(method: &Method) -> bool {
@@ -592,6 +570,7 @@ impl Default for Project {
             arap: None,
             mls: None,
             canvas: Canvas::Keep,
+            animation: None,
         }
     }
 }
@@ -921,6 +900,9 @@ impl Project {
             return bad(format!(
                 "mls.alpha must be a number above 0 and at most {MAX_MLS_ALPHA}, got {alpha}"
             ));
+        }
+        if let Some(animation) = &self.animation {
+            animation.validate(self).map_err(ProjectError::Invalid)?;
         }
         Ok(())
     }
