@@ -16,8 +16,10 @@ use crate::gpu_frame::{FrameBuilder, View};
 use crate::handles::HandleTool;
 use crate::history::History;
 use crate::jobs::{CancelFlag, Job, Outcome, Rebuild, SolveProgress};
+use crate::perform::PerformTool;
 use crate::scene::SceneResources;
 use crate::show::Show;
+use crate::timeline::Timeline;
 pub use crate::tool::Tool;
 use crate::tool::{CanvasTool, Host};
 use crate::viewport::Viewport;
@@ -111,8 +113,15 @@ pub struct EditorApp {
     wake: Option<egui::Context>,
     /// Milliseconds the last frame's logic took on the CPU.
     pub frame_ms: f64,
+    /// The timeline: the time shown, playback, recording.
+    pub timeline: Timeline,
+    /// The perform tool: pose markers and the control cursor (spatial keyframing).
+    pub(crate) perform: PerformTool,
+    /// Space was held for a pan since it went down (its release then does not play).
+    pub(crate) space_panned: bool,
 }
 
+mod animate;
 mod files;
 mod host;
 mod work;
@@ -193,6 +202,9 @@ impl EditorApp {
             checker: None,
             wake: None,
             frame_ms: 0.0,
+            timeline: Timeline::default(),
+            perform: PerformTool::default(),
+            space_panned: false,
         }
     }
 
@@ -360,8 +372,14 @@ impl EditorApp {
             Edit::Clear => Some(0),
             _ => None,
         };
+        let poses = matches!(edit, Edit::Pose(..) | Edit::ResetPose | Edit::CagePose(_));
         match doc.apply(edit) {
             Ok(()) => {
+                if poses {
+                    // With keys, a pose changed is keyed at the time shown (this step).
+                    self.autokey(&before);
+                }
+                let Some(doc) = &self.doc else { return false };
                 if doc.project() != &without_virtuals(&before) {
                     self.history.push(before);
                     self.dirty = true;
@@ -422,7 +440,7 @@ impl EditorApp {
             .doc
             .as_ref()
             .is_some_and(|d| d.method().controls() == Controls::Cage);
-        if lbc && tool != Tool::Cage {
+        if lbc && !matches!(tool, Tool::Cage | Tool::Perform) {
             self.info(
                 "under LBC the cage moves the picture: choose C² weights or ARAP under Method \
                  to work with handles (the cage stays in the project)",
@@ -462,7 +480,7 @@ impl EditorApp {
             .doc
             .as_ref()
             .is_some_and(|d| d.method().controls() == Controls::Cage);
-        if lbc && self.tool != Tool::Cage {
+        if lbc && !matches!(self.tool, Tool::Cage | Tool::Perform) {
             self.with_handles(|handles, host| handles.finish_gesture(host));
             self.tool = Tool::Cage;
             self.brush.cancel();
@@ -527,6 +545,8 @@ impl EditorApp {
     /// about to change under it.
     pub(crate) fn end_gesture(&mut self) {
         self.with_handles(|handles, host| handles.finish_gesture(host));
+        self.with_perform(|perform, host| perform.finish_gesture(host));
+        self.end_key_drag();
         self.end_cage_gesture();
     }
 
@@ -607,6 +627,7 @@ impl EditorApp {
                     self.selected = None;
                 }
                 self.sync_tool_after_history(was_lbc);
+                self.show_current_time();
                 self.info(format!(
                     "{}: {what}",
                     if back { "undone" } else { "redone" }

@@ -21,7 +21,11 @@ impl EditorApp {
         // A fitted view stays fitted when the window changes size (the first frames of
         // a new window, a maximise), until the user pans or zooms.
         // Not in the middle of a drag: the picture would move under the pointer.
-        if (self.needs_fit || (resized && self.view_fitted && !self.handles.dragging()))
+        if (self.needs_fit
+            || (resized
+                && self.view_fitted
+                && !self.handles.dragging()
+                && !self.perform.dragging()))
             && let Some(doc) = &self.doc
         {
             self.viewport.fit([doc.image.width(), doc.image.height()]);
@@ -121,6 +125,11 @@ impl EditorApp {
             );
             self.with_handles(|handles, host| handles.paint(host, &painter, pointer, active));
         }
+        let pointer = ui.input(|i| i.pointer.latest_pos());
+        let performing = self.tool == Tool::Perform;
+        if performing || self.perform.cursor.is_some() {
+            self.with_perform(|perform, host| perform.paint(host, &painter, pointer, performing));
+        }
         if let Some((what, seconds)) = self.busy_with().filter(|(_, s)| *s > 0.25) {
             // A short job (a rebuild at a low density) shows only in the status bar.
             painter.rect_filled(rect, 0.0, Color32::from_black_alpha(120));
@@ -176,9 +185,14 @@ impl EditorApp {
             || (response.drag_started_by(PointerButton::Primary) && space)
         {
             self.panning = true;
+            self.space_panned |= space;
         }
-        // A drag the handle tools start on empty canvas pans too (Puppet, Select).
-        self.with_handles(|handles, host| handles.input(host, ui, response));
+        if self.tool == Tool::Perform {
+            self.with_perform(|perform, host| perform.input(host, ui, response));
+        } else {
+            // A drag the handle tools start on empty canvas pans too (Puppet, Select).
+            self.with_handles(|handles, host| handles.input(host, ui, response));
+        }
         if response.dragged() && self.panning {
             self.viewport.origin += response.drag_delta();
             self.view_fitted = false;

@@ -24,6 +24,7 @@ use project::{
 };
 use weights_core::{Domain, NodeKind, Rig, VirtualHandle};
 
+mod animation;
 mod cage;
 mod checks;
 #[cfg(test)]
@@ -115,6 +116,9 @@ pub enum Edit {
     Canvas(project::Canvas),
     /// Moving least squares' settings: α and the class of map fitted.
     Mls(project::MlsSettings),
+    /// The animation: keys in time and on the canvas, rate, interpolation (`None`:
+    /// none).
+    Animation(Option<Box<project::Animation>>),
 }
 
 /// An open picture with its rig. Cloning copies the rig (tens of megabytes at a
@@ -386,6 +390,13 @@ impl Document {
         match edit {
             Edit::Add(handle) => {
                 self.check_room(&handle)?;
+                // Every key gets the new handle where its pose takes it.
+                let fitted = self.fit_into_keys(&handle)?;
+                if let Some(animation) = &mut project.animation {
+                    for (pose, fit) in animation.poses_mut().zip(fitted) {
+                        pose.handles.push(fit);
+                    }
+                }
                 project.handles.push(handle);
             }
             Edit::Remove(index) => {
@@ -393,13 +404,21 @@ impl Document {
                     bail!("there is no handle {index}");
                 }
                 project.handles.remove(index);
+                if let Some(animation) = &mut project.animation {
+                    animation.remove_handle(index);
+                }
             }
             Edit::Pose(index, handle) => match project.handles.get_mut(index) {
                 Some(slot) if same_rest(slot, &handle) => *slot = handle,
                 Some(_) => bail!("a pose change may not move handle {index} at rest"),
                 None => bail!("there is no handle {index}"),
             },
-            Edit::Clear => project.handles.clear(),
+            Edit::Clear => {
+                project.handles.clear();
+                if let Some(animation) = &mut project.animation {
+                    animation.poses_mut().for_each(|pose| pose.handles.clear());
+                }
+            }
             Edit::ResetPose => {
                 for h in &mut project.handles {
                     *h = at_rest(h);
@@ -424,6 +443,10 @@ impl Document {
                     });
                 }
                 project.cage = Some(CageSpec { rest, pose: None });
+                // A new rest cage: the keys' cage poses no longer fit it.
+                if let Some(animation) = &mut project.animation {
+                    animation.poses_mut().for_each(|pose| pose.cage = None);
+                }
                 if project.method.controls() != Controls::Cage {
                     project.method = Method::for_controls(Controls::Cage);
                 }
@@ -431,6 +454,9 @@ impl Document {
             }
             Edit::ClearCage => {
                 project.cage = None;
+                if let Some(animation) = &mut project.animation {
+                    animation.poses_mut().for_each(|pose| pose.cage = None);
+                }
                 if project.method.controls() == Controls::Cage {
                     project.method = Method::for_controls(Controls::Handles);
                 }
@@ -460,6 +486,12 @@ impl Document {
                 project
                     .validate(Some(self.image.dimensions()))
                     .context("MLS's settings")?;
+            }
+            Edit::Animation(animation) => {
+                project.animation = animation.map(|a| *a);
+                project
+                    .validate(Some(self.image.dimensions()))
+                    .context("the animation")?;
             }
         }
         self.restore(project)

@@ -168,6 +168,24 @@ pub fn describe_change(from: &Project, to: &Project) -> String {
     if from.mls != to.mls {
         parts.push("MLS's settings".to_owned());
     }
+    let empty = project::Animation::default();
+    let (x, y) = (
+        from.animation.as_ref().unwrap_or(&empty),
+        to.animation.as_ref().unwrap_or(&empty),
+    );
+    if x.keys != y.keys {
+        parts.push(match (x.keys.len(), y.keys.len()) {
+            (a, b) if b > a => "a key set".to_owned(),
+            (a, b) if b < a => "a key deleted".to_owned(),
+            _ => "the keys".to_owned(),
+        });
+    }
+    if x.spatial_keys != y.spatial_keys {
+        parts.push("the pose markers".to_owned());
+    }
+    if (x.fps, x.interpolation) != (y.fps, y.interpolation) {
+        parts.push("the animation's settings".to_owned());
+    }
     if parts.is_empty() {
         "nothing visible".to_owned()
     } else {

@@ -20,8 +20,10 @@ mod handles;
 mod history;
 mod jobs;
 mod panels;
+mod perform;
 mod scene;
 mod show;
+mod timeline;
 mod tool;
 mod viewport;
 
@@ -33,8 +35,10 @@ pub use cage::{CageState, CageTool, contour, crossing_edges};
 pub use dialogs::{Answer, Dialogs, FileAction, IMAGES, NativeDialogs, desktop_has_dialogs};
 pub use document::{CageKey, Document, Edit, Settings, posed, solve_cage};
 pub use panels::SHORTCUTS;
+pub use perform::PerformTool;
 pub use scene::SceneResources;
 pub use show::Show;
+pub use timeline::Timeline;
 pub use viewport::Viewport;
 
 /// Opens the editor window on `path` (a picture, or a `.json` project) or on the

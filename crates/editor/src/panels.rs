@@ -64,6 +64,14 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("Shift + drag", "Scale the handle"),
     ("Alt + click a handle", "Delete it"),
     ("Drag empty canvas", "Pan (Puppet and Select tools)"),
+    (
+        "Y",
+        "Perform tool: place pose markers, drag the control cursor to blend them",
+    ),
+    ("I", "Set a key: the pose shown, at the time shown"),
+    ("Space (tap)", "Play or pause the keys"),
+    (", / .", "Previous / next frame"),
+    ("Shift + , / Shift + .", "Previous / next key"),
     ("Right click", "Handle menu: delete, reset pose"),
     ("Delete / Backspace", "Delete the selected handle"),
     ("Middle drag, Space + drag", "Pan"),
@@ -91,6 +99,7 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("F1", "This window"),
 ];
 
+mod timeline;
 mod windows;
 
 impl eframe::App for EditorApp {
@@ -99,6 +108,7 @@ impl eframe::App for EditorApp {
         let ctx = ui.ctx().clone();
         self.poll_job();
         self.sync_tool();
+        self.tick(&ctx);
         self.dropped_files(&ctx);
         let idle = !self.is_busy();
         if !idle {
@@ -121,6 +131,11 @@ impl eframe::App for EditorApp {
             ui.add_enabled_ui(idle, |ui| self.menu_bar(ui));
         });
         egui::Panel::bottom("status").show(ui, |ui| self.status_bar(ui));
+        if self.doc.is_some() {
+            egui::Panel::bottom("timeline").show(ui, |ui| {
+                ui.add_enabled_ui(idle, |ui| self.timeline_ui(ui));
+            });
+        }
         egui::Panel::left("tools")
             .resizable(false)
             .default_size(220.0)
@@ -248,6 +263,29 @@ impl EditorApp {
         }
         if pressed(none, Key::K) {
             self.set_tool(Tool::Cage);
+        }
+        if pressed(none, Key::Y) {
+            self.set_tool(Tool::Perform);
+        }
+        if pressed(none, Key::I) {
+            self.set_key();
+        }
+        if pressed(Modifiers::SHIFT, Key::Comma) {
+            self.step_key(true);
+        } else if pressed(none, Key::Comma) {
+            self.step_frames(-1);
+        }
+        if pressed(Modifiers::SHIFT, Key::Period) {
+            self.step_key(false);
+        } else if pressed(none, Key::Period) {
+            self.step_frames(1);
+        }
+        // Space: a tap plays or pauses; held, it pans with a drag.
+        if ctx.input(|i| i.key_released(Key::Space)) {
+            if !self.space_panned {
+                self.toggle_play();
+            }
+            self.space_panned = false;
         }
         if pressed(none, Key::F) {
             self.needs_fit = true;
@@ -479,9 +517,15 @@ impl EditorApp {
                     "LBC's cage (K): click a polygon around the subject, adjust it, \
                      solve it, then drag its vertices to warp what lies inside",
                 ),
+                (
+                    Tool::Perform,
+                    "Perform",
+                    "Spatial keyframing (Y): place markers that hold poses, then drag the \
+                     control cursor to blend them; with Record on, the drag becomes keys",
+                ),
             ];
             for (t, label, hover) in tools {
-                let enabled = handles || t == Tool::Cage;
+                let enabled = handles || matches!(t, Tool::Cage | Tool::Perform);
                 let button = egui::Button::selectable(tool == t, label);
                 if ui
                     .add_enabled(enabled, button)
@@ -504,6 +548,12 @@ impl EditorApp {
         });
         if self.tool == Tool::Rigidity {
             self.with_brush(|brush, host| brush.panel(host, ui));
+        }
+        if self.tool == Tool::Perform {
+            ui.separator();
+            ui.heading("Perform");
+            self.with_perform(|perform, host| perform.panel(host, ui));
+            ui.separator();
         }
         ui.checkbox(&mut self.auto_rotate, "Auto-rotate points")
             .on_hover_text("Point handles turn with their neighbours' motion");

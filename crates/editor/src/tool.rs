@@ -29,6 +29,9 @@ pub enum Tool {
     Rigidity,
     /// Draw, adjust, solve and pose an LBC cage (the cage tool, `CageTool`).
     Cage,
+    /// Spatial keyframing: place key poses at markers, drag the control cursor to
+    /// blend them (`PerformTool`).
+    Perform,
 }
 
 /// What a tool may use of the editor.

@@ -33,13 +33,22 @@ impl Host for EditorApp {
     }
 
     fn preview(&mut self, project: Project) {
+        // A drag takes over from playback.
+        self.timeline.playing = None;
         let Some(doc) = &mut self.doc else { return };
         if let Err(e) = doc.restore(project) {
             self.error(&e);
         }
+        // A live drag: recording, when armed, starts with it.
+        self.start_take();
     }
 
     fn record(&mut self, before: Project) {
+        if self.end_take() {
+            return;
+        }
+        // With keys, the pose the drag left is keyed at the time shown (this step).
+        self.autokey(&before);
         if let Some(doc) = &self.doc
             && doc.project() != &without_virtuals(&before)
         {
@@ -112,6 +121,17 @@ impl EditorApp {
         let mut handles = std::mem::take(&mut self.handles);
         let out = f(&mut handles, self);
         self.handles = handles;
+        out
+    }
+
+    /// Runs `f` on the perform tool with the app as its host (lent out for the call).
+    pub(crate) fn with_perform<R>(
+        &mut self,
+        f: impl FnOnce(&mut PerformTool, &mut dyn Host) -> R,
+    ) -> R {
+        let mut perform = std::mem::take(&mut self.perform);
+        let out = f(&mut perform, self);
+        self.perform = perform;
         out
     }
 

@@ -186,6 +186,9 @@ impl EditorApp {
                 self.history.clear();
                 self.dirty = false;
                 self.selected = None;
+                self.timeline = crate::timeline::Timeline::default();
+                self.perform = crate::perform::PerformTool::default();
+                self.show_current_time();
                 self.cage.forget_document();
                 if lbc {
                     self.tool = Tool::Cage;
@@ -322,6 +325,7 @@ impl EditorApp {
             short.unwrap_or_default()
         ));
         self.sync_tool_after_history(was_lbc);
+        self.show_current_time();
     }
 }
 

@@ -1,0 +1,292 @@
+//! Animation in the editor, driven as a user drives it: keys set on the timeline and
+//! by posing at a time, playback, undo, handles added and removed while keys exist,
+//! spatial keys blended by the control cursor, a recorded performance, and the
+//! animation saved and reopened — on the built-in lizard, for every method.
+
+mod support;
+
+use egui::{Key, Modifiers};
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use glam::DVec2;
+use project::{HandlePose, Pose};
+
+use editor::{EditorApp, Tool};
+use support::{at, click_label, drag, editor, handles, settle};
+
+fn pose(h: &Harness<'_, EditorApp>) -> Pose {
+    Pose::of(h.state().document().expect("a document").project())
+}
+
+fn keys(h: &Harness<'_, EditorApp>) -> Vec<project::Key> {
+    h.state().keys().to_vec()
+}
+
+/// Where handle `i` is drawn now (a point's position; a bar's first end).
+fn handle_at(h: &Harness<'_, EditorApp>, i: usize) -> DVec2 {
+    editor::posed(&handles(h)[i])[0]
+}
+
+/// Moves the time shown by `frames` frames with the keyboard.
+fn step(h: &mut Harness<'_, EditorApp>, frames: i32) {
+    let key = if frames < 0 { Key::Comma } else { Key::Period };
+    for _ in 0..frames.abs() {
+        h.key_press(key);
+        h.run();
+    }
+}
+
+/// Drags handle `i` by `by` image pixels.
+fn drag_handle(h: &mut Harness<'_, EditorApp>, i: usize, by: DVec2) {
+    let from = handle_at(h, i);
+    let to = from + by;
+    let (a, b) = (at(h, from.x, from.y), at(h, to.x, to.y));
+    drag(h, a, b, Modifiers::NONE);
+}
+
+/// Three keys on the lizard: at rest at 0 s, handle 0 dragged at 0.5 s, handle 1 at
+/// 1 s. Returns the three poses.
+fn three_keys(h: &mut Harness<'_, EditorApp>) -> [Pose; 3] {
+    click_label(h, "Set key");
+    let rest = pose(h);
+    step(h, 12);
+    drag_handle(h, 0, DVec2::new(30.0, -20.0));
+    let second = pose(h);
+    step(h, 12);
+    drag_handle(h, 1, DVec2::new(-25.0, 15.0));
+    let third = pose(h);
+    [rest, second, third]
+}
+
+#[test]
+fn keys_set_by_posing_at_a_time_play_back_and_undo() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    let [rest, second, third] = three_keys(&mut h);
+    let keys = keys(&h);
+    assert_eq!(
+        keys.iter().map(|k| k.time).collect::<Vec<_>>(),
+        [0.0, 0.5, 1.0],
+        "a key set with the button, two by posing at a time with no key"
+    );
+    assert_eq!(keys[1].pose, second);
+    assert_eq!(keys[2].pose, third);
+    assert_ne!(second, rest);
+
+    // Back to a quarter second: the pose halfway between the first two keys.
+    step(&mut h, -18);
+    assert!((h.state().timeline.time - 0.25).abs() < 1e-9);
+    let project = h.state().document().expect("doc").project().clone();
+    assert_eq!(
+        pose(&h),
+        animation::pose_at(&project, 0.25).expect("a pose")
+    );
+    let (HandlePose::Point { translate: a, .. }, HandlePose::Point { translate: b, .. }) =
+        (rest.handles[0], second.handles[0])
+    else {
+        panic!("point handles");
+    };
+    let HandlePose::Point { translate: mid, .. } = pose(&h).handles[0] else {
+        panic!("a point");
+    };
+    for k in 0..2 {
+        assert!((mid[k] - 0.5 * (a[k] + b[k])).abs() < 1e-9);
+    }
+
+    // Play: the time moves on and the pose follows the keys.
+    h.key_press(Key::Space);
+    h.step();
+    assert!(h.state().timeline.is_playing());
+    std::thread::sleep(std::time::Duration::from_millis(120));
+    h.step();
+    let time = h.state().timeline.time;
+    assert!(time > 0.25, "playback moved the time ({time})");
+    let project = h.state().document().expect("doc").project().clone();
+    assert_eq!(
+        pose(&h),
+        animation::pose_at(&project, time).expect("a pose")
+    );
+    h.key_press(Key::Space);
+    h.run();
+    assert!(!h.state().timeline.is_playing());
+
+    // The drag that made the last key is one undo step, key and pose together.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert_eq!(self::keys(&h).len(), 2);
+    h.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
+    h.run();
+    assert_eq!(self::keys(&h).len(), 3);
+}
+
+#[test]
+fn handles_added_or_removed_keep_every_key() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    let poses = three_keys(&mut h);
+    let count = handles(&h).len();
+    // Add a point handle on the lizard's body while posed at the last key.
+    let spot = handle_at(&h, 0) + DVec2::new(0.0, 60.0);
+    h.state_mut().add_point(spot);
+    h.run();
+    assert_eq!(handles(&h).len(), count + 1, "{:?}", h.state().message);
+    for key in keys(&h) {
+        assert_eq!(key.pose.handles.len(), count + 1);
+    }
+    // In the key shown (the last) the new handle's pose is near the one the puppet
+    // tool gave it; in each key it sits where that key's pose takes its rest point.
+    let added = handles(&h)[count].clone();
+    let (
+        HandlePose::Point {
+            translate: t,
+            rotate: r,
+            ..
+        },
+        project::HandleSpec::Point {
+            translate: u,
+            rotate: q,
+            ..
+        },
+    ) = (keys(&h)[2].pose.handles[count], &added)
+    else {
+        panic!("a point handle");
+    };
+    assert!((t[0] - u[0]).hypot(t[1] - u[1]) < 1.0, "{t:?} vs {u:?}");
+    assert!((r - q).abs() < 0.05);
+    for (key, old) in keys(&h).iter().zip(&poses) {
+        assert_eq!(key.pose.handles[..count], old.handles[..]);
+    }
+    // Removing handle 0 removes its track; the others keep theirs.
+    h.state_mut().selected = Some(0);
+    h.state_mut().delete_selected();
+    h.run();
+    for (key, old) in keys(&h).iter().zip(&poses) {
+        assert_eq!(key.pose.handles.len(), count);
+        assert_eq!(key.pose.handles[..count - 1], old.handles[1..]);
+    }
+}
+
+#[test]
+fn the_control_cursor_blends_the_pose_markers_and_a_take_records_it() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    h.key_press(Key::Y);
+    h.run();
+    assert_eq!(h.state().tool, Tool::Perform);
+    // Three markers, each for a pose made with the puppet tool.
+    let spots = [(60.0, 60.0), (400.0, 60.0), (230.0, 380.0)];
+    let mut poses = Vec::new();
+    for (i, &(x, y)) in spots.iter().enumerate() {
+        if i > 0 {
+            h.key_press(Key::W);
+            h.run();
+            drag_handle(&mut h, i - 1, DVec2::new(20.0, 25.0));
+            h.key_press(Key::Y);
+            h.run();
+        }
+        poses.push(pose(&h));
+        let p = at(&h, x, y);
+        h.hover_at(p);
+        h.event(egui::Event::ModifiersChanged(Modifiers::COMMAND));
+        h.event(egui::Event::PointerButton {
+            pos: p,
+            button: egui::PointerButton::Primary,
+            pressed: true,
+            modifiers: Modifiers::COMMAND,
+        });
+        h.event(egui::Event::PointerButton {
+            pos: p,
+            button: egui::PointerButton::Primary,
+            pressed: false,
+            modifiers: Modifiers::COMMAND,
+        });
+        h.run();
+        h.event(egui::Event::ModifiersChanged(Modifiers::NONE));
+        h.run();
+    }
+    let project = h.state().document().expect("doc").project().clone();
+    let markers = &project.animation.as_ref().expect("animation").spatial_keys;
+    assert_eq!(markers.len(), 3, "{:?}", h.state().message);
+    for (marker, pose) in markers.iter().zip(&poses) {
+        assert_eq!(&marker.pose, pose);
+    }
+    // Drag the cursor onto the second marker: its pose exactly.
+    let (a, b) = (at(&h, 150.0, 200.0), at(&h, 400.0, 60.0));
+    drag(&mut h, a, b, Modifiers::NONE);
+    let project = h.state().document().expect("doc").project().clone();
+    let blend = animation::SpatialBlend::of(&project).expect("a blend");
+    let cursor = h.state().viewport.to_image(b);
+    assert_eq!(
+        pose(&h),
+        blend.pose(&project, cursor.to_array()).expect("a pose")
+    );
+
+    // Record a take: the drag becomes keys from the time shown.
+    click_label(&mut h, "⏺ Record");
+    let (a, b) = (at(&h, 100.0, 90.0), at(&h, 230.0, 330.0));
+    h.hover_at(a);
+    h.run();
+    h.event(egui::Event::PointerButton {
+        pos: a,
+        button: egui::PointerButton::Primary,
+        pressed: true,
+        modifiers: Modifiers::NONE,
+    });
+    h.step();
+    for i in 1..=10 {
+        h.hover_at(a + (b - a) * (i as f32 / 10.0));
+        h.step();
+        std::thread::sleep(std::time::Duration::from_millis(30));
+    }
+    h.event(egui::Event::PointerButton {
+        pos: b,
+        button: egui::PointerButton::Primary,
+        pressed: false,
+        modifiers: Modifiers::NONE,
+    });
+    h.run();
+    let keys = keys(&h);
+    assert!(
+        keys.len() >= 2,
+        "a take makes keys ({:?})",
+        h.state().message
+    );
+    assert_eq!(keys[0].time, 0.0);
+    assert!(!h.state().timeline.is_recording());
+    // The take is one undo step.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert!(self::keys(&h).is_empty());
+}
+
+#[test]
+fn an_animation_saved_reopens_the_same_and_the_timeline_looks_right() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    // The built-in picture, as a file the saved project can name.
+    let lizard = support::write_lizard(dir.path());
+    h.state_mut().document_mut().expect("doc").image_path = Some(lizard);
+    three_keys(&mut h);
+    h.state_mut().timeline.onion = true;
+    step(&mut h, -6);
+    h.run();
+    let saved = h.state().document().expect("doc").project().clone();
+    h.key_press_modifiers(Modifiers::COMMAND, Key::S);
+    h.run();
+    let path = dir.path().join("project.json");
+    let reopened = pipeline::load_project(&path).expect("the saved project");
+    assert_eq!(reopened.animation, saved.animation);
+    h.state_mut().open(&path);
+    settle(&mut h);
+    assert_eq!(
+        h.state().document().expect("doc").project().animation,
+        saved.animation
+    );
+    assert!(
+        !h.state().message.as_ref().is_some_and(|m| m.is_error),
+        "{:?}",
+        h.state().message
+    );
+    let _ = h.get_by_label("Timeline");
+    h.snapshot("editor_timeline");
+}
