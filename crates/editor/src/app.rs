@@ -16,6 +16,7 @@ use crate::gpu_frame::{FrameBuilder, View};
 use crate::handles::HandleTool;
 use crate::history::History;
 use crate::jobs::{CancelFlag, Job, Outcome, Rebuild, SolveProgress};
+use crate::onion::Onion;
 use crate::perform::PerformTool;
 use crate::scene::SceneResources;
 use crate::show::Show;
@@ -119,6 +120,8 @@ pub struct EditorApp {
     pub(crate) perform: PerformTool,
     /// Space was held for a pan since it went down (its release then does not play).
     pub(crate) space_panned: bool,
+    /// The onion skin's ghosts.
+    pub(crate) onion: Onion,
 }
 
 mod animate;
@@ -205,6 +208,7 @@ impl EditorApp {
             timeline: Timeline::default(),
             perform: PerformTool::default(),
             space_panned: false,
+            onion: Onion::default(),
         }
     }
 
@@ -255,6 +259,7 @@ impl EditorApp {
         }
         self.handles.sanity_check(Some(doc), self.tool)?;
         self.cage_sanity_check(doc)?;
+        self.timeline_sanity_check(doc)?;
         self.gpu.sanity_check(doc)?;
         if self.log.len() > LOG_LIMIT {
             anyhow::bail!("the message log outgrew its limit");
@@ -395,6 +400,10 @@ impl EditorApp {
                 }
                 self.settings_draft = None;
                 self.sync_tool();
+                if !poses {
+                    // A handle added takes the keys' fitted pose at the time shown.
+                    self.show_current_time();
+                }
                 true
             }
             Err(e) => {
@@ -452,6 +461,11 @@ impl EditorApp {
                 cage.finish_gesture(host);
                 cage.cancel();
             });
+        }
+        if self.tool == Tool::Perform && tool != Tool::Perform {
+            // The control cursor previews poses; with keys, the timeline's pose is back.
+            self.with_perform(|perform, host| perform.finish_gesture(host));
+            self.show_current_time();
         }
         self.tool = tool;
         self.handles.cancel();

@@ -72,6 +72,7 @@ impl EditorApp {
                 painter.image(checker.id(), visible, uv, Color32::WHITE);
             }
         }
+        self.paint_onion(ui, &painter);
         let cage_view = self.cage_view();
         if self.has_gpu {
             let (scale, offset) = self.viewport.device_map();
@@ -313,5 +314,32 @@ pub(crate) fn node_name(rig: &weights_core::Rig, k: usize) -> String {
             Some(h) => format!("virtual node {k} (mostly handle {})", h + 1),
             None => format!("virtual node {k}"),
         },
+    }
+}
+
+impl EditorApp {
+    /// The onion skin, when on (and not while playing): the previous and next keys'
+    /// pictures ghosted under the current one.
+    fn paint_onion(&mut self, ui: &Ui, painter: &egui::Painter) {
+        if !self.timeline.onion {
+            self.onion.clear();
+            return;
+        }
+        if self.timeline.is_playing() || self.timeline.is_taking() {
+            return;
+        }
+        let Some(doc) = &mut self.doc else { return };
+        self.onion.update(doc, self.timeline.time, ui.ctx());
+        let frame = Rect::from_two_pos(
+            self.viewport.to_screen(DVec2::ZERO),
+            self.viewport.to_screen(DVec2::new(
+                f64::from(doc.image.width()),
+                f64::from(doc.image.height()),
+            )),
+        );
+        let uv = Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0));
+        for ghost in &self.onion.ghosts {
+            painter.image(ghost.id(), frame, uv, Color32::WHITE);
+        }
     }
 }

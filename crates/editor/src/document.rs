@@ -30,6 +30,7 @@ mod checks;
 #[cfg(test)]
 mod tests;
 
+pub use animation::PosedMesh;
 pub use cage::{CageKey, solve_cage};
 
 /// The parameters of the weighting a user can change in the side panel.

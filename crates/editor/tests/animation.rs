@@ -267,9 +267,6 @@ fn an_animation_saved_reopens_the_same_and_the_timeline_looks_right() {
     let lizard = support::write_lizard(dir.path());
     h.state_mut().document_mut().expect("doc").image_path = Some(lizard);
     three_keys(&mut h);
-    h.state_mut().timeline.onion = true;
-    step(&mut h, -6);
-    h.run();
     let saved = h.state().document().expect("doc").project().clone();
     h.key_press_modifiers(Modifiers::COMMAND, Key::S);
     h.run();
@@ -287,6 +284,92 @@ fn an_animation_saved_reopens_the_same_and_the_timeline_looks_right() {
         "{:?}",
         h.state().message
     );
+    // Between the second and third keys, with their pictures ghosted behind.
+    h.state_mut().timeline.onion = true;
+    step(&mut h, 15);
     let _ = h.get_by_label("Timeline");
     h.snapshot("editor_timeline");
+}
+
+#[test]
+fn every_handle_method_shows_its_own_answer_between_keys() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    for label in ["C² weights", "ARAP", "MLS"] {
+        let mut h = support::editor_with(
+            Box::new(support::Scripted {
+                dir: dir.path().to_path_buf(),
+            }),
+            false,
+        );
+        click_label(&mut h, label);
+        settle(&mut h);
+        click_label(&mut h, "Set key");
+        step(&mut h, 12);
+        drag_handle(&mut h, 0, DVec2::new(40.0, -30.0));
+        step(&mut h, -6);
+        let doc = h.state().document().expect("doc");
+        let project = doc.project().clone();
+        assert_eq!(keys(&h).len(), 2, "{label}");
+        assert_eq!(
+            Pose::of(&project),
+            animation::pose_at(&project, 0.25).expect("a pose"),
+            "{label}"
+        );
+        // What the view draws between the keys is the method's answer for the rig
+        // posed at that time, set up afresh.
+        let shown = doc.deformer().deformed();
+        let fresh = pipeline::on_handles(
+            &animation::posed_at(&project, 0.25),
+            doc.rig().clone(),
+            Some(&doc.image),
+        )
+        .expect("the method")
+        .deformed();
+        assert_eq!(shown, fresh, "{label}");
+    }
+}
+
+#[test]
+fn a_cage_is_keyed_and_played_under_lbc() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = support::editor_with(
+        Box::new(support::Scripted {
+            dir: dir.path().to_path_buf(),
+        }),
+        false,
+    );
+    h.state_mut().cage.inside_vertices = 300;
+    h.key_press(Key::K);
+    h.run();
+    let cage = [
+        [220.0, 200.0],
+        [390.0, 190.0],
+        [450.0, 300.0],
+        [390.0, 430.0],
+        [240.0, 430.0],
+        [170.0, 320.0],
+    ];
+    for p in cage.iter().chain(&cage[..1]) {
+        let pos = at(&h, p[0], p[1]);
+        support::click_at(&mut h, pos);
+    }
+    h.key_press(Key::Enter);
+    h.step();
+    settle(&mut h);
+    click_label(&mut h, "Set key");
+    step(&mut h, 12);
+    let (a, b) = (at(&h, 390.0, 190.0), at(&h, 420.0, 150.0));
+    drag(&mut h, a, b, Modifiers::NONE);
+    assert_eq!(keys(&h).len(), 2, "{:?}", h.state().message);
+    let posed = keys(&h)[1].pose.cage.clone().expect("a cage pose");
+    assert!((posed[1][0] - 420.0).abs() < 2.0 && (posed[1][1] - 150.0).abs() < 2.0);
+    step(&mut h, -6);
+    let doc = h.state().document().expect("doc");
+    let halfway = doc.cage().and_then(|c| c.pose.clone()).expect("posed");
+    assert!((halfway[1][0] - 0.5 * (390.0 + posed[1][0])).abs() < 1e-9);
+    assert!((halfway[1][1] - 0.5 * (190.0 + posed[1][1])).abs() < 1e-9);
+    // Perform works under LBC too: a marker holds the cage's pose.
+    h.key_press(Key::Y);
+    h.run();
+    assert_eq!(h.state().tool, Tool::Perform);
 }

@@ -163,6 +163,25 @@ const LABELS: &[&str] = &[
     "Cage from outline",
     "Support contour (0.001/n)",
     "Locality plots",
+    "Perform",
+    "Place marker",
+    "Clear markers",
+    "Set key",
+    "Set key",
+    "Delete key",
+    "Hold",
+    "Copy pose",
+    "Paste key",
+    "Loop",
+    "Onion skin",
+    "⏺ Record",
+    "Every frame",
+    "▶ Play",
+    "⏸ Pause",
+    "⏮",
+    "⏭",
+    "⏴",
+    "⏵",
 ];
 
 const KEYS: &[(Modifiers, Key)] = &[
@@ -194,6 +213,15 @@ const KEYS: &[(Modifiers, Key)] = &[
     (Modifiers::COMMAND, Key::E),
     (Modifiers::COMMAND, Key::O),
     (Modifiers::COMMAND.plus(Modifiers::SHIFT), Key::O),
+    (Modifiers::NONE, Key::Y),
+    (Modifiers::NONE, Key::I),
+    (Modifiers::NONE, Key::I),
+    (Modifiers::NONE, Key::Comma),
+    (Modifiers::NONE, Key::Period),
+    (Modifiers::NONE, Key::Period),
+    (Modifiers::SHIFT, Key::Comma),
+    (Modifiers::SHIFT, Key::Period),
+    (Modifiers::NONE, Key::Space),
 ];
 
 impl Monkey {
@@ -216,6 +244,12 @@ impl Monkey {
                 points.extend(d.cage_rest());
                 points.extend(d.cage_pose());
                 points.extend(app.cage_draft().unwrap_or_default());
+                points.extend(
+                    d.project()
+                        .animation
+                        .iter()
+                        .flat_map(|a| a.spatial_keys.iter().map(|k| DVec2::from(k.at))),
+                );
                 points
             })
             .unwrap_or_default();
@@ -342,8 +376,25 @@ impl Monkey {
     /// A drag with a random button, modifiers and length; sometimes Delete, undo or a
     /// tool switch arrives in the middle, sometimes it ends off the canvas.
     fn drag(&mut self) -> String {
-        let from = self.somewhere();
-        let to = if self.rng.chance(0.8) {
+        // Now and then along the timeline: scrubbing, or moving a key.
+        let strip = if self.rng.chance(0.12) {
+            self.h.query_by_label("Timeline").map(|node| node.rect())
+        } else {
+            None
+        };
+        let in_strip = |rng: &mut Rng, r: egui::Rect| {
+            Pos2::new(
+                r.min.x + rng.unit() * r.width(),
+                r.min.y + rng.unit() * r.height(),
+            )
+        };
+        let from = match strip {
+            Some(r) => in_strip(&mut self.rng, r),
+            None => self.somewhere(),
+        };
+        let to = if let Some(r) = strip {
+            in_strip(&mut self.rng, r.expand(30.0))
+        } else if self.rng.chance(0.8) {
             from + Vec2::new(self.rng.unit() - 0.5, self.rng.unit() - 0.5) * 300.0
         } else {
             self.somewhere()
@@ -365,6 +416,9 @@ impl Monkey {
                 (Modifiers::NONE, Key::Escape),
                 (Modifiers::NONE, Key::C),
                 (Modifiers::COMMAND, Key::O),
+                (Modifiers::NONE, Key::I),
+                (Modifiers::NONE, Key::Space),
+                (Modifiers::NONE, Key::Y),
             ]))
         } else {
             None

@@ -392,4 +392,30 @@ impl EditorApp {
         }
         true
     }
+
+    /// The timeline's part of [`EditorApp::sanity_check`]: a finite time, and with keys
+    /// the pose shown is theirs at that time whenever nothing previews another (no
+    /// playback between frames, take, drag, perform tool or job).
+    pub(crate) fn timeline_sanity_check(&self, doc: &Document) -> Result<()> {
+        let time = self.timeline.time;
+        if !(time.is_finite() && time >= 0.0) {
+            anyhow::bail!("the timeline's time is {time}");
+        }
+        let previewing = self.timeline.is_playing()
+            || self.timeline.is_taking()
+            || self.timeline.key_drag.is_some()
+            || self.handles.dragging()
+            || self.perform.dragging()
+            || self.tool == Tool::Perform
+            || self.is_busy();
+        if previewing {
+            return Ok(());
+        }
+        if let Some(pose) = animation::pose_at(doc.project(), time)
+            && pose != Pose::of(doc.project())
+        {
+            anyhow::bail!("the pose shown is not the keys' pose at {time} s");
+        }
+        Ok(())
+    }
 }

@@ -153,3 +153,40 @@ impl Document {
         }
     }
 }
+
+impl Document {
+    /// The mesh the view draws, posed as `pose`: its rest positions (texture
+    /// coordinates), where `pose` takes them, and its triangles in drawing order. The
+    /// document is left as it was (for the onion skin's ghosts).
+    ///
+    /// # Errors
+    /// A pose the method refuses.
+    pub fn posed_mesh(&mut self, pose: &Pose) -> Result<PosedMesh> {
+        let current = self.project.clone();
+        let shown = self.show_pose(pose).map(|_| {
+            let deformer = self.deformer();
+            let cage = deformer.method().controls() == Controls::Cage;
+            PosedMesh {
+                rest: deformer.rest().to_vec(),
+                deformed: deformer.deformed(),
+                triangles: if cage {
+                    deformer.triangles().to_vec()
+                } else {
+                    self.draw_order()
+                },
+            }
+        });
+        self.restore(current)?;
+        shown
+    }
+}
+
+/// A mesh at rest and posed (see [`Document::posed_mesh`]).
+pub struct PosedMesh {
+    /// Rest positions, image pixels.
+    pub rest: Vec<DVec2>,
+    /// Posed positions, image pixels.
+    pub deformed: Vec<DVec2>,
+    /// Triangles, back to front.
+    pub triangles: Vec<[u32; 3]>,
+}
