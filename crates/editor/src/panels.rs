@@ -131,11 +131,6 @@ impl eframe::App for EditorApp {
             ui.add_enabled_ui(idle, |ui| self.menu_bar(ui));
         });
         egui::Panel::bottom("status").show(ui, |ui| self.status_bar(ui));
-        if self.doc.is_some() {
-            egui::Panel::bottom("timeline").show(ui, |ui| {
-                ui.add_enabled_ui(idle, |ui| self.timeline_ui(ui));
-            });
-        }
         egui::Panel::left("tools")
             .resizable(false)
             .default_size(220.0)
@@ -155,6 +150,12 @@ impl eframe::App for EditorApp {
                         self.with_cage(|cage, host| cage.locality_panel(host, ui));
                     });
                 });
+        }
+        // Under the canvas only: the side panels keep their height.
+        if self.doc.is_some() {
+            egui::Panel::bottom("timeline").show(ui, |ui| {
+                ui.add_enabled_ui(idle, |ui| self.timeline_ui(ui));
+            });
         }
         egui::CentralPanel::default()
             .frame(egui::Frame::NONE)

@@ -120,6 +120,7 @@ impl HandleTool {
             host.error(&anyhow::anyhow!("click on the picture to add a handle"));
             return;
         };
+        let rest = unmoved(rest, at);
         let (rotate, scale) = doc.local_pose(rest, at);
         let handle = HandleSpec::Point {
             rest: rest.to_array(),
@@ -140,6 +141,7 @@ impl HandleTool {
             host.error(&anyhow::anyhow!("a bar must start and end on the picture"));
             return;
         };
+        let (ra, rb) = (unmoved(ra, a), unmoved(rb, b));
         let handle = HandleSpec::Bar {
             rest: [ra.to_array(), rb.to_array()],
             pose: Some([a.to_array(), b.to_array()]),
@@ -290,6 +292,13 @@ impl CanvasTool for HandleTool {
     fn cancel(&mut self) {
         self.bar_start = None;
     }
+}
+
+/// `rest`, found by following the pose back from `at`; `at` itself where the two are
+/// within rounding (the picture is not posed there), so a handle added to a picture at
+/// rest is exactly at rest.
+fn unmoved(rest: DVec2, at: DVec2) -> DVec2 {
+    if rest.distance(at) < 1e-9 { at } else { rest }
 }
 
 /// Sets each point handle's rotation to the one that best turns the directions to its

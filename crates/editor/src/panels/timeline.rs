@@ -74,7 +74,11 @@ impl EditorApp {
             {
                 self.delete_key();
             }
-            let mut hold = at_key.is_some_and(|i| self.keys()[i].hold);
+            // Looked up again: the button above may have deleted the key.
+            let at_key = self.key_index_at(time);
+            let mut hold = at_key
+                .and_then(|i| self.keys().get(i))
+                .is_some_and(|k| k.hold);
             if ui
                 .add_enabled(at_key.is_some(), egui::Checkbox::new(&mut hold, "Hold"))
                 .on_hover_text("Keep this key's pose until the next key (no in-between)")
