@@ -250,7 +250,12 @@ impl EditorApp {
     /// A box beside the pointer with the weights of the mesh vertex under it.
     fn hover_weights(&mut self, ui: &Ui, response: &egui::Response) {
         self.hover_readout = None;
-        if !self.show.hover_weights || self.handles.dragging() || self.panning {
+        // Performing, the pointer drives the cursor: no readout in its way.
+        if !self.show.hover_weights
+            || self.handles.dragging()
+            || self.panning
+            || self.tool == Tool::Perform
+        {
             return;
         }
         let Some(pos) = response.hover_pos() else {

@@ -220,6 +220,9 @@ fn the_control_cursor_blends_the_pose_markers_and_a_take_records_it() {
         pose(&h),
         blend.pose(&project, cursor.to_array()).expect("a pose")
     );
+    h.hover_at(at(&h, 300.0, 250.0));
+    h.run();
+    h.snapshot("editor_perform");
 
     // Record a take: the drag becomes keys from the time shown.
     click_label(&mut h, "⏺ Record");
