@@ -122,9 +122,14 @@ pub struct EditorApp {
     pub(crate) space_panned: bool,
     /// The onion skin's ghosts.
     pub(crate) onion: Onion,
+    /// The animation export window, while open: what it asks.
+    pub animation_export: Option<AnimationExport>,
 }
 
 mod animate;
+mod animation_export;
+
+pub use animation_export::AnimationExport;
 mod files;
 mod host;
 mod work;
@@ -209,6 +214,7 @@ impl EditorApp {
             perform: PerformTool::default(),
             space_panned: false,
             onion: Onion::default(),
+            animation_export: None,
         }
     }
 

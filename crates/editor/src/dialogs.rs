@@ -17,6 +17,9 @@ pub enum FileAction {
     SaveProject,
     /// Where to export the warped PNG.
     ExportPng,
+    /// Where to export the animation (an animated PNG, WebP or GIF; for a PNG
+    /// sequence, the folder is named after the file).
+    ExportAnimation,
 }
 
 impl FileAction {
@@ -27,12 +30,16 @@ impl FileAction {
             Self::OpenProject => "Open project",
             Self::SaveProject => "Save project",
             Self::ExportPng => "Export warped PNG",
+            Self::ExportAnimation => "Export animation",
         }
     }
 
     /// Whether the dialog names a file to write.
     pub fn writes(self) -> bool {
-        matches!(self, Self::SaveProject | Self::ExportPng)
+        matches!(
+            self,
+            Self::SaveProject | Self::ExportPng | Self::ExportAnimation
+        )
     }
 
     /// The file name extensions it offers.
@@ -41,6 +48,7 @@ impl FileAction {
             Self::OpenImage => IMAGES,
             Self::OpenProject | Self::SaveProject => &["json"],
             Self::ExportPng => &["png"],
+            Self::ExportAnimation => &["png", "webp", "gif"],
         }
     }
 }

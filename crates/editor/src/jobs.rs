@@ -67,6 +67,24 @@ impl SolveProgress {
     }
 }
 
+/// The frames of an animation written so far, and how many there are, shared by the
+/// worker and the window.
+#[derive(Clone, Default)]
+pub(crate) struct FrameProgress(Arc<[std::sync::atomic::AtomicUsize; 2]>);
+
+impl FrameProgress {
+    /// Records `done` frames of `total`.
+    pub fn set(&self, done: usize, total: usize) {
+        self.0[0].store(done, Ordering::Relaxed);
+        self.0[1].store(total, Ordering::Relaxed);
+    }
+
+    /// Frames written and frames in all (`(0, 0)` before the first).
+    pub fn get(&self) -> (usize, usize) {
+        (self.0[0].load(Ordering::Relaxed), self.0[1].load(Ordering::Relaxed))
+    }
+}
+
 /// Why the picture was re-meshed.
 pub(crate) enum Rebuild {
     /// A new density; `before` is the state to record in the undo history.
@@ -89,6 +107,11 @@ impl CancelFlag {
     fn set(&self) {
         self.0.store(true, Ordering::Relaxed);
     }
+
+    /// The flag itself, for work that takes one.
+    pub fn flag(&self) -> &AtomicBool {
+        &self.0
+    }
 }
 
 /// A job on a worker thread.
@@ -100,6 +123,8 @@ pub(crate) struct Job {
     cancel: CancelFlag,
     /// A cage's solve under way, for the progress display.
     pub progress: Option<SolveProgress>,
+    /// An animation's frames being written, for the progress display.
+    pub frames: Option<FrameProgress>,
 }
 
 impl Job {
@@ -126,6 +151,7 @@ impl Job {
             receiver,
             cancel,
             progress: None,
+            frames: None,
         }
     }
 

@@ -30,7 +30,7 @@ mod viewport;
 
 use std::path::PathBuf;
 
-pub use app::{EditorApp, Message, Pending, Tool};
+pub use app::{AnimationExport, EditorApp, Message, Pending, Tool};
 pub use brush::{Brush, erase};
 pub use cage::{CageState, CageTool, contour, crossing_edges};
 pub use dialogs::{Answer, Dialogs, FileAction, IMAGES, NativeDialogs, desktop_has_dialogs};

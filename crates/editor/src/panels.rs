@@ -160,6 +160,7 @@ impl eframe::App for EditorApp {
         egui::CentralPanel::default()
             .frame(egui::Frame::NONE)
             .show(ui, |ui| self.canvas_ui(ui));
+        self.animation_export_window(&ctx);
         self.help_window(&ctx);
         self.log_window(&ctx);
         self.file_dialog_ui(&ctx);
@@ -345,6 +346,17 @@ impl EditorApp {
                 if ui.button("Export PNG…").clicked() {
                     ui.close();
                     self.export();
+                }
+                if ui
+                    .button("Export animation…")
+                    .on_hover_text(
+                        "The keys played as an animated PNG, WebP or GIF, or a PNG sequence, \
+                         at full resolution",
+                    )
+                    .clicked()
+                {
+                    ui.close();
+                    self.ask_animation_export();
                 }
                 if let Some(doc) = &self.doc {
                     let canvas = doc.project().canvas;

@@ -1,6 +1,10 @@
 //! Files: the open, save and export dialogs (the desktop's, or the built-in one), and
 //! saving and exporting to a path.
 
+use std::sync::Arc;
+
+use pipeline::cage::CageCoordinates;
+
 use super::*;
 
 impl EditorApp {
@@ -13,6 +17,7 @@ impl EditorApp {
         let suggested = match action {
             FileAction::SaveProject => self.suggested_name("json"),
             FileAction::ExportPng => self.suggested_name("warped.png"),
+            FileAction::ExportAnimation => self.suggested_animation_name(),
             FileAction::OpenImage | FileAction::OpenProject => String::new(),
         };
         if !self.builtin_dialogs {
@@ -61,6 +66,7 @@ impl EditorApp {
             FileAction::OpenImage | FileAction::OpenProject => self.request_open(path),
             FileAction::SaveProject => self.save_to(&path),
             FileAction::ExportPng => self.export_in_background(path),
+            FileAction::ExportAnimation => self.export_animation_to(path),
         }
     }
 
@@ -141,24 +147,11 @@ impl EditorApp {
         let project = doc.project_for_saving(None);
         let image = doc.image.clone();
         let deep = doc.deep.clone();
-        let cage = CageKey::of(&project)
-            .filter(|_| project.method.controls() == Controls::Cage)
-            .map(|key| (doc.solution_for(&key).cloned(), key, doc.cage_pose()));
+        let cage = ExportSetup::of(doc, &project);
         Some(move || {
             let clock = Instant::now();
             let result = (|| -> Result<()> {
-                let warper = match cage {
-                    // The cage's coordinates already solved for it (else solved here).
-                    Some((solution, key, pose)) => {
-                        let solution = match solution {
-                            Some(solution) => solution,
-                            None => crate::document::solve_cage(&key, &mut |_| !cancel.is_set())?,
-                        };
-                        let deformer = pipeline::cage::CageDeformer::new(solution, pose)?;
-                        pipeline::Warper::in_mesh_order(Box::new(deformer), project.canvas)
-                    }
-                    None => pipeline::prepare_warper(&image, &project, None, &())?,
-                };
+                let warper = cage.warper(&image, &project, &cancel)?;
                 // A 16-bit picture exports with 16 bits, as `c2warp render` does.
                 let warped = match &deep {
                     Some(deep) => pipeline::warp_picture(deep, &warper)?,
@@ -200,4 +193,39 @@ pub(super) fn file_name(path: &Path) -> String {
         || path.display().to_string(),
         |n| n.to_string_lossy().into_owned(),
     )
+}
+
+/// How an export sets the method up: on the picture, as `c2warp render` does, or with
+/// the cage's coordinates the editor has solved already (else solved on the worker).
+pub(super) struct ExportSetup(Option<(Option<Arc<CageCoordinates>>, CageKey, Vec<DVec2>)>);
+
+impl ExportSetup {
+    /// What exporting `project` (the document's, as saved) needs of `doc`.
+    pub(super) fn of(doc: &Document, project: &project::Project) -> Self {
+        Self(
+            CageKey::of(project)
+                .filter(|_| project.method.controls() == Controls::Cage)
+                .map(|key| (doc.solution_for(&key).cloned(), key, doc.cage_pose())),
+        )
+    }
+
+    /// The method set up for `project` on `image`, posed as `project` is.
+    pub(super) fn warper(
+        self,
+        image: &image::RgbaImage,
+        project: &project::Project,
+        cancel: &CancelFlag,
+    ) -> Result<pipeline::Warper> {
+        Ok(match self.0 {
+            Some((solution, key, pose)) => {
+                let solution = match solution {
+                    Some(solution) => solution,
+                    None => crate::document::solve_cage(&key, &mut |_| !cancel.is_set())?,
+                };
+                let deformer = pipeline::cage::CageDeformer::new(solution, pose)?;
+                pipeline::Warper::in_mesh_order(Box::new(deformer), project.canvas)
+            }
+            None => pipeline::prepare_warper(image, project, None, &())?,
+        })
+    }
 }

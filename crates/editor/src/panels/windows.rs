@@ -65,6 +65,18 @@ impl EditorApp {
                         last.primal_residual, last.dual_residual
                     ));
                 }
+                if let Some((done, total)) = self.frames_progress() {
+                    let fraction = if total > 0 {
+                        done as f32 / total as f32
+                    } else {
+                        0.0
+                    };
+                    ui.add(
+                        egui::ProgressBar::new(fraction)
+                            .desired_width(160.0)
+                            .text(format!("frame {done} of {total}")),
+                    );
+                }
                 if ui.button("Cancel").on_hover_text("Escape").clicked() {
                     self.cancel_job();
                 }
