@@ -1,5 +1,6 @@
 //! `c2warp`: warp images with C² handle weights from the command line.
 
+mod animate;
 mod bench;
 mod deform;
 mod export;
@@ -69,6 +70,35 @@ enum Command {
         /// of it). Overrides the rig's `canvas`.
         #[arg(long)]
         canvas: Option<project::Canvas>,
+    },
+    /// Render every frame of a project's animation (its "animation" keys) and write
+    /// them as an animated PNG, animated WebP, GIF or a folder of PNGs. Each frame is
+    /// what `render` draws for the rig posed at its time.
+    Animate {
+        /// The project: a rig file with "animation" keys, whose "image" names the
+        /// picture (relative to the project file).
+        project: PathBuf,
+        /// Where to write: OUT.png (animated PNG), OUT.webp (animated WebP), OUT.gif,
+        /// or a folder (DIR/, or one that exists) for frame_00000.png, … A file is
+        /// replaced atomically; nothing is left behind on failure.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// The picture (overrides the project's "image").
+        #[arg(long)]
+        image: Option<PathBuf>,
+        /// Frames per second (default: the project's animation.fps, else 24; at most
+        /// 240, 50 for a GIF).
+        #[arg(long, allow_negative_numbers = true)]
+        fps: Option<f64>,
+        /// Time of the first frame in seconds (default 0).
+        #[arg(long, allow_negative_numbers = true)]
+        from: Option<f64>,
+        /// Time of the last frame in seconds (default: the last key's).
+        #[arg(long, allow_negative_numbers = true)]
+        to: Option<f64>,
+        /// Draw with the GPU (8 bits per channel) instead of on the CPU.
+        #[arg(long)]
+        gpu: bool,
     },
     /// Write the deformed mesh as Wavefront OBJ: one `v x y 0` line per vertex (the
     /// input's order, inserted vertices after), then the faces.
@@ -228,9 +258,12 @@ fn main() -> ExitCode {
     // Before any thread starts: the GPU path's Vulkan layer (the editor's too)
     // complains on stderr without it (see runtime_dir.rs).
     let _runtime_dir = match &cli.command {
-        Some(Command::Render { gpu: true, .. } | Command::Open { .. }) | None => {
-            runtime_dir::ensure()
-        }
+        Some(
+            Command::Render { gpu: true, .. }
+            | Command::Animate { gpu: true, .. }
+            | Command::Open { .. },
+        )
+        | None => runtime_dir::ensure(),
         _ => None,
     };
     let result = match cli.command {
@@ -258,6 +291,21 @@ fn run(command: Command) -> Result<()> {
             method,
             canvas,
         } => render(&image, &rig, &output, density, gpu, method, canvas),
+        Command::Animate {
+            project,
+            output,
+            image,
+            fps,
+            from,
+            to,
+            gpu,
+        } => animate::run(&animate::Request {
+            project: &project,
+            image: image.as_deref(),
+            output: &output,
+            span: pipeline::animate::Span { fps, from, to },
+            gpu,
+        }),
         Command::Deform {
             source,
             rig,

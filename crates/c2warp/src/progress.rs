@@ -36,6 +36,12 @@ impl Steps {
         self.bar.set_message(message);
     }
 
+    /// Shows how many of an animation's frames are written.
+    pub fn frames(&self, done: usize, total: usize) {
+        self.bar
+            .set_message(format!("drawing and writing frames: {done} of {total}"));
+    }
+
     /// Clears the counter.
     pub fn finish(&self) {
         self.bar.finish_and_clear();

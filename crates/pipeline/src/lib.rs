@@ -1,6 +1,7 @@
 //! Image + project → mesh → rig → warped image: the path the `c2warp` command line and
 //! the editor share, so an export from either gives the same pixels.
 
+pub mod animate;
 pub mod arap;
 mod c2;
 pub mod cage;
@@ -417,7 +418,9 @@ pub fn rig_on_mesh(
 
 /// A method set up on a picture, with its mesh's triangles in the order they are
 /// drawn: what [`warp`], [`warp_picture`] and [`warp_gpu`] draw, the same way for every
-/// method.
+/// method. A clone is a method of its own, to pose apart (an animation's frames are
+/// drawn on several threads, each with its own).
+#[derive(Clone)]
 pub struct Warper {
     /// The method, posed.
     pub deformer: Box<dyn Deformer>,
@@ -628,7 +631,16 @@ impl Warper {
 /// # Errors
 /// No adapter, or a GPU failure.
 pub fn warp_gpu(image: &RgbaImage, warper: &Warper) -> Result<RgbaImage> {
-    let gpu = render::GpuContext::new()?;
+    warp_gpu_with(&render::GpuContext::new()?, image, warper)
+}
+
+/// As [`warp_gpu`], on a GPU context already made (an animation makes one for all
+/// its frames).
+pub(crate) fn warp_gpu_with(
+    gpu: &render::GpuContext,
+    image: &RgbaImage,
+    warper: &Warper,
+) -> Result<RgbaImage> {
     let rest = warper.rest();
     let triangles = &warper.triangles;
     let (w, h) = image.dimensions();

@@ -244,76 +244,136 @@ fn replace_with<F>(path: &Path, fill: F) -> Result<(), RenderError>
 where
     F: FnOnce(&mut File) -> Result<(), RenderError>,
 {
-    let invalid = || RenderError::InvalidPath {
-        path: path.to_owned(),
-    };
-    path.file_name().ok_or_else(invalid)?;
-    let target = follow_links(path)?;
-    match fs::metadata(&target) {
-        // A device, FIFO or socket cannot be replaced: write through to it. (A
-        // directory falls through, and the rename reports it.)
-        Ok(meta) if !meta.is_file() && !meta.is_dir() => write_through(path, &target, fill),
-        _ => replace_file(path, &target, fill),
-    }
+    let (replacement, mut file) = Replacement::begin(path)?;
+    fill(&mut file)?;
+    replacement.commit(file)
 }
 
-/// Opens the existing non-regular file `target` (where `path` leads) and writes to it.
-fn write_through<F>(path: &Path, target: &Path, fill: F) -> Result<(), RenderError>
-where
-    F: FnOnce(&mut File) -> Result<(), RenderError>,
-{
-    let mut file = OpenOptions::new()
-        .write(true)
-        .open(target)
-        .map_err(|source| RenderError::Io {
+/// A file being replaced, for writers that fill it piece by piece (animations):
+/// [`begin`](Self::begin) opens a temporary file beside the target (or the target
+/// itself when it cannot be replaced), [`commit`](Self::commit) puts it in place.
+/// Dropped before that, the temporary file is removed and the target is untouched.
+pub(crate) struct Replacement {
+    /// The path as the caller gave it, for errors.
+    path: PathBuf,
+    /// Where the data lands (`path`, or the end of its chain of links).
+    target: PathBuf,
+    /// The directory the temporary file is in, synced after the rename.
+    dir: PathBuf,
+    /// The temporary file; `None` when writing through to a device or FIFO.
+    temp: Option<TempFile>,
+}
+
+impl Replacement {
+    /// Opens the file to fill for replacing `path`, as [`write_atomic`] does: a new
+    /// temporary file in the target's directory, or the device or FIFO at `path`.
+    ///
+    /// # Errors
+    /// [`RenderError::InvalidPath`], [`RenderError::MissingDirectory`] or
+    /// [`RenderError::Io`], as for [`write_atomic`].
+    pub(crate) fn begin(path: &Path) -> Result<(Self, File), RenderError> {
+        let invalid = || RenderError::InvalidPath {
             path: path.to_owned(),
-            action: "open",
+        };
+        path.file_name().ok_or_else(invalid)?;
+        let target = follow_links(path)?;
+        match fs::metadata(&target) {
+            // A device, FIFO or socket cannot be replaced: write through to it. (A
+            // directory falls through, and the rename reports it.)
+            Ok(meta) if !meta.is_file() && !meta.is_dir() => {
+                let file = OpenOptions::new()
+                    .write(true)
+                    .open(&target)
+                    .map_err(|source| RenderError::Io {
+                        path: path.to_owned(),
+                        action: "open",
+                        source,
+                    })?;
+                let replacement = Self {
+                    path: path.to_owned(),
+                    dir: PathBuf::new(),
+                    target,
+                    temp: None,
+                };
+                Ok((replacement, file))
+            }
+            _ => {
+                let name = target.file_name().ok_or_else(invalid)?.to_string_lossy();
+                let dir = match target.parent() {
+                    Some(parent) if !parent.as_os_str().is_empty() => parent.to_owned(),
+                    _ => PathBuf::from("."),
+                };
+                let (temp, file) = create_temp(&dir, path, &name)?;
+                let replacement = Self {
+                    path: path.to_owned(),
+                    target,
+                    dir,
+                    temp: Some(temp),
+                };
+                Ok((replacement, file))
+            }
+        }
+    }
+
+    /// Whether the data goes straight to a device or FIFO (no temporary file, not
+    /// atomic, possibly not seekable).
+    pub(crate) fn writes_through(&self) -> bool {
+        self.temp.is_none()
+    }
+
+    /// Makes the filled `file` durable: gives it the permissions of the file it
+    /// replaces and syncs it to disk (for a device or FIFO: flushes it). It is
+    /// not yet in place; [`publish`](Self::publish) does that.
+    ///
+    /// # Errors
+    /// [`RenderError::Io`] if syncing fails.
+    pub(crate) fn seal(&self, mut file: File) -> Result<(), RenderError> {
+        let io_error = |source| RenderError::Io {
+            path: self.path.clone(),
+            action: "write",
+            source,
+        };
+        if self.temp.is_none() {
+            return file.flush().map_err(io_error);
+        }
+        if let Ok(meta) = fs::metadata(&self.target)
+            && meta.is_file()
+        {
+            // Best effort: failing to copy the mode is no reason to lose the data.
+            let _ = file.set_permissions(meta.permissions());
+        }
+        file.sync_all().map_err(io_error)
+    }
+
+    /// Renames the sealed temporary file over the target (nothing to do for a
+    /// device or FIFO).
+    ///
+    /// # Errors
+    /// [`RenderError::Io`] if the rename fails (the temporary file is then removed).
+    pub(crate) fn publish(mut self) -> Result<(), RenderError> {
+        let Some(temp) = self.temp.as_mut() else {
+            return Ok(());
+        };
+        fs::rename(&temp.path, &self.target).map_err(|source| RenderError::Io {
+            path: self.path.clone(),
+            action: "replace",
             source,
         })?;
-    fill(&mut file)?;
-    file.flush().map_err(|source| RenderError::Io {
-        path: path.to_owned(),
-        action: "write",
-        source,
-    })
-}
+        temp.renamed = true;
 
-/// Writes a temporary file beside `target` (where `path` leads) and renames it over.
-fn replace_file<F>(path: &Path, target: &Path, fill: F) -> Result<(), RenderError>
-where
-    F: FnOnce(&mut File) -> Result<(), RenderError>,
-{
-    let invalid = || RenderError::InvalidPath {
-        path: path.to_owned(),
-    };
-    let name = target.file_name().ok_or_else(invalid)?.to_string_lossy();
-    let dir = match target.parent() {
-        Some(parent) if !parent.as_os_str().is_empty() => parent,
-        _ => Path::new("."),
-    };
-    let (mut temp, mut file) = create_temp(dir, path, &name)?;
-    let io_error = |action, source| RenderError::Io {
-        path: path.to_owned(),
-        action,
-        source,
-    };
-
-    fill(&mut file)?;
-    if let Ok(meta) = fs::metadata(target)
-        && meta.is_file()
-    {
-        // Best effort: failing to copy the mode is no reason to lose the data.
-        let _ = file.set_permissions(meta.permissions());
+        // Make the rename itself durable (best effort; not possible everywhere).
+        if let Ok(dir) = File::open(&self.dir) {
+            let _ = dir.sync_all();
+        }
+        Ok(())
     }
-    file.sync_all().map_err(|e| io_error("write", e))?;
-    drop(file);
 
-    fs::rename(&temp.path, target).map_err(|e| io_error("replace", e))?;
-    temp.renamed = true;
-
-    // Make the rename itself durable (best effort; not possible everywhere).
-    if let Ok(dir) = File::open(dir) {
-        let _ = dir.sync_all();
+    /// [`seal`](Self::seal) then [`publish`](Self::publish).
+    ///
+    /// # Errors
+    /// Theirs.
+    pub(crate) fn commit(self, file: File) -> Result<(), RenderError> {
+        self.seal(file)?;
+        self.publish()
     }
-    Ok(())
 }

@@ -135,6 +135,16 @@ pub enum RenderError {
         detail: String,
     },
 
+    /// An animation cannot be written as asked: an unknown output path, no frames, a
+    /// frame rate out of range, a frame of the wrong size, too many or too few frames.
+    #[error("cannot write animation {}: {detail}", path.display())]
+    Animation {
+        /// The animation's file (or directory, for a PNG sequence).
+        path: PathBuf,
+        /// What is wrong, e.g. `"frame 3 is 64x64 pixels, not 128x128"`.
+        detail: String,
+    },
+
     /// `rest` and `deformed` have different lengths.
     #[error("mesh has {rest} rest positions but {deformed} deformed positions")]
     MeshLengthMismatch {

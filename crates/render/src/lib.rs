@@ -17,6 +17,9 @@
 //!   other inputs the same careful way (regular files only, capped).
 //! * [`save_png_atomic`] / [`write_atomic`] replace files atomically, so a
 //!   crash or a full disk never leaves a half-written file over a good one.
+//! * [`AnimationWriter`] streams an animation frame by frame, at full resolution
+//!   with alpha, as animated PNG, animated WebP, GIF or a PNG sequence
+//!   ([`AnimationFormat`]), put in place atomically when finished.
 //!
 //! Coordinates follow one convention throughout: origin at the top-left
 //! corner, y down, pixel `(x, y)` covering `[x, x+1] × [y, y+1]` with its
@@ -24,6 +27,7 @@
 
 #![warn(missing_docs)]
 
+mod animated;
 mod atomic;
 mod composite;
 mod error;
@@ -38,6 +42,7 @@ mod sample;
 mod view;
 mod warp;
 
+pub use animated::{AnimationFormat, AnimationWriter};
 pub use atomic::{PngPixels, save_png_atomic, write_atomic, write_png};
 pub use composite::{over, over16};
 pub use error::RenderError;

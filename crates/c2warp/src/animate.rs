@@ -1,0 +1,65 @@
+//! `c2warp animate`: every frame of a project's animation, written as an animated
+//! PNG, animated WebP, GIF or PNG sequence.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+
+use anyhow::{Context, Result, bail};
+use pipeline::animate::{Animator, Span, plan};
+use pipeline::{load_picture, load_project};
+use render::AnimationFormat;
+
+/// What `c2warp animate` was asked.
+pub struct Request<'a> {
+    /// The project (a rig file with keys).
+    pub project: &'a Path,
+    /// The picture, if given (else the project's `"image"`).
+    pub image: Option<&'a Path>,
+    /// The animation's file, or a folder for a PNG sequence.
+    pub output: &'a Path,
+    /// Rate and range (each defaulting to the project's).
+    pub span: Span,
+    /// Draw on the GPU.
+    pub gpu: bool,
+}
+
+/// Runs `c2warp animate`: checks the output's form, the rate and the range before any
+/// work, sets the method up once, then draws and writes every frame (with a progress
+/// counter on a terminal).
+pub fn run(request: &Request) -> Result<()> {
+    let format = AnimationFormat::from_path(request.output)?;
+    let project = load_project(request.project)?;
+    let frames = plan(&project, request.span, format)
+        .with_context(|| format!("cannot animate {}", request.project.display()))?;
+    let image = picture_path(request.project, request.image, project.image.as_deref())?;
+    let picture = load_picture(&image)?;
+    let progress = crate::progress::Steps::new(2);
+    progress.step("meshing and weighting");
+    let animator = Animator::new(&picture, &project, &frames, request.gpu, &progress)?;
+    crate::warn(&*animator.warper().deformer);
+    progress.step("drawing and writing frames");
+    animator.write(
+        &frames,
+        request.output,
+        format,
+        &|done, total| progress.frames(done, total),
+        &AtomicBool::new(false),
+    )?;
+    progress.finish();
+    Ok(())
+}
+
+/// The picture to animate: `given`, else the project's `"image"` (relative to the
+/// project file's folder).
+fn picture_path(project: &Path, given: Option<&Path>, named: Option<&Path>) -> Result<PathBuf> {
+    if let Some(given) = given {
+        return Ok(given.to_path_buf());
+    }
+    let Some(named) = named else {
+        bail!(
+            "{} names no picture (\"image\"): give one with --image PATH",
+            project.display()
+        );
+    };
+    Ok(project.parent().unwrap_or(Path::new("")).join(named))
+}

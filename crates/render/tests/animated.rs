@@ -1,0 +1,581 @@
+//! Animations: each format written frame by frame, decoded back and compared.
+
+mod support;
+
+use std::fs::{self, File};
+use std::io::BufReader;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use image::codecs::gif::GifDecoder;
+use image::codecs::png::PngDecoder;
+use image::codecs::webp::WebPDecoder;
+use image::{AnimationDecoder, Delay, Frame, Rgba, RgbaImage};
+use render::{
+    AnimationFormat, AnimationWriter, ImageLimits, Picture, RenderError, Rgba16Image, load_picture,
+    save_png_atomic,
+};
+use support::random_image;
+
+const FPS: f64 = 24.0;
+
+/// Files in `dir`, sorted.
+fn listing(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = fs::read_dir(dir)
+        .expect("list dir")
+        .map(|e| {
+            e.expect("dir entry")
+                .file_name()
+                .to_string_lossy()
+                .into_owned()
+        })
+        .collect();
+    names.sort();
+    names
+}
+
+/// Writes `frames` to `path` as `format` at [`FPS`].
+fn write(path: &Path, format: AnimationFormat, frames: &[Picture]) -> Result<(), RenderError> {
+    let (width, height) = frames[0].dimensions();
+    let mut writer = AnimationWriter::create(path, format, width, height, frames.len(), FPS)?;
+    for frame in frames {
+        writer.push(frame)?;
+    }
+    writer.finish()
+}
+
+/// Three distinct 8-bit frames of random colours and alphas (some transparent).
+fn random_frames(width: u32, height: u32) -> Vec<Picture> {
+    (0..3)
+        .map(|seed| Picture::from(random_image(width, height, 10 + seed)))
+        .collect()
+}
+
+/// Three distinct 16-bit frames with transparent pixels and values that 8 bits
+/// cannot hold.
+fn frames16(width: u32, height: u32) -> Vec<Picture> {
+    (0..3u16)
+        .map(|k| {
+            Picture::from(Rgba16Image::from_fn(width, height, |x, y| {
+                let v = (x as u16 * 4099 + y as u16 * 257 + k * 1001) | 1;
+                let alpha = if (x + y + u32::from(k)) % 3 == 0 {
+                    0
+                } else {
+                    v ^ 0x5a5a
+                };
+                Rgba([v, v.wrapping_mul(3), 65535 - v, alpha])
+            }))
+        })
+        .collect()
+}
+
+/// The total duration of `frames` in milliseconds.
+fn total_ms(frames: &[Frame]) -> f64 {
+    frames
+        .iter()
+        .map(|frame| {
+            let (num, den) = frame.delay().numer_denom_ms();
+            f64::from(num) / f64::from(den)
+        })
+        .sum()
+}
+
+fn decode_apng(path: &Path) -> Vec<Frame> {
+    let file = BufReader::new(File::open(path).expect("open"));
+    PngDecoder::new(file)
+        .expect("png")
+        .apng()
+        .expect("apng")
+        .into_frames()
+        .collect_frames()
+        .expect("frames")
+}
+
+fn decode_webp(path: &Path) -> Vec<Frame> {
+    let file = BufReader::new(File::open(path).expect("open"));
+    WebPDecoder::new(file)
+        .expect("webp")
+        .into_frames()
+        .collect_frames()
+        .expect("frames")
+}
+
+fn decode_gif(path: &Path) -> Vec<Frame> {
+    let file = BufReader::new(File::open(path).expect("open"));
+    GifDecoder::new(file)
+        .expect("gif")
+        .into_frames()
+        .collect_frames()
+        .expect("frames")
+}
+
+#[test]
+fn formats_from_paths() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let format = |p: &Path| AnimationFormat::from_path(p).expect("format");
+    assert_eq!(format(Path::new("a/walk.png")), AnimationFormat::Apng);
+    assert_eq!(format(Path::new("walk.PNG")), AnimationFormat::Apng);
+    assert_eq!(format(Path::new("walk.webp")), AnimationFormat::WebP);
+    assert_eq!(format(Path::new("walk.gif")), AnimationFormat::Gif);
+    assert_eq!(format(Path::new("frames/")), AnimationFormat::PngSequence);
+    assert_eq!(format(dir.path()), AnimationFormat::PngSequence);
+    for bad in ["walk.mp4", "walk", "frames.png.tmp"] {
+        let error = AnimationFormat::from_path(Path::new(bad)).expect_err(bad);
+        let message = error.to_string();
+        assert!(matches!(error, RenderError::Animation { .. }), "{message}");
+        assert!(
+            message.contains(bad) && message.contains(".webp"),
+            "{message}"
+        );
+        assert!(!message.contains('\n'), "{message}");
+    }
+    assert_eq!(AnimationFormat::Apng.label(), "animated PNG");
+    assert_eq!(AnimationFormat::Gif.max_fps(), 50.0);
+}
+
+#[test]
+fn apng_8_bit_round_trip() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("walk.png");
+    let frames = random_frames(13, 7);
+    write(&path, AnimationFormat::Apng, &frames).expect("write");
+    assert_eq!(listing(dir.path()), ["walk.png"]);
+
+    let decoded = decode_apng(&path);
+    assert_eq!(decoded.len(), 3);
+    for (frame, picture) in decoded.iter().zip(&frames) {
+        assert_eq!(frame.buffer(), &*picture.to_rgba8());
+        assert_eq!(frame.delay(), Delay::from_numer_denom_ms(1000, 24));
+    }
+    assert!((total_ms(&decoded) - 3000.0 / FPS).abs() < 1e-6);
+    // A PNG viewer without APNG support sees the first frame.
+    let still = load_picture(&path, &ImageLimits::default()).expect("load");
+    assert_eq!(still, frames[0]);
+}
+
+#[test]
+fn apng_16_bit_round_trip_is_exact() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("walk.png");
+    let frames = frames16(9, 6);
+    write(&path, AnimationFormat::Apng, &frames).expect("write");
+
+    let mut reader = png::Decoder::new(BufReader::new(File::open(&path).expect("open")))
+        .read_info()
+        .expect("png header");
+    let info = reader.info();
+    assert_eq!(info.bit_depth, png::BitDepth::Sixteen);
+    assert_eq!(info.color_type, png::ColorType::Rgba);
+    let animation = info.animation_control.expect("acTL");
+    assert_eq!((animation.num_frames, animation.num_plays), (3, 0));
+    let mut buffer = vec![0; reader.output_buffer_size().expect("size")];
+    for picture in &frames {
+        let output = reader.next_frame(&mut buffer).expect("frame");
+        let control = reader.info().frame_control.expect("fcTL");
+        assert_eq!((control.delay_num, control.delay_den), (1, 24));
+        assert_eq!(control.blend_op, png::BlendOp::Source);
+        assert_eq!(control.dispose_op, png::DisposeOp::None);
+        let samples: Vec<u16> = buffer[..output.buffer_size()]
+            .chunks_exact(2)
+            .map(|b| u16::from_be_bytes([b[0], b[1]]))
+            .collect();
+        let Picture::Rgba16(expected) = picture else {
+            panic!("16-bit frames")
+        };
+        assert_eq!(&samples, expected.as_raw());
+    }
+}
+
+#[test]
+fn apng_of_one_frame_is_a_png() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("still.png");
+    let frame = frames16(5, 4).remove(1);
+    write(&path, AnimationFormat::Apng, std::slice::from_ref(&frame)).expect("write");
+    let loaded = load_picture(&path, &ImageLimits::default()).expect("load");
+    assert_eq!(loaded, frame);
+}
+
+#[test]
+fn webp_round_trip_is_lossless() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("walk.webp");
+    let mut frames = random_frames(11, 8);
+    // A 16-bit frame is rounded to 8 bits.
+    frames[1] = frames16(11, 8).remove(1);
+    write(&path, AnimationFormat::WebP, &frames).expect("write");
+    assert_eq!(listing(dir.path()), ["walk.webp"]);
+
+    let bytes = fs::read(&path).expect("read");
+    assert_eq!(&bytes[..4], b"RIFF");
+    let riff_size = u32::from_le_bytes([bytes[4], bytes[5], bytes[6], bytes[7]]);
+    assert_eq!(riff_size as usize, bytes.len() - 8);
+
+    let decoded = decode_webp(&path);
+    assert_eq!(decoded.len(), 3);
+    for (frame, picture) in decoded.iter().zip(&frames) {
+        assert_eq!(frame.buffer(), &*picture.to_rgba8());
+    }
+    let delays: Vec<_> = decoded.iter().map(|f| f.delay().numer_denom_ms()).collect();
+    assert_eq!(delays, [(42, 1), (41, 1), (42, 1)]);
+    assert!((total_ms(&decoded) - 3000.0 / FPS).abs() <= 0.5);
+}
+
+#[test]
+fn gif_keeps_flat_colours_and_transparency() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("walk.gif");
+    let colours = [
+        Rgba([200, 30, 40, 255]),
+        Rgba([10, 220, 90, 200]),
+        Rgba([0, 0, 255, 255]),
+    ];
+    let frames: Vec<Picture> = (0..3u32)
+        .map(|k| {
+            Picture::from(RgbaImage::from_fn(16, 10, |x, y| {
+                if (x + k) % 4 == 0 {
+                    Rgba([255, 255, 255, 100]) // transparent: alpha below 128
+                } else if y < 5 {
+                    colours[k as usize]
+                } else {
+                    colours[(k as usize + 1) % 3]
+                }
+            }))
+        })
+        .collect();
+    write(&path, AnimationFormat::Gif, &frames).expect("write");
+
+    let decoded = decode_gif(&path);
+    assert_eq!(decoded.len(), 3);
+    for (frame, picture) in decoded.iter().zip(&frames) {
+        for (got, want) in frame.buffer().pixels().zip(picture.to_rgba8().pixels()) {
+            if want[3] < 128 {
+                assert_eq!(got[3], 0, "transparent stays transparent");
+            } else {
+                assert_eq!(*got, Rgba([want[0], want[1], want[2], 255]));
+            }
+        }
+    }
+    let delays: Vec<_> = decoded.iter().map(|f| f.delay().numer_denom_ms()).collect();
+    assert_eq!(delays, [(40, 1), (40, 1), (50, 1)]);
+    assert!((total_ms(&decoded) - 3000.0 / FPS).abs() <= 10.0);
+}
+
+#[test]
+fn gif_quantises_many_colours() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("smooth.gif");
+    let frames: Vec<Picture> = (0..3u32)
+        .map(|k| {
+            Picture::from(RgbaImage::from_fn(64, 48, |x, y| {
+                let a = if x < 8 { 0 } else { 255 };
+                Rgba([(x * 4) as u8, (y * 5) as u8, (k * 60) as u8, a])
+            }))
+        })
+        .collect();
+    // 16-bit frames are rounded to 8 bits first.
+    let mut frames = frames;
+    frames[2] = Picture::from(Rgba16Image::from_fn(64, 48, |x, y| {
+        let a = if x < 8 { 0 } else { 65535 };
+        Rgba([(x * 4 * 257) as u16, (y * 5 * 257) as u16, 120 * 257, a])
+    }));
+    write(&path, AnimationFormat::Gif, &frames).expect("write");
+    let decoded = decode_gif(&path);
+    assert_eq!(decoded.len(), 3);
+    for (frame, picture) in decoded.iter().zip(&frames) {
+        let mut error = 0u64;
+        let mut opaque = 0u64;
+        for (got, want) in frame.buffer().pixels().zip(picture.to_rgba8().pixels()) {
+            if want[3] == 0 {
+                assert_eq!(got[3], 0);
+            } else {
+                assert_eq!(got[3], 255);
+                opaque += 1;
+                error += (0..3).map(|c| got[c].abs_diff(want[c]) as u64).sum::<u64>();
+            }
+        }
+        let mean = error as f64 / (3 * opaque) as f64;
+        // NeuQuant without dithering, learning from few pixels.
+        assert!(mean < 10.0, "mean error {mean}");
+    }
+}
+
+#[test]
+fn gif_refuses_rates_it_cannot_play() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("fast.gif");
+    let error = AnimationWriter::create(&path, AnimationFormat::Gif, 4, 4, 3, 60.0)
+        .err()
+        .expect("60 fps GIF refused");
+    assert!(error.to_string().contains("50"), "{error}");
+    let error = AnimationWriter::create(&path, AnimationFormat::Gif, 4, 4, 3, 0.001)
+        .err()
+        .expect("1000 s frames refused");
+    assert!(error.to_string().contains("655.35 s"), "{error}");
+    AnimationWriter::create(&path, AnimationFormat::Apng, 4, 4, 3, 60.0).expect("60 fps APNG");
+    assert!(listing(dir.path()).is_empty());
+}
+
+#[test]
+fn png_sequence_round_trip_replaces_a_longer_one() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let frames_dir = dir.path().join("frames");
+    fs::create_dir(&frames_dir).expect("mkdir");
+    // An earlier, longer sequence, and files that are not frames.
+    let old = Picture::from(random_image(3, 3, 99));
+    for i in 0..5 {
+        save_png_atomic(&frames_dir.join(format!("frame_{i:05}.png")), &old).expect("old");
+    }
+    save_png_atomic(&frames_dir.join("frame_000007.png"), &old).expect("old");
+    fs::write(frames_dir.join("frame_1.png"), b"mine").expect("other");
+    fs::write(frames_dir.join("notes.txt"), b"mine").expect("other");
+
+    let mut frames = random_frames(6, 5);
+    frames[2] = frames16(6, 5).remove(0);
+    let mut with_slash = frames_dir.clone().into_os_string();
+    with_slash.push("/");
+    let path = PathBuf::from(with_slash);
+    let format = AnimationFormat::from_path(&path).expect("format");
+    assert_eq!(format, AnimationFormat::PngSequence);
+
+    let mut writer = AnimationWriter::create(&path, format, 6, 5, 3, FPS).expect("create");
+    for frame in &frames {
+        writer.push(frame).expect("push");
+    }
+    // Nothing replaced before the end.
+    let before = listing(&frames_dir);
+    assert_eq!(
+        before.iter().filter(|n| !n.starts_with('.')).count(),
+        8,
+        "{before:?}"
+    );
+    assert_eq!(
+        load_picture(&frames_dir.join("frame_00000.png"), &ImageLimits::default()).expect("old"),
+        old
+    );
+    writer.finish().expect("finish");
+
+    assert_eq!(
+        listing(&frames_dir),
+        [
+            "frame_00000.png",
+            "frame_00001.png",
+            "frame_00002.png",
+            "frame_1.png",
+            "notes.txt"
+        ]
+    );
+    let expected_dir = dir.path().join("expected");
+    fs::create_dir(&expected_dir).expect("mkdir");
+    for (i, frame) in frames.iter().enumerate() {
+        let name = format!("frame_{i:05}.png");
+        let loaded = load_picture(&frames_dir.join(&name), &ImageLimits::default()).expect("load");
+        assert_eq!(&loaded, frame);
+        // Byte for byte what save_png_atomic writes.
+        save_png_atomic(&expected_dir.join(&name), frame).expect("save");
+        assert_eq!(
+            fs::read(frames_dir.join(&name)).expect("read"),
+            fs::read(expected_dir.join(&name)).expect("read")
+        );
+    }
+}
+
+#[test]
+fn png_sequence_directory_is_created_and_removed_if_abandoned() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let frames_dir = dir.path().join("new");
+    let frames = random_frames(4, 4);
+    let mut writer =
+        AnimationWriter::create(&frames_dir, AnimationFormat::PngSequence, 4, 4, 3, FPS)
+            .expect("create");
+    assert!(frames_dir.is_dir());
+    writer.push(&frames[0]).expect("push");
+    drop(writer);
+    assert!(listing(dir.path()).is_empty());
+
+    write(&frames_dir, AnimationFormat::PngSequence, &frames).expect("write");
+    assert_eq!(listing(&frames_dir).len(), 3);
+
+    let orphan = dir.path().join("no").join("such");
+    let error = AnimationWriter::create(&orphan, AnimationFormat::PngSequence, 4, 4, 3, FPS)
+        .err()
+        .expect("missing parent");
+    assert!(
+        matches!(&error, RenderError::MissingDirectory { dir: d, .. } if d == &dir.path().join("no")),
+        "{error}"
+    );
+}
+
+#[test]
+fn an_unfinished_sequence_leaves_the_old_one() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let old = Picture::from(random_image(4, 4, 7));
+    for i in 0..3 {
+        save_png_atomic(&dir.path().join(format!("frame_{i:05}.png")), &old).expect("old");
+    }
+    let before: Vec<Vec<u8>> = listing(dir.path())
+        .iter()
+        .map(|name| fs::read(dir.path().join(name)).expect("read"))
+        .collect();
+    let frames = random_frames(4, 4);
+    let mut writer =
+        AnimationWriter::create(dir.path(), AnimationFormat::PngSequence, 4, 4, 3, FPS)
+            .expect("create");
+    writer.push(&frames[0]).expect("push");
+    writer.push(&frames[1]).expect("push");
+    let error = writer.finish().expect_err("too few");
+    assert!(error.to_string().contains("only 2 of its 3"), "{error}");
+    let after: Vec<Vec<u8>> = listing(dir.path())
+        .iter()
+        .map(|name| fs::read(dir.path().join(name)).expect("read"))
+        .collect();
+    assert_eq!(listing(dir.path()).len(), 3);
+    assert_eq!(after, before);
+}
+
+#[test]
+fn bad_requests_are_refused_and_leave_the_old_file() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let frames = random_frames(5, 4);
+    let wrong = Picture::from(random_image(4, 5, 3));
+    for format in [
+        AnimationFormat::Apng,
+        AnimationFormat::WebP,
+        AnimationFormat::Gif,
+    ] {
+        let path = dir.path().join(match format {
+            AnimationFormat::Apng => "old.png",
+            AnimationFormat::WebP => "old.webp",
+            _ => "old.gif",
+        });
+        fs::write(&path, b"precious").expect("old file");
+        let check = |error: RenderError, needle: &str| {
+            let message = error.to_string();
+            assert!(matches!(error, RenderError::Animation { .. }), "{message}");
+            assert!(message.contains(needle), "{message}");
+            assert!(message.contains("old."), "{message}");
+            assert!(!message.contains('\n'), "{message}");
+            assert_eq!(fs::read(&path).expect("old file"), b"precious");
+        };
+        let create = |frames: usize, fps: f64| {
+            AnimationWriter::create(&path, format, 5, 4, frames, fps).map(|_| ())
+        };
+        check(create(0, FPS).expect_err("no frames"), "at least one frame");
+        for fps in [f64::NAN, f64::INFINITY, 0.0, -1.0, 241.0] {
+            check(create(3, fps).expect_err("bad rate"), "frames per second");
+        }
+        check(
+            AnimationWriter::create(&path, format, 0, 4, 3, FPS)
+                .map(|_| ())
+                .expect_err("empty"),
+            "0x4",
+        );
+
+        let mut writer = AnimationWriter::create(&path, format, 5, 4, 2, FPS).expect("create");
+        check(
+            writer.push(&wrong).expect_err("wrong size"),
+            "4x5 pixels, not 5x4",
+        );
+        writer.push(&frames[0]).expect("push");
+        check(writer.finish().expect_err("too few"), "only 1 of its 2");
+
+        let mut writer = AnimationWriter::create(&path, format, 5, 4, 2, FPS).expect("create");
+        writer.push(&frames[0]).expect("push");
+        writer.push(&frames[1]).expect("push");
+        check(
+            writer.push(&frames[2]).expect_err("too many"),
+            "one too many",
+        );
+        drop(writer);
+
+        // A dropped writer leaves nothing behind.
+        let mut writer = AnimationWriter::create(&path, format, 5, 4, 3, FPS).expect("create");
+        writer.push(&frames[0]).expect("push");
+        drop(writer);
+        assert_eq!(fs::read(&path).expect("old file"), b"precious");
+        fs::remove_file(&path).expect("remove");
+        assert!(listing(dir.path()).is_empty(), "{:?}", listing(dir.path()));
+    }
+}
+
+#[cfg(unix)]
+#[test]
+fn a_link_is_followed() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let real = dir.path().join("real.webp");
+    let link = dir.path().join("link.webp");
+    fs::write(&real, b"old").expect("old");
+    std::os::unix::fs::symlink("real.webp", &link).expect("symlink");
+    let frames = random_frames(3, 3);
+    write(&link, AnimationFormat::WebP, &frames).expect("write");
+    assert!(fs::symlink_metadata(&link).expect("link").is_symlink());
+    assert_eq!(decode_webp(&real).len(), 3);
+}
+
+/// A 1024×1024 picture from `assets/<name>`, scaled to 1024 pixels high and centred
+/// on a transparent square.
+fn asset_square(name: &str) -> RgbaImage {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../assets")
+        .join(name);
+    let picture = load_picture(&path, &ImageLimits::default())
+        .expect("asset")
+        .into_rgba8();
+    let (w, h) = picture.dimensions();
+    let scaled_w = (w * 1024 / h).min(1024);
+    let scaled = image::imageops::resize(&picture, scaled_w, 1024, image::imageops::Triangle);
+    let mut canvas = RgbaImage::new(1024, 1024);
+    image::imageops::overlay(&mut canvas, &scaled, i64::from((1024 - scaled_w) / 2), 0);
+    canvas
+}
+
+/// The cost of one 1024×1024 frame in each format: the giraffe (a cut-out on
+/// transparency, as warped output is) and the editor screenshot (opaque, many
+/// colours). Run with `--release --ignored --nocapture`.
+#[test]
+#[ignore = "timing; run in release with --nocapture"]
+fn encoder_cost_per_1024_frame() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    const N: usize = 4;
+    for asset in ["giraffe.png", "screenshot.png"] {
+        let canvas = asset_square(asset);
+        let frame16 = Picture::from(Rgba16Image::from_fn(1024, 1024, |x, y| {
+            let p = canvas.get_pixel(x, y);
+            Rgba(p.0.map(|v| u16::from(v) * 257 + (x as u16 & 0xff)))
+        }));
+        let frame8 = Picture::from(canvas);
+        for (name, format, frame) in [
+            ("a.png", AnimationFormat::Apng, &frame8),
+            ("a16.png", AnimationFormat::Apng, &frame16),
+            ("a.webp", AnimationFormat::WebP, &frame8),
+            ("a.gif", AnimationFormat::Gif, &frame8),
+            ("seq", AnimationFormat::PngSequence, &frame8),
+            ("seq16", AnimationFormat::PngSequence, &frame16),
+        ] {
+            let path = dir.path().join(name);
+            let start = Instant::now();
+            let mut writer =
+                AnimationWriter::create(&path, format, 1024, 1024, N, 24.0).expect("create");
+            for _ in 0..N {
+                writer.push(frame).expect("push");
+            }
+            writer.finish().expect("finish");
+            let seconds = start.elapsed().as_secs_f64();
+            let bytes: u64 = if path.is_dir() {
+                fs::read_dir(&path)
+                    .expect("list")
+                    .map(|e| e.expect("entry").metadata().expect("meta").len())
+                    .sum()
+            } else {
+                fs::metadata(&path).expect("meta").len()
+            };
+            println!(
+                "{asset:>14} {:>14} {:>2}-bit: {:7.1} ms/frame, {:6.0} KiB/frame",
+                format.label(),
+                frame.bits_per_channel(),
+                seconds * 1000.0 / N as f64,
+                bytes as f64 / 1024.0 / N as f64
+            );
+        }
+    }
+}

@@ -1,0 +1,293 @@
+//! End-to-end tests of `c2warp animate`: every frame is what `c2warp render` draws for
+//! the rig posed at its time, for every method; the animated files hold the same
+//! frames as the PNG sequence; bad requests fail at once and leave files alone.
+
+mod support;
+
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use image::AnimationDecoder as _;
+use support::{data, fails, ok, os, render_args};
+
+/// A rig on `opaque.png` (96 × 64) for `method`, with three point handles and a bar, a
+/// cage around the middle, and three keys (at 0, 0.5 and 1 s; smooth, so that the
+/// frames between keys are curves, not blends of two). Small meshes keep it quick.
+fn animated_rig(dir: &Path, method: &str) -> PathBuf {
+    let rest_cage = [[24.0, 16.0], [72.0, 16.0], [72.0, 48.0], [24.0, 48.0]];
+    let rig = serde_json::json!({
+        "version": 1,
+        "method": method,
+        "image": data("opaque.png"),
+        "density": 300,
+        "arap": {"density": 200},
+        "lbc": {"density": 200},
+        "handles": [
+            {"type": "point", "rest": [20, 20]},
+            {"type": "point", "rest": [76, 44], "depth": 1},
+            {"type": "bar", "rest": [[30, 52], [60, 52]]}
+        ],
+        "cage": {"rest": rest_cage},
+        "animation": {
+            "fps": 4,
+            "interpolation": "smooth",
+            "keys": [
+                {"time": 0, "pose": [{}, {}, {"pose": [[30, 52], [60, 52]]}]},
+                {"time": 0.5, "pose": [
+                    {"translate": [3, -2], "rotate": 0.2},
+                    {"translate": [-4, 3], "scale": 1.1},
+                    {"pose": [[31, 50], [62, 55]]}],
+                 "cage": [[24, 16], [76, 14], [74, 50], [24, 48]]},
+                {"time": 1, "pose": [
+                    {"translate": [-2, 2]},
+                    {"translate": [5, -3], "rotate": -0.3},
+                    {"pose": [[28, 53], [59, 51]]}],
+                 "cage": [[22, 18], [72, 16], [70, 46], [26, 48]]}
+            ]
+        }
+    });
+    let path = dir.join(format!("{method}.json"));
+    fs::write(&path, rig.to_string()).expect("write rig");
+    path
+}
+
+/// `c2warp animate RIG -o OUT` followed by `extra`.
+fn animate(rig: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
+    let mut args = vec![os("animate"), rig.as_os_str(), os("-o"), out.as_os_str()];
+    args.extend(extra.iter().map(|e| os(e)));
+    ok(&args)
+}
+
+/// The frames of a PNG sequence, in order.
+fn sequence(dir: &Path) -> Vec<PathBuf> {
+    let mut frames: Vec<PathBuf> = fs::read_dir(dir)
+        .expect("list the sequence")
+        .map(|e| e.expect("entry").path())
+        .collect();
+    frames.sort();
+    frames
+}
+
+/// The frames of an animated PNG, WebP or GIF, decoded.
+fn decoded(path: &Path) -> Vec<image::RgbaImage> {
+    let file = std::io::BufReader::new(fs::File::open(path).expect("open"));
+    let frames = match path.extension().and_then(|e| e.to_str()) {
+        Some("png") => image::codecs::png::PngDecoder::new(file)
+            .expect("a PNG")
+            .apng()
+            .expect("an animated PNG")
+            .into_frames(),
+        Some("webp") => image::codecs::webp::WebPDecoder::new(file)
+            .expect("a WebP")
+            .into_frames(),
+        _ => image::codecs::gif::GifDecoder::new(file)
+            .expect("a GIF")
+            .into_frames(),
+    };
+    frames.map(|f| f.expect("a frame").into_buffer()).collect()
+}
+
+#[test]
+fn every_frame_is_what_render_draws_for_the_pose_at_its_time_for_every_method() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    for method in project::Method::ALL {
+        let name = method.name();
+        let rig = animated_rig(dir.path(), name);
+        // A trailing separator names a folder: a PNG sequence.
+        let out = dir.path().join(format!("{name}-frames/"));
+        animate(&rig, &out, &[]);
+        let frames = sequence(&out);
+        // 0 to 1 s at 4 frames a second: the three keys and the frames between them.
+        let names: Vec<_> = frames
+            .iter()
+            .map(|f| f.file_name().expect("a name").to_string_lossy().to_string())
+            .collect();
+        assert_eq!(
+            names,
+            (0..5)
+                .map(|i| format!("frame_{i:05}.png"))
+                .collect::<Vec<_>>()
+        );
+        let project = pipeline::load_project(&rig).expect("the rig");
+        let mut previous: Option<Vec<u8>> = None;
+        for (i, frame) in frames.iter().enumerate() {
+            let time = i as f64 / 4.0;
+            let posed = dir.path().join(format!("{name}-posed-{i}.json"));
+            fs::write(&posed, animation::posed_at(&project, time).to_json()).expect("write");
+            let single = dir.path().join(format!("{name}-{i}.png"));
+            ok(&render_args(&data("opaque.png"), &posed, &single, &[]));
+            let got = fs::read(frame).expect("read frame");
+            assert!(
+                got == fs::read(&single).expect("read render"),
+                "{name}: frame {i} ({time} s) is not what render draws"
+            );
+            assert_ne!(previous.as_ref(), Some(&got), "{name}: frame {i} moved");
+            previous = Some(got);
+        }
+    }
+}
+
+#[test]
+fn animated_files_hold_the_frames_of_the_sequence() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let rig = animated_rig(dir.path(), "c2");
+    let frames = dir.path().join("frames/");
+    animate(&rig, &frames, &["--fps", "8", "--from", "0.25"]);
+    let expected: Vec<image::RgbaImage> =
+        sequence(&frames).iter().map(|f| support::load(f)).collect();
+    // 0.25 s to 1 s at 8 frames a second.
+    assert_eq!(expected.len(), 7);
+    for name in ["walk.png", "walk.webp"] {
+        let out = dir.path().join(name);
+        animate(&rig, &out, &["--fps", "8", "--from", "0.25"]);
+        let got = decoded(&out);
+        assert_eq!(got.len(), expected.len(), "{name}");
+        for (i, (a, b)) in got.iter().zip(&expected).enumerate() {
+            assert!(a == b, "{name}: frame {i} differs from the sequence's");
+        }
+    }
+    // A GIF has a palette of 256 colours and one bit of alpha: its frames are near
+    // (this picture has 5,229 colours: NeuQuant misses them by 10 a channel on average).
+    let gif = dir.path().join("walk.gif");
+    animate(&rig, &gif, &["--fps", "8", "--from", "0.25"]);
+    let got = decoded(&gif);
+    assert_eq!(got.len(), expected.len());
+    for (i, (a, b)) in got.iter().zip(&expected).enumerate() {
+        assert_eq!(a.dimensions(), b.dimensions());
+        let total: u64 = a
+            .as_raw()
+            .iter()
+            .zip(b.as_raw())
+            .map(|(x, y)| u64::from(x.abs_diff(*y)))
+            .sum();
+        let mean = total as f64 / a.as_raw().len() as f64;
+        assert!(mean < 16.0, "GIF frame {i}: mean difference {mean}");
+    }
+}
+
+#[test]
+fn the_project_names_its_picture_and_image_overrides_it() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    // A project beside its picture, naming it relatively (as the editor saves it).
+    fs::copy(data("opaque.png"), dir.path().join("pic.png")).expect("copy");
+    let mut rig: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(animated_rig(dir.path(), "mls")).expect("read"))
+            .expect("JSON");
+    rig["image"] = "pic.png".into();
+    let project = dir.path().join("project.json");
+    fs::write(&project, rig.to_string()).expect("write");
+    let first = dir.path().join("first.png");
+    animate(&project, &first, &["--to", "0"]);
+    assert_eq!(decoded(&first).len(), 1);
+    // --image overrides it; without either, a clear line.
+    let other = dir.path().join("other.png");
+    let blank = dir.path().join("blank.png");
+    image::RgbaImage::from_pixel(96, 64, image::Rgba([9, 9, 9, 255]))
+        .save(&blank)
+        .expect("save");
+    animate(
+        &project,
+        &other,
+        &["--to", "0", "--image", blank.to_str().expect("UTF-8")],
+    );
+    assert_ne!(decoded(&other), decoded(&first));
+    rig.as_object_mut().expect("an object").remove("image");
+    fs::write(&project, rig.to_string()).expect("write");
+    let line = fails(&[
+        os("animate"),
+        project.as_os_str(),
+        os("-o"),
+        other.as_os_str(),
+    ]);
+    assert!(
+        line.contains("names no picture") && line.contains("--image"),
+        "{line}"
+    );
+}
+
+#[test]
+fn bad_requests_fail_at_once_with_one_line_and_leave_the_output_alone() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let rig = animated_rig(dir.path(), "c2");
+    let out = dir.path().join("out.png");
+    fs::write(&out, b"keep me").expect("write");
+    let no_keys = dir.path().join("still.json");
+    fs::write(
+        &no_keys,
+        r#"{"version":1,"handles":[{"type":"point","rest":[20,20]}]}"#,
+    )
+    .expect("write");
+    let cases: &[(&Path, &str, &[&str], &str)] = &[
+        (
+            &no_keys,
+            "out.png",
+            &[],
+            "has no animation keys: set keys in the editor's timeline",
+        ),
+        (
+            &rig,
+            "out.png",
+            &["--from", "0.8", "--to", "0.2"],
+            "would run backwards: from 0.8 s to 0.2 s",
+        ),
+        (
+            &rig,
+            "out.png",
+            &["--from", "2"],
+            "from 2 s to 1 s (the last key's time; give an end time)",
+        ),
+        (
+            &rig,
+            "out.png",
+            &["--from", "-1"],
+            "the start time must be from 0 to 86400 seconds, got -1",
+        ),
+        (
+            &rig,
+            "out.png",
+            &["--to", "nan"],
+            "the end time must be from 0 to 86400 seconds, got NaN",
+        ),
+        (
+            &rig,
+            "out.png",
+            &["--fps", "0"],
+            "above 0 and at most 240 frames per second, got 0",
+        ),
+        (
+            &rig,
+            "out.png",
+            &["--fps", "300"],
+            "above 0 and at most 240 frames per second, got 300",
+        ),
+        (&rig, "out.png", &["--fps", "inf"], "got inf"),
+        (
+            &rig,
+            "out.gif",
+            &["--fps", "60"],
+            "a GIF plays at most 50 frames per second, not 60",
+        ),
+        (
+            &rig,
+            "out.jpg",
+            &[],
+            "must end in .png (animated PNG), .webp (animated WebP) or .gif",
+        ),
+        (&rig, "missing/out.png", &[], "missing"),
+    ];
+    for (rig, name, extra, expected) in cases {
+        let target = dir.path().join(name);
+        let mut args = vec![os("animate"), rig.as_os_str(), os("-o"), target.as_os_str()];
+        args.extend(extra.iter().map(|e| os(e)));
+        let line = fails(&args);
+        assert!(line.contains(expected), "{extra:?}: {line}");
+    }
+    assert_eq!(fs::read(&out).expect("read"), b"keep me");
+    // Nothing else was left in the folder (no temporary files, no sequence).
+    let mut left: Vec<_> = fs::read_dir(dir.path())
+        .expect("list")
+        .map(|e| e.expect("entry").file_name())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["c2.json", "out.png", "still.json"]);
+}
