@@ -106,6 +106,7 @@ impl Dialogs for NativeDialogs {
                 dialog.add_filter("C2Warp project", &["json"])
             }
             FileAction::ExportPng => dialog.add_filter("PNG", &["png"]),
+            FileAction::ExportAnimation => dialog.add_filter("Animation", &["png", "webp", "gif"]),
         };
         let chosen = if action.writes() {
             dialog.set_file_name(suggested).save_file()

@@ -81,7 +81,10 @@ impl FrameProgress {
 
     /// Frames written and frames in all (`(0, 0)` before the first).
     pub fn get(&self) -> (usize, usize) {
-        (self.0[0].load(Ordering::Relaxed), self.0[1].load(Ordering::Relaxed))
+        (
+            self.0[0].load(Ordering::Relaxed),
+            self.0[1].load(Ordering::Relaxed),
+        )
     }
 }
 

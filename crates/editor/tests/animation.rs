@@ -376,3 +376,50 @@ fn a_cage_is_keyed_and_played_under_lbc() {
     h.run();
     assert_eq!(h.state().tool, Tool::Perform);
 }
+
+#[test]
+fn an_exported_animation_is_what_render_draws_for_each_frame() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    // A small picture and mesh, so that drawing the frames is quick.
+    let mut settings = h.state().document().expect("doc").settings();
+    settings.density = 2000;
+    assert!(h.state_mut().edit(editor::Edit::Settings(settings)));
+    settle(&mut h);
+    three_keys(&mut h);
+    h.get_by_label("File").click();
+    h.run();
+    click_label(&mut h, "Export animation…");
+    h.snapshot("editor_export_animation");
+    let export = h.state().animation_export.expect("the export window");
+    assert_eq!((export.from, export.to, export.fps), (0.0, 1.0, 24.0));
+    // Every third frame, to keep the test short.
+    h.state_mut().animation_export = Some(editor::AnimationExport { fps: 8.0, ..export });
+    click_label(&mut h, "Export…");
+    assert!(h.state().is_busy(), "{:?}", h.state().message);
+    settle(&mut h);
+    assert!(
+        !h.state().message.as_ref().is_some_and(|m| m.is_error),
+        "{:?}",
+        h.state().message
+    );
+    let file = std::fs::File::open(dir.path().join("animation.png")).expect("the APNG");
+    let decoder =
+        image::codecs::png::PngDecoder::new(std::io::BufReader::new(file)).expect("a PNG");
+    use image::AnimationDecoder as _;
+    let frames: Vec<image::RgbaImage> = decoder
+        .apng()
+        .expect("an APNG")
+        .into_frames()
+        .map(|f| f.expect("a frame").into_buffer())
+        .collect();
+    assert_eq!(frames.len(), 9);
+    let project = h.state().document().expect("doc").project_for_saving(None);
+    let image = h.state().document().expect("doc").image.clone();
+    for (i, frame) in frames.iter().enumerate().step_by(4) {
+        let posed = animation::posed_at(&project, i as f64 / 8.0);
+        let warper = pipeline::prepare_warper(&image, &posed, None, &()).expect("set up");
+        let rendered = pipeline::warp(&image, &warper).expect("drawn");
+        assert!(*frame == rendered, "frame {i} differs from the render");
+    }
+}

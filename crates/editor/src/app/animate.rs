@@ -144,7 +144,8 @@ impl EditorApp {
         let count = animation.keys.len();
         if self.edit(Edit::Animation(Some(Box::new(animation)))) {
             self.timeline.time = time;
-            self.info(format!("key set at {time:.2} s ({count} keys)"));
+            let keys = if count == 1 { "key" } else { "keys" };
+            self.info(format!("key set at {time:.2} s ({count} {keys})"));
         }
     }
 

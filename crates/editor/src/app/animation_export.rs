@@ -61,20 +61,19 @@ impl EditorApp {
         let mut open = true;
         let mut go = false;
         egui::Window::new("Export animation")
+            .anchor(egui::Align2::CENTER_CENTER, [0.0, 0.0])
             .open(&mut open)
             .collapsible(false)
             .resizable(false)
             .show(ctx, |ui| {
+                egui::ComboBox::from_label("Format")
+                    .selected_text(export.format.label())
+                    .show_ui(ui, |ui| {
+                        for format in FORMATS {
+                            ui.selectable_value(&mut export.format, format, format.label());
+                        }
+                    });
                 egui::Grid::new("export animation").show(ui, |ui| {
-                    ui.label("Format");
-                    egui::ComboBox::from_id_salt("animation format")
-                        .selected_text(export.format.label())
-                        .show_ui(ui, |ui| {
-                            for format in FORMATS {
-                                ui.selectable_value(&mut export.format, format, format.label());
-                            }
-                        });
-                    ui.end_row();
                     ui.label("From");
                     ui.add(
                         egui::DragValue::new(&mut export.from)
@@ -173,6 +172,7 @@ impl EditorApp {
         let progress = FrameProgress::default();
         let (flag, shown) = (cancel.clone(), progress.clone());
         let format = export.format;
+        let label = format!("Exporting {} frames", frames.times.len());
         let work = move || {
             let clock = Instant::now();
             let result = (|| -> Result<()> {
@@ -193,7 +193,6 @@ impl EditorApp {
                 ms: clock.elapsed().as_secs_f64() * 1e3,
             }
         };
-        let label = format!("Exporting {} frames", frames.times.len());
         self.start_job(label, cancel, work);
         if let Some(job) = &mut self.job {
             job.frames = Some(progress);

@@ -24,6 +24,7 @@ impl Dialogs for Scripted {
             FileAction::OpenImage => "lizard.png",
             FileAction::OpenProject | FileAction::SaveProject => "project.json",
             FileAction::ExportPng => "warped.png",
+            FileAction::ExportAnimation => "animation.png",
         };
         Answer::Chosen(self.dir.join(name))
     }
