@@ -423,3 +423,90 @@ fn an_exported_animation_is_what_render_draws_for_each_frame() {
         assert!(*frame == rendered, "frame {i} differs from the render");
     }
 }
+
+#[test]
+fn the_timeline_in_edge_states() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = support::editor_with(
+        Box::new(support::Scripted {
+            dir: dir.path().to_path_buf(),
+        }),
+        false,
+    );
+    // Nothing to play, nothing to export, no key to delete: each says so.
+    h.key_press(Key::Space);
+    h.run();
+    assert!(!h.state().timeline.is_playing());
+    h.state_mut().ask_animation_export();
+    assert!(h.state().animation_export.is_none());
+    h.state_mut().delete_key();
+    assert!(keys(&h).is_empty());
+    // No handles: keys hold empty poses, and play.
+    click_label(&mut h, "Clear all handles");
+    assert!(handles(&h).is_empty());
+    h.key_press(Key::I);
+    h.run();
+    step(&mut h, 6);
+    h.key_press(Key::I);
+    h.run();
+    assert_eq!(keys(&h).len(), 2);
+    assert!(keys(&h).iter().all(|k| k.pose.handles.is_empty()));
+    h.key_press(Key::Space);
+    h.step();
+    assert!(h.state().timeline.is_playing());
+    h.key_press(Key::Space);
+    h.step();
+    // One handle added while keys exist: every key gets it, at rest here (nothing is
+    // posed).
+    h.state_mut().add_point(DVec2::new(300.0, 300.0));
+    h.run();
+    assert_eq!(handles(&h).len(), 1, "{:?}", h.state().message);
+    assert!(keys(&h).iter().all(|k| k.pose.handles.len() == 1));
+    // A job running: keys wait, with a message, and nothing changes.
+    let mut s = h.state().document().expect("doc").settings();
+    s.density = 3000;
+    assert!(h.state_mut().edit(editor::Edit::Settings(s)));
+    assert!(h.state().is_busy());
+    let before = keys(&h);
+    h.state_mut().set_key();
+    assert_eq!(keys(&h), before);
+    settle(&mut h);
+    // Clear the handles again: the tracks go, the keys stay.
+    click_label(&mut h, "Clear all handles");
+    assert!(keys(&h).iter().all(|k| k.pose.handles.is_empty()));
+    assert_eq!(keys(&h).len(), 2);
+    // Record armed and disarmed without a drag leaves the keys alone.
+    click_label(&mut h, "⏺ Record");
+    assert!(h.state().timeline.is_recording());
+    click_label(&mut h, "⏺ Record");
+    assert!(!h.state().timeline.is_recording());
+    assert_eq!(keys(&h).len(), 2);
+    h.state().sanity_check().expect("sane");
+}
+
+#[test]
+fn a_cancelled_animation_export_writes_nothing() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = support::editor_with(
+        Box::new(support::Scripted {
+            dir: dir.path().to_path_buf(),
+        }),
+        false,
+    );
+    three_keys(&mut h);
+    let target = dir.path().join("animation.png");
+    std::fs::write(&target, b"an older file").expect("write");
+    h.state_mut().ask_animation_export();
+    h.state_mut().export_animation_to(target.clone());
+    assert!(h.state().is_busy());
+    h.state_mut().cancel_job();
+    // The worker stops at its next frame; give it time to finish.
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    assert_eq!(std::fs::read(&target).expect("read"), b"an older file");
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path())
+        .expect("list")
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name())
+        .collect();
+    assert_eq!(leftovers.len(), 1, "{leftovers:?}");
+}
