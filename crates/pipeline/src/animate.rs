@@ -23,7 +23,9 @@
 //! let output = std::path::Path::new("walk.png");
 //! let format = render::AnimationFormat::from_path(output)?;
 //! let frames = animate::plan(&project, Span::default(), format)?;
-//! animate::write(&picture, &project, &frames, output, format, false, &|_, _| {}, &AtomicBool::new(false))?;
+//! let (gpu, cancel) = (false, AtomicBool::new(false));
+//! let progress = |done, total| eprintln!("{done} of {total} frames");
+//! animate::write(&picture, &project, &frames, output, format, gpu, &progress, &cancel)?;
 //! # Ok(())
 //! # }
 //! ```
@@ -37,7 +39,7 @@ use std::sync::mpsc;
 use anyhow::{Context, Result, bail, ensure};
 use image::RgbaImage;
 use project::Project;
-use project::animation::{DEFAULT_FPS, MAX_FPS, MAX_TIME};
+use project::animation::{MAX_FPS, MAX_TIME};
 use rayon::prelude::*;
 use render::{AnimationFormat, AnimationWriter, Picture};
 
@@ -141,11 +143,6 @@ pub fn plan(project: &Project, span: Span, format: AnimationFormat) -> Result<Fr
         fps,
         times: animation::frame_times(fps, from, to),
     })
-}
-
-/// The rate of `project`'s animation when nothing else is asked (its `fps`, else 24).
-pub fn default_fps(project: &Project) -> f64 {
-    project.animation.as_ref().map_or(DEFAULT_FPS, |a| a.fps)
 }
 
 /// Where frames are drawn.
