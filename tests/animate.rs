@@ -291,3 +291,33 @@ fn bad_requests_fail_at_once_with_one_line_and_leave_the_output_alone() {
     left.sort();
     assert_eq!(left, ["c2.json", "out.png", "still.json"]);
 }
+
+#[test]
+fn with_gpu_every_frame_is_what_render_draws_with_gpu() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let rig = animated_rig(dir.path(), "c2");
+    let out = dir.path().join("gpu/");
+    // One GPU context for the frames at 0.5 s (a key) and 0.75 s (between keys).
+    animate(&rig, &out, &["--gpu", "--from", "0.5"]);
+    let frames = sequence(&out);
+    assert_eq!(frames.len(), 3);
+    let project = pipeline::load_project(&rig).expect("the rig");
+    for (i, frame) in frames.iter().enumerate().take(2) {
+        let time = 0.5 + i as f64 / 4.0;
+        let posed = dir.path().join(format!("posed-{i}.json"));
+        fs::write(&posed, animation::posed_at(&project, time).to_json()).expect("write");
+        let single = dir.path().join(format!("{i}.png"));
+        ok(&render_args(
+            &data("opaque.png"),
+            &posed,
+            &single,
+            &["--gpu"],
+        ));
+        // The same adapter draws the same pixels (lavapipe, here and in CI).
+        let (worst, share) = support::difference(&support::load(frame), &support::load(&single), 0);
+        assert!(
+            worst == 0,
+            "frame {i}: {share} of the channels differ, by up to {worst}"
+        );
+    }
+}

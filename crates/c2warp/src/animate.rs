@@ -36,7 +36,9 @@ pub fn run(request: &Request) -> Result<()> {
     let progress = crate::progress::Steps::new(2);
     progress.step("meshing and weighting");
     let animator = Animator::new(&picture, &project, &frames, request.gpu, &progress)?;
-    crate::warn(&*animator.warper().deformer);
+    for note in animator.notes() {
+        eprintln!("warning: {note}");
+    }
     progress.step("drawing and writing frames");
     animator.write(
         &frames,

@@ -23,7 +23,9 @@
 //! let output = std::path::Path::new("walk.png");
 //! let format = render::AnimationFormat::from_path(output)?;
 //! let frames = animate::plan(&project, Span::default(), format)?;
-//! animate::write(&picture, &project, &frames, output, format, false, &|_, _| {}, &AtomicBool::new(false))?;
+//! let (gpu, cancel) = (false, AtomicBool::new(false));
+//! let progress = |done, total| eprintln!("{done} of {total} frames");
+//! animate::write(&picture, &project, &frames, output, format, gpu, &progress, &cancel)?;
 //! # Ok(())
 //! # }
 //! ```
@@ -37,7 +39,7 @@ use std::sync::mpsc;
 use anyhow::{Context, Result, bail, ensure};
 use image::RgbaImage;
 use project::Project;
-use project::animation::{DEFAULT_FPS, MAX_FPS, MAX_TIME};
+use project::animation::{MAX_FPS, MAX_TIME};
 use rayon::prelude::*;
 use render::{AnimationFormat, AnimationWriter, Picture};
 
@@ -143,11 +145,6 @@ pub fn plan(project: &Project, span: Span, format: AnimationFormat) -> Result<Fr
     })
 }
 
-/// The rate of `project`'s animation when nothing else is asked (its `fps`, else 24).
-pub fn default_fps(project: &Project) -> f64 {
-    project.animation.as_ref().map_or(DEFAULT_FPS, |a| a.fps)
-}
-
 /// Where frames are drawn.
 enum Device {
     /// On the CPU, in the picture's depth.
@@ -160,8 +157,9 @@ enum Device {
 pub struct Animator<'a> {
     /// What every frame shares.
     scene: Scene<'a>,
-    /// The method, in the last pose drawn (first: the first frame's).
-    warper: Warper,
+    /// The method, in the last pose drawn (first: the first frame's); behind a lock
+    /// so that an animator is shared between threads (each frame drawn on a copy).
+    warper: Mutex<Warper>,
 }
 
 /// What every frame of an animation shares (read by every drawing thread).
@@ -229,12 +227,15 @@ impl<'a> Animator<'a> {
         if let Some(&first) = frames.times.first() {
             scene.follow(&mut warper, first)?;
         }
-        Ok(Self { scene, warper })
+        Ok(Self {
+            scene,
+            warper: Mutex::new(warper),
+        })
     }
 
-    /// The method, posed at the last frame drawn (its notes, its mesh).
-    pub fn warper(&self) -> &Warper {
-        &self.warper
+    /// What the method says of its setup (a solve that did not converge).
+    pub fn notes(&self) -> Vec<String> {
+        lock(&self.warper).map_or_else(|_| Vec::new(), |w| w.deformer.notes())
     }
 
     /// The size of every frame in pixels: the picture's, or with `"canvas": "fit"` the
@@ -251,7 +252,11 @@ impl<'a> Animator<'a> {
     /// # Errors
     /// What the method refuses of the pose; a GPU failure.
     pub fn render(&mut self, time: f64) -> Result<Picture> {
-        self.scene.draw(&mut self.warper, time)
+        let warper = self
+            .warper
+            .get_mut()
+            .map_err(|_| anyhow::anyhow!("a thread drawing the animation stopped unexpectedly"))?;
+        self.scene.draw(warper, time)
     }
 
     /// Draws the frames at `frames.times` and writes them to `output` as `format`,
@@ -263,7 +268,7 @@ impl<'a> Animator<'a> {
     ///
     /// Call it from a thread of its own (a command's main thread, an editor's worker),
     /// not from inside a rayon pool: from there the frames are drawn and written in
-    /// turn rather than side by side.
+    /// turn rather than side by side (see [`Animator::for_each_frame`]).
     ///
     /// # Errors
     /// What drawing a frame or the writer refuses (a frame rate the format cannot
@@ -276,16 +281,47 @@ impl<'a> Animator<'a> {
         progress: &(dyn Fn(usize, usize) + Sync),
         cancel: &AtomicBool,
     ) -> Result<()> {
-        let scene = &self.scene;
         let total = frames.times.len();
         let (width, height) = self.size();
         let mut writer = AnimationWriter::create(output, format, width, height, total, frames.fps)?;
         progress(0, total);
+        self.for_each_frame(
+            &frames.times,
+            &mut |_, picture| {
+                writer.push(&picture)?;
+                progress(writer.pushed(), total);
+                Ok(())
+            },
+            cancel,
+        )?;
+        writer.finish()?;
+        Ok(())
+    }
+
+    /// Draws the frames at `times` in parallel and hands each, in order, to `each`
+    /// (with its index), on a thread of its own while the next frames are drawn: what
+    /// [`Animator::write`] does with a writer. Chunks of two frames a thread are drawn
+    /// at once, each thread with its own copy of the method; `each` runs on the chunk
+    /// before. Called from inside a rayon pool, it draws a chunk and then hands it
+    /// over, in turn (a thread of the pool waiting on `each` could hold up work that
+    /// `each` waits for).
+    ///
+    /// # Errors
+    /// What drawing a frame refuses, or `each`'s first error (no frame is drawn or
+    /// handed over after either); [`Cancelled`] when `cancel` is set (checked before
+    /// each chunk and each frame handed over).
+    pub fn for_each_frame(
+        &self,
+        times: &[f64],
+        each: &mut (dyn FnMut(usize, Picture) -> Result<()> + Send),
+        cancel: &AtomicBool,
+    ) -> Result<()> {
+        let scene = &self.scene;
         let chunk = scene.chunk_len();
         // A copy of the method for each frame drawn at once, reused chunk after chunk
         // (more than one a thread where a thread waiting inside one frame's drawing
         // takes up another).
-        let template = Mutex::new(self.warper.clone());
+        let template = &self.warper;
         let spare: Mutex<Vec<Warper>> = Mutex::new(Vec::new());
         let draw_chunk = |times: &[f64]| -> Result<Vec<Picture>> {
             times
@@ -294,7 +330,7 @@ impl<'a> Animator<'a> {
                     let taken = spare.lock().ok().and_then(|mut s| s.pop());
                     let mut warper = match taken {
                         Some(warper) => warper,
-                        None => lock(&template)?.clone(),
+                        None => lock(template)?.clone(),
                     };
                     let picture = scene.draw(&mut warper, time);
                     lock(&spare)?.push(warper);
@@ -303,44 +339,42 @@ impl<'a> Animator<'a> {
                 .collect()
         };
         let cancelled = || cancel.load(Ordering::Relaxed);
-        let push = |writer: &mut AnimationWriter, pictures: Vec<Picture>| -> Result<()> {
+        let mut next = 0;
+        let mut hand_over = |pictures: Vec<Picture>| -> Result<()> {
             for picture in pictures {
                 if cancelled() {
                     return Err(Cancelled.into());
                 }
-                writer.push(&picture)?;
-                progress(writer.pushed(), total);
+                each(next, picture)?;
+                next += 1;
             }
             Ok(())
         };
         if rayon::current_thread_index().is_some() {
-            // Inside the pool, a thread waiting on the encoder could hold up the very
-            // work the encoder waits for: draw and write in turn.
-            for times in frames.times.chunks(chunk) {
+            for times in times.chunks(chunk) {
                 if cancelled() {
                     return Err(Cancelled.into());
                 }
-                push(&mut writer, draw_chunk(times)?)?;
+                hand_over(draw_chunk(times)?)?;
             }
         } else {
             std::thread::scope(|scope| -> Result<()> {
                 let (send, receive) = mpsc::sync_channel::<Vec<Picture>>(1);
-                let writer = &mut writer;
-                let encoder = scope.spawn(move || -> Result<()> {
+                let taker = scope.spawn(move || -> Result<()> {
                     for pictures in receive {
-                        push(writer, pictures)?;
+                        hand_over(pictures)?;
                     }
                     Ok(())
                 });
                 let mut drawn = Ok(());
-                for times in frames.times.chunks(chunk) {
+                for times in times.chunks(chunk) {
                     if cancelled() {
                         drawn = Err(Cancelled.into());
                         break;
                     }
                     match draw_chunk(times) {
                         Ok(pictures) => {
-                            // A closed channel: the encoder failed, and says why below.
+                            // A closed channel: `each` failed, and says why below.
                             if send.send(pictures).is_err() {
                                 break;
                             }
@@ -352,18 +386,17 @@ impl<'a> Animator<'a> {
                     }
                 }
                 drop(send);
-                let encoded = encoder
+                let taken = taker
                     .join()
-                    .unwrap_or_else(|_| bail!("the animation's encoder stopped unexpectedly"));
-                // The encoder's error first: a drawing loop that stopped because the
-                // encoder did has nothing to add.
-                encoded.and(drawn)
+                    .unwrap_or_else(|_| bail!("the animation's writer stopped unexpectedly"));
+                // `each`'s error first: a drawing loop that stopped because `each` did
+                // has nothing to add.
+                taken.and(drawn)
             })?;
         }
         if cancelled() {
             return Err(Cancelled.into());
         }
-        writer.finish()?;
         Ok(())
     }
 }
