@@ -284,7 +284,10 @@ impl EditorApp {
         if self.cage.draft().is_some() && self.tool != Tool::Cage {
             anyhow::bail!("a cage is being drawn with the {:?} tool", self.tool);
         }
-        if doc.method().controls() == Controls::Cage && self.tool != Tool::Cage {
+        // Under LBC the cage moves the picture: its tool, or the perform tool's markers.
+        if doc.method().controls() == Controls::Cage
+            && !matches!(self.tool, Tool::Cage | Tool::Perform)
+        {
             anyhow::bail!("LBC with the {:?} tool", self.tool);
         }
         Ok(())
