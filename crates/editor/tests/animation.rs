@@ -344,14 +344,7 @@ fn a_cage_is_keyed_and_played_under_lbc() {
     h.state_mut().cage.inside_vertices = 300;
     h.key_press(Key::K);
     h.run();
-    let cage = [
-        [220.0, 200.0],
-        [390.0, 190.0],
-        [450.0, 300.0],
-        [390.0, 430.0],
-        [240.0, 430.0],
-        [170.0, 320.0],
-    ];
+    let cage = support::BODY;
     for p in cage.iter().chain(&cage[..1]) {
         let pos = at(&h, p[0], p[1]);
         support::click_at(&mut h, pos);

@@ -13,17 +13,7 @@ use glam::DVec2;
 use project::{LbcSettings, Method, Tau};
 
 use editor::{CageKey, CageState, Edit, EditorApp, Tool};
-use support::{at, changed, click_at, click_label, drag, editor, settle, shot};
-
-/// The cage clicked around the lizard's body (image pixels, at rest).
-const BODY: [[f64; 2]; 6] = [
-    [220.0, 200.0],
-    [390.0, 190.0],
-    [450.0, 300.0],
-    [390.0, 430.0],
-    [240.0, 430.0],
-    [170.0, 320.0],
-];
+use support::{BODY, at, changed, click_at, click_label, drag, editor, settle, shot};
 
 /// Mesh vertices inside the cage in these tests: few, so a debug build solves in
 /// seconds.

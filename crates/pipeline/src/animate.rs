@@ -492,18 +492,11 @@ fn place(picture: Picture, own: Frame, all: Frame) -> Result<Picture> {
     if own == all {
         return Ok(picture);
     }
-    let mut out = crate::blank(picture.bits_per_channel(), all)?;
-    let (x, y) = (own.origin[0] - all.origin[0], own.origin[1] - all.origin[1]);
-    match (&mut out, &picture) {
-        (Picture::Rgba8(out), Picture::Rgba8(picture)) => {
-            image::imageops::replace(out, picture, x, y);
-        }
-        (Picture::Rgba16(out), Picture::Rgba16(picture)) => {
-            image::imageops::replace(out, picture, x, y);
-        }
-        _ => unreachable!("a blank picture of the same depth"),
-    }
-    Ok(out)
+    crate::placed(
+        &picture,
+        all,
+        [own.origin[0] - all.origin[0], own.origin[1] - all.origin[1]],
+    )
 }
 
 /// Sets `project`'s method up on `picture` and writes the frames at `frames.times` to

@@ -490,21 +490,30 @@ impl Warper {
                 if frame.origin == [0, 0] && (frame.width, frame.height) == picture.dimensions() {
                     return Ok(outside);
                 }
-                let (x, y) = (-frame.origin[0], -frame.origin[1]);
-                let mut out = blank(picture)?;
-                match (&mut out, &outside) {
-                    (Picture::Rgba8(out), Picture::Rgba8(outside)) => {
-                        image::imageops::replace(out, outside, x, y);
-                    }
-                    (Picture::Rgba16(out), Picture::Rgba16(outside)) => {
-                        image::imageops::replace(out, outside, x, y);
-                    }
-                    _ => unreachable!("a blank picture of the same depth"),
-                }
-                Ok(out)
+                placed(&outside, frame, [-frame.origin[0], -frame.origin[1]])
             }
         }
     }
+}
+
+/// A transparent picture the size of `frame`, in `picture`'s depth, with `picture`
+/// drawn at pixel `at` of it (what falls outside is cut off).
+///
+/// # Errors
+/// Not enough memory for it.
+pub(crate) fn placed(picture: &Picture, frame: Frame, at: [i64; 2]) -> Result<Picture> {
+    let mut out = blank(picture.bits_per_channel(), frame)?;
+    let [x, y] = at;
+    match (&mut out, picture) {
+        (Picture::Rgba8(out), Picture::Rgba8(picture)) => {
+            image::imageops::replace(out, picture, x, y);
+        }
+        (Picture::Rgba16(out), Picture::Rgba16(picture)) => {
+            image::imageops::replace(out, picture, x, y);
+        }
+        _ => unreachable!("a blank picture of the same depth"),
+    }
+    Ok(out)
 }
 
 /// A transparent picture of `bits` per channel (8 or 16) the size of `frame`.

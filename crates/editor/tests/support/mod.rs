@@ -13,6 +13,16 @@ use project::HandleSpec;
 
 use editor::{Answer, Dialogs, EditorApp, FileAction};
 
+/// A cage clicked around the lizard's body (image pixels, at rest).
+pub const BODY: [[f64; 2]; 6] = [
+    [220.0, 200.0],
+    [390.0, 190.0],
+    [450.0, 300.0],
+    [390.0, 430.0],
+    [240.0, 430.0],
+    [170.0, 320.0],
+];
+
 /// Answers every file dialog with a fixed file in `dir`.
 pub struct Scripted {
     pub dir: PathBuf,
