@@ -29,6 +29,15 @@ impl<'a> Layout<'a> {
         }
     }
 
+    /// `pose` with the cage's vertices listed where it leaves them out (the cage at
+    /// rest), as [`project::Pose::of`] lists them.
+    pub fn filled(&self, mut pose: Pose) -> Pose {
+        if pose.cage.is_none() {
+            pose.cage = self.cage_rest.map(<[_]>::to_vec);
+        }
+        pose
+    }
+
     /// Numbers per pose: 4 per handle, 2 per cage vertex.
     pub fn len(&self) -> usize {
         4 * self.handles.len() + 2 * self.cage_rest.map_or(0, <[_]>::len)

@@ -117,10 +117,10 @@ impl SpatialBlend {
         {
             return None;
         }
-        if let Some(k) = keys.iter().find(|k| k.at == at) {
-            return Some(k.pose.clone());
-        }
         let layout = Layout::of(project);
+        if let Some(k) = keys.iter().find(|k| k.at == at) {
+            return Some(layout.filled(k.pose.clone()));
+        }
         let weights = self.weights(at);
         let mut first = Vec::new();
         layout.channels(&keys[0].pose, None, &mut first);

@@ -9,7 +9,7 @@ use crate::channels::Layout;
 ///
 /// Before the first key the first key's pose holds, after the last the last's. At a
 /// key's time, and after a key that holds until the next, the pose is that key's
-/// exactly. Between two keys `a` and `b`, with `u = (t − t_a)/(t_b − t_a)`:
+/// exactly (a cage left out of a key listed at rest, as [`Pose::of`] lists it). Between two keys `a` and `b`, with `u = (t − t_a)/(t_b − t_a)`:
 /// * linear: every channel moves as `a + u·(b − a)` — a point's translation,
 ///   rotation (as keyed: more than half a turn stays more than half a turn) and
 ///   scale; a bar's centre and length, and its direction by the smaller turn; each
@@ -22,19 +22,19 @@ pub fn pose_at(project: &Project, time: f64) -> Option<Pose> {
     let keys = &animation.keys;
     let first = keys.first()?;
     let last = keys.last()?;
+    let layout = Layout::of(project);
     if time.is_nan() || time <= first.time {
-        return Some(first.pose.clone());
+        return Some(layout.filled(first.pose.clone()));
     }
     if time >= last.time {
-        return Some(last.pose.clone());
+        return Some(layout.filled(last.pose.clone()));
     }
     // The key at or before `time`: keys[k].time <= time < keys[k + 1].time.
     let k = keys.partition_point(|key| key.time <= time) - 1;
     let (a, b) = (&keys[k], &keys[k + 1]);
     if time == a.time || a.hold {
-        return Some(a.pose.clone());
+        return Some(layout.filled(a.pose.clone()));
     }
-    let layout = Layout::of(project);
     let u = (time - a.time) / (b.time - a.time);
     let mut pa = Vec::new();
     let mut pb = Vec::new();
@@ -217,12 +217,16 @@ mod tests {
     fn every_key_is_its_own_pose_exactly() {
         for interpolation in Interpolation::ALL {
             let p = three_keys(interpolation);
-            for k in &p.animation.as_ref().expect("animation").keys {
-                assert_eq!(pose_at(&p, k.time).as_ref(), Some(&k.pose));
-            }
+            let layout = Layout::of(&p);
             let keys = &p.animation.as_ref().expect("animation").keys;
-            assert_eq!(pose_at(&p, -5.0).as_ref(), Some(&keys[0].pose));
-            assert_eq!(pose_at(&p, 99.0).as_ref(), Some(&keys[2].pose));
+            for k in keys {
+                assert_eq!(pose_at(&p, k.time), Some(layout.filled(k.pose.clone())));
+            }
+            // The keys without a cage pose have the cage at rest.
+            let rest = p.cage.as_ref().expect("a cage").rest.clone();
+            assert_eq!(pose_at(&p, 0.0).and_then(|p| p.cage), Some(rest));
+            assert_eq!(pose_at(&p, -5.0), Some(layout.filled(keys[0].pose.clone())));
+            assert_eq!(pose_at(&p, 99.0), Some(layout.filled(keys[2].pose.clone())));
         }
     }
 

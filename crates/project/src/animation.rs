@@ -229,11 +229,16 @@ impl HandlePose {
 }
 
 impl Pose {
-    /// The pose `project`'s handles and cage have.
+    /// The pose `project`'s handles and cage have: every bar's ends and, with a cage,
+    /// every cage vertex's position (at rest included), so that two poses that look
+    /// the same compare equal.
     pub fn of(project: &Project) -> Self {
         Self {
             handles: project.handles.iter().map(HandlePose::of).collect(),
-            cage: project.cage.as_ref().and_then(|c| c.pose.clone()),
+            cage: project
+                .cage
+                .as_ref()
+                .map(|c| c.pose.clone().unwrap_or_else(|| c.rest.clone())),
         }
     }
 

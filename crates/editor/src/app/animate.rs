@@ -412,10 +412,24 @@ impl EditorApp {
         if previewing {
             return Ok(());
         }
-        if let Some(pose) = animation::pose_at(doc.project(), time)
-            && pose != Pose::of(doc.project())
-        {
-            anyhow::bail!("the pose shown is not the keys' pose at {time} s");
+        if let Some(pose) = animation::pose_at(doc.project(), time) {
+            let shown = Pose::of(doc.project());
+            if let Some(i) =
+                (0..pose.handles.len()).find(|&i| pose.handles.get(i) != shown.handles.get(i))
+            {
+                anyhow::bail!(
+                    "handle {i} shows {:?}, but the keys' pose at {time} s is {:?}",
+                    shown.handles.get(i),
+                    pose.handles[i]
+                );
+            }
+            if pose != shown {
+                anyhow::bail!(
+                    "the cage shows {:?}, but the keys' pose at {time} s has {:?}",
+                    shown.cage,
+                    pose.cage
+                );
+            }
         }
         Ok(())
     }

@@ -158,8 +158,18 @@ impl EditorApp {
             }
             ui.checkbox(&mut self.timeline.keep_every_frame, "Every frame")
                 .on_hover_text(
-                    "Keep a key per recorded frame instead of the fewest keys within half a pixel",
+                    "Keep a key per recorded frame instead of the fewest keys that replay \
+                     the take within the tolerance",
                 );
+            ui.add_enabled(
+                !self.timeline.keep_every_frame,
+                egui::DragValue::new(&mut self.timeline.tolerance)
+                    .range(0.05..=20.0)
+                    .speed(0.05)
+                    .prefix("within ")
+                    .suffix(" px"),
+            )
+            .on_hover_text("How far a recorded take's keys may stray from what was performed");
         });
         self.strip(ui);
     }
