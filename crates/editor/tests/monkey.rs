@@ -363,6 +363,7 @@ impl Monkey {
                 self.frames(1);
                 "wait for the job".to_owned()
             }
+            97..=98 => self.perform(),
             _ => {
                 let size = *self.rng.pick(&[
                     Vec2::new(1200.0, 800.0),
@@ -373,6 +374,44 @@ impl Monkey {
                 self.frames(2);
                 format!("window {size:?}")
             }
+        }
+    }
+
+    /// The perform tool: a pose marker placed (with the button or Ctrl + click), or the
+    /// control cursor dragged.
+    fn perform(&mut self) -> String {
+        if self.h.state().tool != editor::Tool::Perform {
+            self.h.key_press(Key::Y);
+            self.frames(1);
+        }
+        let pos = self.somewhere();
+        match self.rng.below(3) {
+            0 => {
+                if let Some(node) = self.h.query_by_label("Place marker") {
+                    node.click();
+                    self.frames(1);
+                }
+                self.h.hover_at(pos);
+                self.frames(1);
+                self.button(pos, egui::PointerButton::Primary, true, Modifiers::NONE);
+                self.frames(1);
+                self.button(pos, egui::PointerButton::Primary, false, Modifiers::NONE);
+                self.frames(2);
+                format!("place a marker at {pos:?}")
+            }
+            1 => {
+                let ctrl = Modifiers::COMMAND;
+                self.h.event(egui::Event::ModifiersChanged(ctrl));
+                self.h.hover_at(pos);
+                self.frames(1);
+                self.button(pos, egui::PointerButton::Primary, true, ctrl);
+                self.frames(1);
+                self.button(pos, egui::PointerButton::Primary, false, ctrl);
+                self.h.event(egui::Event::ModifiersChanged(Modifiers::NONE));
+                self.frames(2);
+                format!("Ctrl + click at {pos:?}")
+            }
+            _ => format!("perform: {}", self.drag()),
         }
     }
 
@@ -616,6 +655,8 @@ fn walk(seed: u64, actions: usize) {
     let mut cage_states = [0usize; 3];
     // Times the project was saved and reopened to compare.
     let mut reopened = 0usize;
+    // Actions taken with two keys or more, the most keys seen, actions with markers.
+    let (mut keyed, mut most_keys, mut marked) = (0usize, 0usize, 0usize);
     for step in 0..actions {
         let result = std::panic::catch_unwind(AssertUnwindSafe(|| {
             let started = Instant::now();
@@ -627,6 +668,15 @@ fn walk(seed: u64, actions: usize) {
             if app.tool == editor::Tool::Cage {
                 cage_states[app.cage_state() as usize] += 1;
             }
+            let keys = app.keys().len();
+            keyed += usize::from(keys >= 2);
+            most_keys = most_keys.max(keys);
+            marked += usize::from(app.document().is_some_and(|d| {
+                d.project()
+                    .animation
+                    .as_ref()
+                    .is_some_and(|a| !a.spatial_keys.is_empty())
+            }));
             app.sanity_check()?;
             // Saved and reopened at random points, the project builds what is on screen.
             match app.document() {
@@ -685,6 +735,10 @@ fn walk(seed: u64, actions: usize) {
         "  with the cage tool: {} actions drawing, {} at rest, {} posed; reopened {reopened} \
          times",
         cage_states[0], cage_states[1], cage_states[2]
+    );
+    println!(
+        "  with two keys or more: {keyed} actions (at most {most_keys} keys); with pose \
+         markers: {marked}"
     );
     slowest.sort_by(|a, b| b.0.total_cmp(&a.0));
     for (s, what) in slowest.iter().take(3) {
