@@ -27,6 +27,52 @@ pub fn rig_file(data: &[u8]) {
     assert_eq!(again, project, "a project round-trips through its JSON");
     // Validation against a picture size never panics either.
     let _ = project.validate(Some((64, 48)));
+    animated(&project);
+}
+
+/// A valid project's animation gives, at any time and any cursor, a pose that poses
+/// the project into a valid one (finite, in range), and each key's own pose at its time.
+fn animated(project: &project::Project) {
+    let Some(animation) = &project.animation else {
+        return;
+    };
+    let last = animation.duration();
+    for time in [-1.0, 0.0, 0.37 * last, 0.5 * last, last, last + 1.0] {
+        let posed = animation::posed_at(project, time);
+        if let Err(e) = posed.validate(None) {
+            panic!("the pose at {time} s poses the rig into an invalid one: {e}");
+        }
+    }
+    for key in &animation.keys {
+        let pose = animation::pose_at(project, key.time).expect("a pose with keys");
+        assert_eq!(
+            pose.handles, key.pose.handles,
+            "the pose at a key's time is the key's"
+        );
+    }
+    if let Some(blend) = animation::SpatialBlend::of(project) {
+        let weights = blend.weights([3.0, -7.0]);
+        assert!(
+            weights.iter().all(|w| w.is_finite()),
+            "finite blend weights"
+        );
+        if let Some(pose) = blend.pose(project, [3.0, -7.0]) {
+            // Far-off markers may blend beyond the pose limits; finite is what counts.
+            let numbers = pose.handles.iter().flat_map(|h| match *h {
+                project::HandlePose::Point {
+                    translate,
+                    rotate,
+                    scale,
+                } => vec![translate[0], translate[1], rotate, scale],
+                project::HandlePose::Bar { pose } => pose.iter().flatten().copied().collect(),
+            });
+            let cage = pose.cage.iter().flatten().flatten().copied();
+            assert!(
+                numbers.chain(cage).all(f64::is_finite),
+                "a finite blended pose"
+            );
+        }
+    }
 }
 
 /// The OBJ reader: any bytes either read into a mesh whose indices are in range and
