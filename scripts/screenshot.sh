@@ -29,7 +29,7 @@ window=$(xdotool search --sync --name C2Warp | head -1)
 sleep 3
 # No window manager: give the window the keyboard focus, and click an empty spot.
 xdotool windowfocus "$window" || true
-xdotool mousemove 1150 760 click 1
+xdotool mousemove 1180 60 click 1
 sleep 0.5
 # Drags from one screen point to another in eight steps, as a hand would.
 drag() {
@@ -47,7 +47,7 @@ if [ "$mode" = cage ]; then
   # (Enter) and a wait for the solve.
   xdotool key k
   sleep 1
-  xdotool mousemove 67 374 click 1
+  xdotool mousemove 67 397 click 1
   sleep 1
   xdotool key h
   sleep 0.5
@@ -55,8 +55,8 @@ if [ "$mode" = cage ]; then
   # The solve takes a few seconds in a release build.
   sleep "${SOLVE_SECONDS:-12}"
   # The cage's vertex by the tail's end, then the one by the front leg.
-  drag 933 610 975 520
-  drag 739 304 800 235
+  drag 933 567 975 480
+  drag 739 261 800 192
   xdotool mousemove 1100 760
   sleep 1.5
   import -window root "$out"
