@@ -5,7 +5,6 @@ mod support;
 use std::fs::{self, File};
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 use image::codecs::gif::GifDecoder;
 use image::codecs::png::PngDecoder;
@@ -510,72 +509,4 @@ fn a_link_is_followed() {
     write(&link, AnimationFormat::WebP, &frames).expect("write");
     assert!(fs::symlink_metadata(&link).expect("link").is_symlink());
     assert_eq!(decode_webp(&real).len(), 3);
-}
-
-/// A 1024×1024 picture from `assets/<name>`, scaled to 1024 pixels high and centred
-/// on a transparent square.
-fn asset_square(name: &str) -> RgbaImage {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../assets")
-        .join(name);
-    let picture = load_picture(&path, &ImageLimits::default())
-        .expect("asset")
-        .into_rgba8();
-    let (w, h) = picture.dimensions();
-    let scaled_w = (w * 1024 / h).min(1024);
-    let scaled = image::imageops::resize(&picture, scaled_w, 1024, image::imageops::Triangle);
-    let mut canvas = RgbaImage::new(1024, 1024);
-    image::imageops::overlay(&mut canvas, &scaled, i64::from((1024 - scaled_w) / 2), 0);
-    canvas
-}
-
-/// The cost of one 1024×1024 frame in each format: the giraffe (a cut-out on
-/// transparency, as warped output is) and the editor screenshot (opaque, many
-/// colours). Run with `--release --ignored --nocapture`.
-#[test]
-#[ignore = "timing; run in release with --nocapture"]
-fn encoder_cost_per_1024_frame() {
-    let dir = tempfile::tempdir().expect("tempdir");
-    const N: usize = 4;
-    for asset in ["giraffe.png", "screenshot.png"] {
-        let canvas = asset_square(asset);
-        let frame16 = Picture::from(Rgba16Image::from_fn(1024, 1024, |x, y| {
-            let p = canvas.get_pixel(x, y);
-            Rgba(p.0.map(|v| u16::from(v) * 257 + (x as u16 & 0xff)))
-        }));
-        let frame8 = Picture::from(canvas);
-        for (name, format, frame) in [
-            ("a.png", AnimationFormat::Apng, &frame8),
-            ("a16.png", AnimationFormat::Apng, &frame16),
-            ("a.webp", AnimationFormat::WebP, &frame8),
-            ("a.gif", AnimationFormat::Gif, &frame8),
-            ("seq", AnimationFormat::PngSequence, &frame8),
-            ("seq16", AnimationFormat::PngSequence, &frame16),
-        ] {
-            let path = dir.path().join(name);
-            let start = Instant::now();
-            let mut writer =
-                AnimationWriter::create(&path, format, 1024, 1024, N, 24.0).expect("create");
-            for _ in 0..N {
-                writer.push(frame).expect("push");
-            }
-            writer.finish().expect("finish");
-            let seconds = start.elapsed().as_secs_f64();
-            let bytes: u64 = if path.is_dir() {
-                fs::read_dir(&path)
-                    .expect("list")
-                    .map(|e| e.expect("entry").metadata().expect("meta").len())
-                    .sum()
-            } else {
-                fs::metadata(&path).expect("meta").len()
-            };
-            println!(
-                "{asset:>14} {:>14} {:>2}-bit: {:7.1} ms/frame, {:6.0} KiB/frame",
-                format.label(),
-                frame.bits_per_channel(),
-                seconds * 1000.0 / N as f64,
-                bytes as f64 / 1024.0 / N as f64
-            );
-        }
-    }
 }
