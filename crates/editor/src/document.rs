@@ -668,35 +668,22 @@ impl Document {
         let deformed = self.deformed.as_ref().map(|(_, d)| d.as_slice())?;
         let domain = self.rig.domain();
         let rest = domain.positions();
-        for &[a, b, c] in domain.triangles() {
-            let [pa, pb, pc] = [a, b, c].map(|v| deformed[v as usize]);
-            let area = (pb - pa).perp_dot(pc - pa);
-            if area.abs() < 1e-12 {
-                continue;
-            }
-            let u = (pb - p).perp_dot(pc - p) / area;
-            let v = (pc - p).perp_dot(pa - p) / area;
-            let w = 1.0 - u - v;
-            let eps = -1e-9;
-            if u < eps || v < eps || w < eps {
-                continue;
-            }
-            let [ra, rb, rc] = [a, b, c].map(|v| rest[v as usize]);
-            let at_rest = ra * u + rb * v + rc * w;
-            // The affine map rest → deformed of this triangle, as its similarity part.
-            let rest_frame = glam::DMat2::from_cols(rb - ra, rc - ra);
-            let pose_frame = glam::DMat2::from_cols(pb - pa, pc - pa);
-            let rotation_scale = if rest_frame.determinant().abs() > 1e-12 {
-                let j = pose_frame * rest_frame.inverse();
-                let angle = (j.x_axis.y - j.y_axis.x).atan2(j.x_axis.x + j.y_axis.y);
-                let scale = j.determinant().max(0.0).sqrt();
-                (angle, if scale > 1e-6 { scale } else { 1.0 })
-            } else {
-                (0.0, 1.0)
-            };
-            return Some((at_rest, rotation_scale.0, rotation_scale.1));
-        }
-        None
+        let ([a, b, c], [u, v, w]) = locate(deformed, domain.triangles(), p)?;
+        let [pa, pb, pc] = [a, b, c].map(|v| deformed[v as usize]);
+        let [ra, rb, rc] = [a, b, c].map(|v| rest[v as usize]);
+        let at_rest = ra * u + rb * v + rc * w;
+        // The affine map rest → deformed of this triangle, as its similarity part.
+        let rest_frame = glam::DMat2::from_cols(rb - ra, rc - ra);
+        let pose_frame = glam::DMat2::from_cols(pb - pa, pc - pa);
+        let (angle, scale) = if rest_frame.determinant().abs() > 1e-12 {
+            let j = pose_frame * rest_frame.inverse();
+            let angle = (j.x_axis.y - j.y_axis.x).atan2(j.x_axis.x + j.y_axis.y);
+            let scale = j.determinant().max(0.0).sqrt();
+            (angle, if scale > 1e-6 { scale } else { 1.0 })
+        } else {
+            (0.0, 1.0)
+        };
+        Some((at_rest, angle, scale))
     }
 
     /// The rotation and scale a new point handle at rest position `rest`, placed at
@@ -786,6 +773,28 @@ impl Document {
             })
             .collect()
     }
+}
+
+/// The first of `triangles` (corners indexing `points`) that contains `p`, and `p`'s
+/// barycentric coordinates in it; flat triangles are skipped.
+pub(crate) fn locate(
+    points: &[DVec2],
+    triangles: &[[u32; 3]],
+    p: DVec2,
+) -> Option<([u32; 3], [f64; 3])> {
+    triangles.iter().find_map(|&[a, b, c]| {
+        let corner = |v: u32| points.get(v as usize).copied();
+        let (pa, pb, pc) = (corner(a)?, corner(b)?, corner(c)?);
+        let area = (pb - pa).perp_dot(pc - pa);
+        if area.abs() < 1e-12 {
+            return None;
+        }
+        let u = (pb - p).perp_dot(pc - p) / area;
+        let v = (pc - p).perp_dot(pa - p) / area;
+        let w = 1.0 - u - v;
+        let eps = -1e-9;
+        (u >= eps && v >= eps && w >= eps).then_some(([a, b, c], [u, v, w]))
+    })
 }
 
 /// Whether two handles have the same kind and rest geometry.

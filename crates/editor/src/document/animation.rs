@@ -73,23 +73,9 @@ impl Document {
         self.deformed();
         let deformed = self.deformed.as_ref().map(|(_, d)| d.as_slice())?;
         let domain = self.rig.domain();
-        let rest = domain.positions();
-        domain.triangles().iter().find_map(|&[a, b, c]| {
-            let [ra, rb, rc] = [a, b, c].map(|v| rest[v as usize]);
-            let area = (rb - ra).perp_dot(rc - ra);
-            if area.abs() < 1e-12 {
-                return None;
-            }
-            let u = (rb - p).perp_dot(rc - p) / area;
-            let v = (rc - p).perp_dot(ra - p) / area;
-            let w = 1.0 - u - v;
-            let eps = -1e-9;
-            if u < eps || v < eps || w < eps {
-                return None;
-            }
-            let at = |v: u32| deformed.get(v as usize).copied();
-            Some(at(a)? * u + at(b)? * v + at(c)? * w)
-        })
+        let ([a, b, c], [u, v, w]) = super::locate(domain.positions(), domain.triangles(), p)?;
+        let at = |v: u32| deformed.get(v as usize).copied();
+        Some(at(a)? * u + at(b)? * v + at(c)? * w)
     }
 
     /// The pose `handle` (not yet added) should have in each of the animation's keys,
