@@ -63,6 +63,11 @@ fn sequence(dir: &Path) -> Vec<PathBuf> {
     let mut frames: Vec<PathBuf> = fs::read_dir(dir)
         .expect("list the sequence")
         .map(|e| e.expect("entry").path())
+        .filter(|p| {
+            p.file_name()
+                .and_then(|n| n.to_str())
+                .is_some_and(|n| n.starts_with("frame_"))
+        })
         .collect();
     frames.sort();
     frames
@@ -240,27 +245,27 @@ fn bad_requests_fail_at_once_with_one_line_and_leave_the_output_alone() {
             &rig,
             "out.png",
             &["--from", "-1"],
-            "the start time must be from 0 to 86400 seconds, got -1",
+            "'--from <FROM>': expected a number from 0 to 86,400 s",
         ),
         (
             &rig,
             "out.png",
             &["--to", "nan"],
-            "the end time must be from 0 to 86400 seconds, got NaN",
+            "'--to <TO>': expected a number from 0 to 86,400 s",
         ),
         (
             &rig,
             "out.png",
             &["--fps", "0"],
-            "above 0 and at most 240 frames per second, got 0",
+            "'--fps <FPS>': expected a number above 0 to 240 frames per second",
         ),
         (
             &rig,
             "out.png",
             &["--fps", "300"],
-            "above 0 and at most 240 frames per second, got 300",
+            "invalid value '300' for '--fps <FPS>'",
         ),
-        (&rig, "out.png", &["--fps", "inf"], "got inf"),
+        (&rig, "out.png", &["--fps", "inf"], "invalid value 'inf'"),
         (
             &rig,
             "out.gif",
@@ -320,4 +325,109 @@ fn with_gpu_every_frame_is_what_render_draws_with_gpu() {
             "frame {i}: {share} of the channels differ, by up to {worst}"
         );
     }
+}
+
+/// The names of the hidden temporary files in `dir`.
+fn temporaries(dir: &Path) -> Vec<String> {
+    fs::read_dir(dir)
+        .expect("list")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().to_string())
+        .filter(|n| n.ends_with(".tmp"))
+        .collect()
+}
+
+/// Starts `c2warp animate` on the lizard's walk at 240 frames a second (hundreds of
+/// frames: long enough to be interrupted) into `out`, and waits until it has a
+/// temporary file in `watch`.
+#[cfg(unix)]
+fn start_a_long_animation(out: &Path, watch: &Path) -> std::process::Child {
+    let walk = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/lizard-walk.json");
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_c2warp"))
+        .args([os("animate"), walk.as_os_str(), os("-o"), out.as_os_str()])
+        .args(["--fps", "240"])
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .expect("start c2warp");
+    let start = std::time::Instant::now();
+    while temporaries(watch).is_empty() {
+        assert!(
+            start.elapsed() < std::time::Duration::from_secs(120),
+            "no temporary file appeared"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child
+}
+
+/// Sends `signal` to `child` and waits for it to end.
+#[cfg(unix)]
+fn signal(mut child: std::process::Child, signal: &str) -> std::process::ExitStatus {
+    let sent = std::process::Command::new("kill")
+        .args([signal, &child.id().to_string()])
+        .status()
+        .expect("kill");
+    assert!(sent.success());
+    child.wait().expect("wait")
+}
+
+#[cfg(unix)]
+#[test]
+fn an_interrupted_animation_keeps_the_old_output_and_leaves_no_temporary_file() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("walk.png");
+    fs::write(&out, b"the old animation").expect("write");
+    for sig in ["-TERM", "-INT"] {
+        let child = start_a_long_animation(&out, dir.path());
+        let status = signal(child, sig);
+        assert!(!status.success(), "{sig}: {status}");
+        assert_eq!(temporaries(dir.path()), Vec::<String>::new(), "{sig}");
+        assert_eq!(fs::read(&out).expect("read"), b"the old animation");
+    }
+    // A PNG sequence: its frames' temporary files go too.
+    let frames = dir.path().join("frames");
+    fs::create_dir(&frames).expect("mkdir");
+    let status = signal(start_a_long_animation(&frames, &frames), "-TERM");
+    assert!(!status.success());
+    assert_eq!(temporaries(&frames), Vec::<String>::new());
+    // Killed outright, a run cannot clean up; the next run into the same place does.
+    let child = start_a_long_animation(&out, dir.path());
+    signal(child, "-KILL");
+    assert_eq!(temporaries(dir.path()).len(), 1);
+    let rig = animated_rig(dir.path(), "c2");
+    animate(&rig, &out, &["--to", "0.25"]);
+    assert_eq!(temporaries(dir.path()), Vec::<String>::new());
+}
+
+#[test]
+fn a_folder_of_frames_never_loses_a_file_it_did_not_write() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let rig = animated_rig(dir.path(), "c2");
+    let frames = dir.path().join("frames/");
+    animate(&rig, &frames, &[]);
+    assert_eq!(sequence(&frames).len(), 5);
+    // A frame of its own as the picture: the frames would replace it.
+    let first = frames.join("frame_00000.png");
+    let before = fs::read(&first).expect("read");
+    let line = fails(&[
+        os("animate"),
+        rig.as_os_str(),
+        os("--image"),
+        first.as_os_str(),
+        os("-o"),
+        frames.as_os_str(),
+    ]);
+    assert!(line.contains("one of the inputs"), "{line}");
+    assert_eq!(fs::read(&first).expect("read"), before);
+    // Someone else's frame in the folder: refused, nothing touched.
+    fs::write(frames.join("frame_00030.png"), b"theirs").expect("write");
+    let line = fails(&[os("animate"), rig.as_os_str(), os("-o"), frames.as_os_str()]);
+    assert!(line.contains("frame_00030.png"), "{line}");
+    assert_eq!(
+        fs::read(frames.join("frame_00030.png")).expect("kept"),
+        b"theirs"
+    );
+    fs::remove_file(frames.join("frame_00030.png")).expect("remove");
+    // A shorter run replaces its own earlier frames and removes the rest of them.
+    animate(&rig, &frames, &["--to", "0.5"]);
+    assert_eq!(sequence(&frames).len(), 3);
 }

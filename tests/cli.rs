@@ -636,7 +636,10 @@ fn density_zero_is_refused_alike_from_the_rig_and_the_command_line() {
             &["--density", density],
         ));
         let rule = rule.replace("got 0", &format!("got {density}"));
-        assert_eq!(line, format!("error: {rule}"));
+        assert_eq!(
+            line,
+            format!("error: invalid value '{density}' for '--density <DENSITY>': {rule}")
+        );
         let line = fails(&[
             os("weights"),
             os("--image"),
@@ -648,7 +651,10 @@ fn density_zero_is_refused_alike_from_the_rig_and_the_command_line() {
             os("-o"),
             out.as_os_str(),
         ]);
-        assert_eq!(line, format!("error: {rule}"));
+        assert!(
+            line.ends_with(&format!("'--density <DENSITY>': {rule}")),
+            "{line}"
+        );
     }
     assert!(!out.exists());
 }
@@ -1001,4 +1007,217 @@ fn a_rig_file_that_is_not_an_object_says_what_it_is() {
             "{text}: {line}"
         );
     }
+}
+
+/// Copies `name` from the test data into `dir`.
+fn copy_data(dir: &Path, name: &str) -> PathBuf {
+    let to = dir.join(name);
+    fs::copy(data(name), &to).expect("copy test data");
+    to
+}
+
+#[test]
+fn no_command_writes_over_its_input() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    let pic = copy_data(d, "dino.png");
+    let rig = copy_data(d, "dino-rig.json");
+    let mesh = copy_data(d, "strip.obj");
+    fs::create_dir(d.join("sub")).expect("mkdir");
+    #[cfg(unix)]
+    std::os::unix::fs::symlink(&pic, d.join("link.png")).expect("symlink");
+    let originals: Vec<(PathBuf, Vec<u8>)> = [&pic, &rig, &mesh]
+        .iter()
+        .map(|p| ((*p).clone(), fs::read(p).expect("read")))
+        .collect();
+    let through_dots = d.join("sub/../dino.png");
+    let mut cases: Vec<(Vec<&OsStr>, &Path)> = vec![
+        (render_args(&pic, &rig, &pic, &[]), &pic),
+        (render_args(&pic, &rig, &rig, &[]), &rig),
+        (render_args(&pic, &rig, &through_dots, &[]), &pic),
+        (
+            vec![os("cage"), pic.as_os_str(), os("-o"), pic.as_os_str()],
+            &pic,
+        ),
+        (
+            vec![
+                os("cage"),
+                pic.as_os_str(),
+                os("--rig"),
+                rig.as_os_str(),
+                os("-o"),
+                rig.as_os_str(),
+            ],
+            &rig,
+        ),
+        (
+            vec![
+                os("weights"),
+                os("--image"),
+                pic.as_os_str(),
+                os("--rig"),
+                rig.as_os_str(),
+                os("-o"),
+                rig.as_os_str(),
+            ],
+            &rig,
+        ),
+        (
+            vec![
+                os("deform"),
+                os("--mesh"),
+                mesh.as_os_str(),
+                os("--rig"),
+                rig.as_os_str(),
+                os("-o"),
+                mesh.as_os_str(),
+            ],
+            &mesh,
+        ),
+    ];
+    #[cfg(unix)]
+    let link = d.join("link.png");
+    #[cfg(unix)]
+    cases.push((render_args(&pic, &rig, &link, &[]), &pic));
+    for (args, input) in &cases {
+        let line = fails(args);
+        let name = input.file_name().and_then(OsStr::to_str).expect("name");
+        assert!(
+            line.contains("one of the inputs") && line.contains(name),
+            "{args:?}: {line}"
+        );
+    }
+    for (path, bytes) in &originals {
+        assert_eq!(
+            &fs::read(path).expect("read"),
+            bytes,
+            "{} changed",
+            path.display()
+        );
+    }
+    assert_eq!(fs::read_dir(d.join("sub")).expect("list").count(), 0);
+}
+
+#[test]
+fn numeric_flags_give_one_line_naming_the_flag_and_its_range() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("out.json");
+    let pic = data("dino.png");
+    let rig = data("dino-rig.json");
+    let cage = |extra: &[&str]| {
+        let mut args = vec![os("cage"), pic.as_os_str(), os("-o"), out.as_os_str()];
+        args.extend(extra.iter().map(|e| os(e)));
+        fails(&args)
+    };
+    for (line, flag, range) in [
+        (cage(&["--vertices", "-1"]), "--vertices", "from 3 to 1,000"),
+        (cage(&["--vertices=-1"]), "--vertices", "from 3 to 1,000"),
+        (
+            cage(&["--vertices", "2.5"]),
+            "--vertices",
+            "from 3 to 1,000",
+        ),
+        (cage(&["--offset", "-5"]), "--offset", "from 0 to 10,000 px"),
+        (
+            cage(&["--offset", "1e9"]),
+            "--offset",
+            "from 0 to 10,000 px",
+        ),
+        (
+            cage(&["--offset", "NaN"]),
+            "--offset",
+            "from 0 to 10,000 px",
+        ),
+        (
+            fails(&render_args(&pic, &rig, &out, &["--density", "-5"])),
+            "--density",
+            "from 16 to 4,000,000",
+        ),
+        (
+            fails(&[
+                os("bench"),
+                os("--image"),
+                pic.as_os_str(),
+                os("--rig"),
+                rig.as_os_str(),
+                os("--positions"),
+                os("-3"),
+            ]),
+            "--positions",
+            "from 1 to 10,000",
+        ),
+        (
+            fails(&[
+                os("animate"),
+                rig.as_os_str(),
+                os("-o"),
+                out.as_os_str(),
+                os("--fps"),
+                os("-24"),
+            ]),
+            "--fps",
+            "above 0 to 240 frames per second",
+        ),
+        (
+            fails(&[
+                os("animate"),
+                rig.as_os_str(),
+                os("-o"),
+                out.as_os_str(),
+                os("--from"),
+                os("-1"),
+            ]),
+            "--from",
+            "from 0 to 86,400 s",
+        ),
+    ] {
+        assert!(
+            line.contains(&format!("'{flag} <")) && line.contains(range),
+            "{flag}: {line}"
+        );
+    }
+    assert!(!out.exists());
+}
+
+#[test]
+fn render_takes_a_project_alone_or_a_picture_and_its_rig() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    let pic = copy_data(d, "dino.png");
+    fs::create_dir(d.join("rigs")).expect("mkdir");
+    // `cage` names the picture relative to the rig's folder, even outside it.
+    let project = d.join("rigs/dino.json");
+    ok(&[os("cage"), pic.as_os_str(), os("-o"), project.as_os_str()]);
+    let text = fs::read_to_string(&project).expect("read");
+    let json: serde_json::Value = serde_json::from_str(&text).expect("json");
+    assert_eq!(json["image"], "../dino.png", "{text}");
+    let alone = d.join("alone.png");
+    let both = d.join("both.png");
+    ok(&[
+        os("render"),
+        project.as_os_str(),
+        os("-o"),
+        alone.as_os_str(),
+        os("--density"),
+        os("300"),
+    ]);
+    ok(&render_args(&pic, &project, &both, &["--density", "300"]));
+    assert_eq!(
+        fs::read(&alone).expect("read"),
+        fs::read(&both).expect("read")
+    );
+    // The other commands that read a project find its picture the same way.
+    let obj = d.join("out.obj");
+    ok(&[
+        os("deform"),
+        os("--rig"),
+        project.as_os_str(),
+        os("--density"),
+        os("300"),
+        os("-o"),
+        obj.as_os_str(),
+    ]);
+    // A picture without its rig says what to give.
+    let line = fails(&[os("render"), pic.as_os_str(), os("-o"), alone.as_os_str()]);
+    assert!(line.contains("--rig"), "{line}");
 }

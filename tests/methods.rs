@@ -732,7 +732,7 @@ fn cage_writes_a_rig_whose_cage_encloses_the_picture_and_renders_it_unchanged_at
         os("-o"),
         refused.as_os_str(),
     ]);
-    assert!(line.contains("3 to 1000 vertices"), "{line}");
+    assert!(line.contains("from 3 to 1,000"), "{line}");
     assert!(!refused.exists());
 }
 

@@ -1,10 +1,10 @@
 //! `c2warp animate`: every frame of a project's animation, written as an animated
 //! PNG, animated WebP, GIF or PNG sequence.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use pipeline::animate::{Animator, Span, plan};
 use pipeline::{load_picture, load_project};
 use render::AnimationFormat;
@@ -31,7 +31,11 @@ pub fn run(request: &Request) -> Result<()> {
     let project = load_project(request.project)?;
     let frames = plan(&project, request.span, format)
         .with_context(|| format!("cannot animate {}", request.project.display()))?;
-    let image = picture_path(request.project, request.image, project.image.as_deref())?;
+    let image = match request.image {
+        Some(image) => image.to_path_buf(),
+        None => crate::named_picture(request.project, project.image.as_deref())?,
+    };
+    render::refuse_input_as_output(request.output, &[request.project, &image])?;
     let picture = load_picture(&image)?;
     let progress = crate::progress::Steps::new(2);
     progress.step("meshing and weighting");
@@ -49,19 +53,4 @@ pub fn run(request: &Request) -> Result<()> {
     )?;
     progress.finish();
     Ok(())
-}
-
-/// The picture to animate: `given`, else the project's `"image"` (relative to the
-/// project file's folder).
-fn picture_path(project: &Path, given: Option<&Path>, named: Option<&Path>) -> Result<PathBuf> {
-    if let Some(given) = given {
-        return Ok(given.to_path_buf());
-    }
-    let Some(named) = named else {
-        bail!(
-            "{} names no picture (\"image\"): give one with --image PATH",
-            project.display()
-        );
-    };
-    Ok(project.parent().unwrap_or(Path::new("")).join(named))
 }

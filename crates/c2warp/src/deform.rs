@@ -18,7 +18,9 @@ pub fn run(source: &Source, rig_path: &Path, method: Option<Method>, output: &Pa
     if let Some(method) = method {
         project.method = method;
     }
-    let input = Input::load(source)?;
+    let file = source.file(rig_path, &project)?;
+    render::refuse_input_as_output(output, &[rig_path, &file])?;
+    let input = Input::load(source, &file)?;
     let progress = crate::progress::Steps::new(3);
     progress.step("meshing and weighting");
     // With --mesh, the given mesh is the method's own (ARAP solves on it, LBC takes it

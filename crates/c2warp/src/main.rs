@@ -4,6 +4,7 @@ mod animate;
 mod bench;
 mod deform;
 mod export;
+mod flags;
 mod progress;
 mod runtime_dir;
 
@@ -44,18 +45,20 @@ enum Command {
     /// Warp an image by a rig and write a PNG of the same size (alpha kept; 16 bits
     /// per channel for a 16-bit source).
     Render {
-        /// The image (PNG, JPEG, WebP, TIFF, BMP, or a GIF's first frame).
-        image: PathBuf,
-        /// The rig file (RIG.json).
+        /// The picture (PNG, JPEG, WebP, TIFF, BMP, or a GIF's first frame) with
+        /// `--rig`; or the project (a rig file, .json) alone, whose "image" names the
+        /// picture (relative to the project's folder).
+        input: PathBuf,
+        /// The rig file (RIG.json), when INPUT is the picture.
         #[arg(long)]
-        rig: PathBuf,
+        rig: Option<PathBuf>,
         /// Where to write the PNG (`-`: standard output). A file is replaced
-        /// atomically; a device or FIFO is written to; a symbolic link's target is
-        /// written.
+        /// atomically (never one of the inputs); a device or FIFO is written to; a
+        /// symbolic link's target is written.
         #[arg(short, long)]
         output: PathBuf,
         /// Target number of mesh vertices (overrides the rig's `density`).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true, value_parser = flags::density)]
         density: Option<usize>,
         /// Draw with the GPU (a software Vulkan driver works too) instead of on the
         /// CPU: a skinned method's transforms are blended in the vertex shader. The GPU
@@ -80,7 +83,10 @@ enum Command {
         project: PathBuf,
         /// Where to write: OUT.png (animated PNG), OUT.webp (animated WebP), OUT.gif,
         /// or a folder (DIR/, or one that exists) for frame_00000.png, … A file is
-        /// replaced atomically; nothing is left behind on failure.
+        /// replaced atomically (never one of the inputs); nothing is left behind on
+        /// failure or when interrupted. A folder takes only frames: those of an
+        /// earlier run into it that this one does not replace are removed, and a
+        /// folder holding frames this program did not write there is refused.
         #[arg(short, long)]
         output: PathBuf,
         /// The picture (overrides the project's "image").
@@ -88,13 +94,16 @@ enum Command {
         image: Option<PathBuf>,
         /// Frames per second (default: the project's animation.fps, else 24; at most
         /// 240, 50 for a GIF).
-        #[arg(long, allow_negative_numbers = true)]
+        #[arg(long, allow_negative_numbers = true,
+              value_parser = flags::number(0.0..=render::AnimationWriter::MAX_FPS, true, " frames per second"))]
         fps: Option<f64>,
         /// Time of the first frame in seconds (default 0).
-        #[arg(long, allow_negative_numbers = true)]
+        #[arg(long, allow_negative_numbers = true,
+              value_parser = flags::number(0.0..=project::animation::MAX_TIME, false, " s"))]
         from: Option<f64>,
         /// Time of the last frame in seconds (default: the last key's).
-        #[arg(long, allow_negative_numbers = true)]
+        #[arg(long, allow_negative_numbers = true,
+              value_parser = flags::number(0.0..=project::animation::MAX_TIME, false, " s"))]
         to: Option<f64>,
         /// Draw with the GPU (8 bits per channel) instead of on the CPU.
         #[arg(long)]
@@ -135,7 +144,8 @@ enum Command {
         #[arg(long)]
         rig: PathBuf,
         /// Random positions to insert and remove a handle at.
-        #[arg(long, default_value_t = 31)]
+        #[arg(long, default_value_t = 31, allow_negative_numbers = true,
+              value_parser = flags::count(1..=MAX_POSITIONS))]
         positions: usize,
         /// The method to time (overrides the rig's `method`).
         #[arg(long, value_parser = methods())]
@@ -148,17 +158,20 @@ enum Command {
         /// The picture (PNG, JPEG, WebP, TIFF, BMP, or a GIF's first frame).
         image: PathBuf,
         /// Vertices of the cage.
-        #[arg(long, default_value_t = 16)]
+        #[arg(long, default_value_t = 16, allow_negative_numbers = true,
+              value_parser = flags::count(3..=project::MAX_CAGE_VERTICES))]
         vertices: usize,
         /// How far outside the visible pixels the cage runs at least, in pixels
         /// (default: 1% of the picture's diagonal, 3 to 20).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true,
+              value_parser = flags::number(0.0..=MAX_CAGE_OFFSET, false, " px"))]
         offset: Option<f64>,
         /// A rig to start from: its handles and settings are kept, its cage replaced.
         #[arg(long)]
         rig: Option<PathBuf>,
-        /// Where to write the rig (`-`: standard output); `"method"` is `"lbc"`, the
-        /// cage at rest, `"image"` the picture relative to the rig's folder.
+        /// Where to write the rig (`-`: standard output; never one of the inputs);
+        /// `"method"` is `"lbc"`, the cage at rest, `"image"` the picture relative to
+        /// the rig's folder.
         #[arg(short, long)]
         output: PathBuf,
     },
@@ -175,15 +188,24 @@ enum Command {
 #[group(skip)]
 struct Source {
     /// A 2-D mesh as Wavefront OBJ (`v x y [z]`, `f a b c`); vertices used as given.
-    #[arg(long, required_unless_present = "image", conflicts_with = "image")]
+    #[arg(long, conflicts_with = "image")]
     mesh: Option<PathBuf>,
-    /// An image to mesh (alpha outlines, or the full rectangle).
+    /// An image to mesh (alpha outlines, or the full rectangle). With neither
+    /// `--mesh` nor `--image`, the picture the rig file's "image" names.
     #[arg(long)]
     image: Option<PathBuf>,
     /// Target number of mesh vertices when meshing an image.
-    #[arg(long, conflicts_with = "mesh")]
+    #[arg(long, conflicts_with = "mesh", allow_negative_numbers = true,
+          value_parser = flags::density)]
     density: Option<usize>,
 }
+
+/// The most positions `c2warp bench --positions` times.
+const MAX_POSITIONS: usize = 10_000;
+
+/// The farthest `c2warp cage --offset` reaches, in pixels (a picture's side is at
+/// most 65,535 px; a cage that far out is the picture's rectangle).
+const MAX_CAGE_OFFSET: f64 = 10_000.0;
 
 /// `--method`: every method by its rig-file name.
 fn methods() -> impl clap::builder::TypedValueParser<Value = Method> {
@@ -201,23 +223,47 @@ enum Input {
     Mesh(pipeline::Mesh),
 }
 
-impl Input {
-    /// Reads the picture or the OBJ mesh `source` names (a mesh is checked).
-    fn load(source: &Source) -> Result<Self> {
-        if let Some(density) = source.density {
-            // Before the slow part: the rule and the message of a rig file's density.
-            project::validate_density(density)?;
+impl Source {
+    /// The file the samples come from: the mesh or the image given, else the picture
+    /// the rig file at `rig` names.
+    fn file(&self, rig: &Path, project: &Project) -> Result<PathBuf> {
+        match (&self.mesh, &self.image) {
+            (Some(path), _) | (None, Some(path)) => Ok(path.clone()),
+            (None, None) => {
+                named_picture(rig, project.image.as_deref()).context("give --mesh or --image")
+            }
         }
-        if let Some(path) = &source.image {
+    }
+}
+
+/// The picture a project names (its `"image"`, relative to the project file's
+/// folder).
+///
+/// # Errors
+/// A project that names none.
+pub(crate) fn named_picture(project: &Path, named: Option<&Path>) -> Result<PathBuf> {
+    let Some(named) = named else {
+        bail!(
+            "{} names no picture (\"image\"): give one with --image PATH",
+            project.display()
+        );
+    };
+    Ok(project.parent().unwrap_or(Path::new("")).join(named))
+}
+
+impl Input {
+    /// Reads `file`, the OBJ mesh or the picture `source` stands for (a mesh is
+    /// checked).
+    fn load(source: &Source, file: &Path) -> Result<Self> {
+        if source.mesh.is_none() {
             return Ok(Self::Picture {
-                image: pipeline::load_image(path)?,
+                image: pipeline::load_image(file)?,
                 density: source.density,
             });
         }
-        let path = source.mesh.as_deref().context("give --mesh or --image")?;
-        let mesh = pipeline::load_obj(path)?;
+        let mesh = pipeline::load_obj(file)?;
         mesh.sanity_check()
-            .with_context(|| format!("mesh {}", path.display()))?;
+            .with_context(|| format!("mesh {}", file.display()))?;
         Ok(Self::Mesh(mesh))
     }
 
@@ -254,7 +300,16 @@ fn warn(deformer: &dyn Deformer) {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(error) => match flags::value_error_line(&error) {
+            Some(line) => {
+                eprintln!("{line}");
+                return ExitCode::from(2);
+            }
+            None => error.exit(),
+        },
+    };
     // Before any thread starts: the GPU path's Vulkan layer (the editor's too)
     // complains on stderr without it (see runtime_dir.rs).
     let _runtime_dir = match &cli.command {
@@ -266,6 +321,16 @@ fn main() -> ExitCode {
         | None => runtime_dir::ensure(),
         _ => None,
     };
+    // Interrupted (Ctrl-C, SIGTERM, SIGHUP), a run removes the temporary files of the
+    // writes it has in progress, so every output stays as it was and nothing is left.
+    if let Err(error) = ctrlc::set_handler(|| {
+        render::remove_temporary_files();
+        std::process::exit(130);
+    }) {
+        eprintln!(
+            "warning: cannot watch for Ctrl-C ({error}): an interrupted run may leave temporary files"
+        );
+    }
     let result = match cli.command {
         None => editor::run(cli.file),
         Some(command) => run(command),
@@ -283,14 +348,22 @@ fn run(command: Command) -> Result<()> {
     match command {
         Command::Open { file } => editor::run(Some(file)),
         Command::Render {
-            image,
+            input,
             rig,
             output,
             density,
             gpu,
             method,
             canvas,
-        } => render(&image, &rig, &output, density, gpu, method, canvas),
+        } => render(
+            &input,
+            rig.as_deref(),
+            &output,
+            density,
+            gpu,
+            method,
+            canvas,
+        ),
         Command::Animate {
             project,
             output,
@@ -341,16 +414,25 @@ fn cage(
     rig: Option<&Path>,
     output: &Path,
 ) -> Result<()> {
+    let inputs: Vec<&Path> = std::iter::once(image).chain(rig).collect();
+    render::refuse_input_as_output(output, &inputs)?;
     let mut project = match rig {
         Some(rig) => load_project(rig)?,
         None => Project::default(),
     };
-    let picture = pipeline::load_image(image)?;
-    let (w, h) = picture.dimensions();
+    // Only the alpha channel matters, read a row at a time: a huge picture with a
+    // small figure on it costs its bitmap, not its pixels.
+    let coverage = pipeline::cage::coverage_of_file(image)?;
+    let (w, h) = coverage.dimensions();
     let offset = offset.unwrap_or_else(|| pipeline::cage::outline_offset(w, h));
-    let ring = pipeline::cage::cage_from_outline(&picture, vertices, offset)?;
+    let ring = pipeline::cage::cage_around(&coverage, vertices, offset)?;
     if let Some(note) = pipeline::cage::outline_note(vertices, ring.len()) {
         eprintln!("note: {note}");
+    }
+    if pipeline::cage::is_whole_picture(&ring, w, h) && !coverage.is_opaque() {
+        eprintln!(
+            "note: at {offset} px out the cage reaches every edge: it is the picture's rectangle"
+        );
     }
     project.cage = Some(project::CageSpec {
         rest: ring.iter().map(|p| p.to_array()).collect(),
@@ -367,27 +449,45 @@ fn cage(
     write_text(output, project.to_json().as_bytes())
 }
 
+/// The rig file, the project it holds and the picture a command warps: `first` is
+/// the picture and `rig` the rig file, or, without `rig`, `first` is the project and
+/// names its picture.
+fn project_and_picture(first: &Path, rig: Option<&Path>) -> Result<(PathBuf, Project, PathBuf)> {
+    if let Some(rig) = rig {
+        return Ok((rig.to_path_buf(), load_project(rig)?, first.to_path_buf()));
+    }
+    let is_json = first
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"));
+    if !is_json {
+        bail!(
+            "{} is a picture: give its rig with --rig RIG.json, or give the project (.json) alone",
+            first.display()
+        );
+    }
+    let project = load_project(first)?;
+    let picture = named_picture(first, project.image.as_deref())?;
+    Ok((first.to_path_buf(), project, picture))
+}
+
 fn render(
-    image: &Path,
-    rig: &Path,
+    input: &Path,
+    rig: Option<&Path>,
     output: &Path,
     density: Option<usize>,
     gpu: bool,
     method: Option<Method>,
     canvas: Option<project::Canvas>,
 ) -> Result<()> {
-    if let Some(density) = density {
-        // Before the slow part: the rule and the message of a rig file's density.
-        project::validate_density(density)?;
-    }
-    let mut project = load_project(rig)?;
+    let (rig, mut project, image) = project_and_picture(input, rig)?;
+    render::refuse_input_as_output(output, &[&image, &rig])?;
     if let Some(method) = method {
         project.method = method;
     }
     if let Some(canvas) = canvas {
         project.canvas = canvas;
     }
-    let picture = load_picture(image)?;
+    let picture = load_picture(&image)?;
     warp_and_save(&picture, &project, density, output, gpu)?;
     Ok(())
 }

@@ -509,3 +509,46 @@ fn a_fifo_or_a_device_is_refused_at_once() {
         assert_eq!(handles(&h), before);
     }
 }
+
+#[test]
+fn no_save_or_export_replaces_the_picture_or_the_project() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let source = dir.path().join("cat.png");
+    let picture = image::RgbaImage::from_pixel(40, 30, image::Rgba([200, 100, 50, 255]));
+    picture.save(&source).expect("write a picture");
+    let original = std::fs::read(&source).expect("read");
+    let mut h = editor_with(Box::new(NoDesktop), false);
+    h.state_mut().open_in_background(source.clone());
+    settle(&mut h);
+    let project = dir.path().join("cat.json");
+    h.state_mut().save_to(&project);
+    let saved = std::fs::read(&project).expect("saved");
+    // Saving the project over its picture, exporting over the picture or the project
+    // (also through `..`): refused, said, nothing written.
+    std::fs::create_dir(dir.path().join("sub")).expect("mkdir");
+    let through_dots = dir.path().join("sub/../cat.png");
+    for (target, export) in [
+        (&source, false),
+        (&through_dots, false),
+        (&source, true),
+        (&project, true),
+    ] {
+        if export {
+            h.state_mut().export_to(target);
+        } else {
+            h.state_mut().save_to(target);
+        }
+        let message = h.state().message.clone().expect("a message");
+        assert!(
+            message.is_error && message.text.contains("one of the inputs"),
+            "{}: {}",
+            target.display(),
+            message.text
+        );
+    }
+    assert_eq!(std::fs::read(&source).expect("read"), original);
+    assert_eq!(std::fs::read(&project).expect("read"), saved);
+    // Saving the project over itself is what Save is for.
+    h.state_mut().save_to(&project);
+    assert!(!h.state().message.clone().expect("a message").is_error);
+}

@@ -35,6 +35,100 @@ pub struct Enclosure {
     pub pieces: usize,
 }
 
+/// Which pixels of a picture are visible (alpha > 0): one bit a pixel, so that a
+/// 16384 × 16384 picture costs 32 MB. What [`enclosing_ring_of`] encloses.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Coverage {
+    width: usize,
+    height: usize,
+    /// 64-bit words a row.
+    stride: usize,
+    bits: Vec<u64>,
+}
+
+impl Coverage {
+    /// A `width × height` picture with nothing visible.
+    pub fn new(width: u32, height: u32) -> Self {
+        let (width, height) = (width as usize, height as usize);
+        let stride = width.div_ceil(64);
+        Self {
+            width,
+            height,
+            stride,
+            bits: vec![0; stride * height],
+        }
+    }
+
+    /// The visible pixels of `image`.
+    pub fn of_image(image: &image::RgbaImage) -> Self {
+        let mut coverage = Self::new(image.width(), image.height());
+        let mut alpha = Vec::with_capacity(coverage.width);
+        for (y, row) in image.rows().enumerate() {
+            alpha.clear();
+            alpha.extend(row.map(|p| p.0[3]));
+            coverage.set_row(y as u32, &alpha);
+        }
+        coverage
+    }
+
+    /// Sets row `y` from its pixels' alpha values (visible where above 0). Pixels
+    /// beyond the row's width are ignored; a row beyond the height is.
+    pub fn set_row(&mut self, y: u32, alpha: &[u8]) {
+        let y = y as usize;
+        if y >= self.height {
+            return;
+        }
+        let row = &mut self.bits[y * self.stride..(y + 1) * self.stride];
+        row.fill(0);
+        for (x, &a) in alpha.iter().take(self.width).enumerate() {
+            if a > 0 {
+                row[x / 64] |= 1 << (x % 64);
+            }
+        }
+    }
+
+    /// The picture's width and height in pixels.
+    pub fn dimensions(&self) -> (u32, u32) {
+        (self.width as u32, self.height as u32)
+    }
+
+    /// Whether pixel `(x, y)` is visible.
+    pub fn get(&self, x: usize, y: usize) -> bool {
+        self.bits[y * self.stride + x / 64] >> (x % 64) & 1 == 1
+    }
+
+    /// Whether every pixel is visible.
+    pub fn is_opaque(&self) -> bool {
+        self.extent()
+            .is_some_and(|(_, count)| count == self.width * self.height)
+    }
+
+    /// The visible pixels' bounding box `[x0, x1) × [y0, y1)` and their count, or
+    /// `None` when nothing is visible.
+    fn extent(&self) -> Option<([usize; 4], usize)> {
+        let mut count = 0;
+        let mut bounds: Option<[usize; 4]> = None;
+        for y in 0..self.height {
+            let row = &self.bits[y * self.stride..(y + 1) * self.stride];
+            let first = row.iter().position(|&w| w != 0);
+            let Some(first) = first else { continue };
+            let last = row.iter().rposition(|&w| w != 0).unwrap_or(first);
+            count += row.iter().map(|w| w.count_ones() as usize).sum::<usize>();
+            let x0 = first * 64 + row[first].trailing_zeros() as usize;
+            let x1 = last * 64 + 64 - row[last].leading_zeros() as usize;
+            bounds = Some(match bounds {
+                None => [x0, y, x1, y + 1],
+                Some([a, b, c, _]) => [a.min(x0), b, c.max(x1), y + 1],
+            });
+        }
+        bounds.map(|b| (b, count))
+    }
+}
+
+/// The most pixels the working mask of [`enclosing_ring_of`] holds (4096²): a larger
+/// region around the visible pixels is worked on in cells of several pixels.
+const MAX_WORKING_PIXELS: usize = 4096 * 4096;
+
 /// A simple polygon of `vertices` vertices (more where that few cannot enclose the
 /// shape without crossing itself) around every pixel of `image` with alpha > 0, at
 /// least `margin` pixels outside them, within the picture's rectangle.
@@ -42,6 +136,7 @@ pub struct Enclosure {
 /// An opaque picture gives its rectangle. Pieces apart from one another (specks, a
 /// detached hand) are all enclosed. The ring has fewer than `vertices` vertices only
 /// when the traced outline itself has (a small shape): callers may split its edges.
+/// See [`enclosing_ring_of`], which this calls on the picture's [`Coverage`].
 ///
 /// # Errors
 /// [`MeshError::EmptyDomain`] for a picture with no visible pixel;
@@ -49,6 +144,24 @@ pub struct Enclosure {
 /// finite, non-negative number.
 pub fn enclosing_ring(
     image: &image::RgbaImage,
+    vertices: usize,
+    margin: f64,
+) -> Result<Enclosure, MeshError> {
+    enclosing_ring_of(&Coverage::of_image(image), vertices, margin)
+}
+
+/// [`enclosing_ring`] of the visible pixels `coverage` marks.
+///
+/// The work is done on the visible pixels' bounding box grown by the margin, not on
+/// the whole picture; where that region holds more than 4096² pixels it is worked on
+/// in square cells of several pixels (a cell counts as visible when any pixel in it
+/// is, and the margin is kept in whole cells), so that the ring may run up to a cell
+/// or two farther out, and time and memory stay bounded whatever the picture's size.
+///
+/// # Errors
+/// As [`enclosing_ring`].
+pub fn enclosing_ring_of(
+    coverage: &Coverage,
     vertices: usize,
     margin: f64,
 ) -> Result<Enclosure, MeshError> {
@@ -62,13 +175,10 @@ pub fn enclosing_ring(
             "the margin must be a number of pixels, not {margin}"
         )));
     }
-    let (w, h) = (image.width() as usize, image.height() as usize);
-    let mut mask: Vec<bool> = image.pixels().map(|p| p.0[3] > 0).collect();
-    if !mask.contains(&true) {
-        return Err(MeshError::EmptyDomain);
-    }
+    let (w, h) = (coverage.width, coverage.height);
+    let ([bx0, by0, bx1, by1], count) = coverage.extent().ok_or(MeshError::EmptyDomain)?;
     let (fw, fh) = (w as f64, h as f64);
-    if mask.iter().all(|&m| m) {
+    if count == w * h {
         let ring = vec![
             DVec2::ZERO,
             DVec2::new(fw, 0.0),
@@ -77,17 +187,46 @@ pub fn enclosing_ring(
         ];
         return Ok(Enclosure { ring, pieces: 1 });
     }
-    dilate(&mut mask, w, h, margin.ceil() as usize);
-    make_well_composed(&mut mask, w, h);
-    let pieces = join_pieces(&mut mask, w, h);
-    let outer = trace(&mask, w, h)
+    // The working region: the bounding box, the margin and two cells more around it
+    // (so that dilation, well-composing and bridges stay inside), within the picture.
+    let reach = margin.ceil() as usize;
+    let cell = (1..)
+        .find(|&s: &usize| {
+            let grown = |a: usize, b: usize, n: usize| (b - a + 2 * (reach + 2 * s)).min(n);
+            grown(bx0, bx1, w).div_ceil(s) * grown(by0, by1, h).div_ceil(s) <= MAX_WORKING_PIXELS
+        })
+        .unwrap_or(1);
+    let pad = reach + 2 * cell;
+    let (x0, y0) = (bx0.saturating_sub(pad), by0.saturating_sub(pad));
+    let (x1, y1) = ((bx1 + pad).min(w), (by1 + pad).min(h));
+    let (cw, ch) = ((x1 - x0).div_ceil(cell), (y1 - y0).div_ceil(cell));
+    let mut mask = vec![false; cw * ch];
+    for y in by0..by1 {
+        let row = &coverage.bits[y * coverage.stride..(y + 1) * coverage.stride];
+        let cy = (y - y0) / cell;
+        for (k, &word) in row.iter().enumerate() {
+            let mut word = word;
+            while word != 0 {
+                let x = k * 64 + word.trailing_zeros() as usize;
+                word &= word - 1;
+                mask[cy * cw + (x - x0) / cell] = true;
+            }
+        }
+    }
+    dilate(&mut mask, cw, ch, reach.div_ceil(cell));
+    make_well_composed(&mut mask, cw, ch);
+    let pieces = join_pieces(&mut mask, cw, ch);
+    let outer = trace(&mask, cw, ch)
         .into_iter()
         .map(|r| r.pts)
         .max_by_key(|pts| lattice::twice_signed_area(pts))
         .ok_or(MeshError::EmptyDomain)?;
+    // Cell corners back to pixels (the last cell of a row or column may be narrower).
+    let to_x = |c: i64| (x0 + c as usize * cell).min(x1) as f64;
+    let to_y = |c: i64| (y0 + c as usize * cell).min(y1) as f64;
     let ring: Vec<DVec2> = outer
         .iter()
-        .map(|p| DVec2::new(p[0] as f64, p[1] as f64))
+        .map(|p| DVec2::new(to_x(p[0]), to_y(p[1])))
         .collect();
     let ring = Reducer::new(ring, DVec2::new(fw, fh)).reduce(vertices);
     Ok(Enclosure { ring, pieces })

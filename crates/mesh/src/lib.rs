@@ -58,7 +58,7 @@ mod trace;
 mod triangulate;
 
 pub use domain::{Domain, DomainOptions, Polygon, domain_for_density, domain_from_image};
-pub use enclose::{Enclosure, enclosing_ring};
+pub use enclose::{Coverage, Enclosure, enclosing_ring, enclosing_ring_of};
 pub use error::MeshError;
 pub use mesh::Mesh;
 pub use triangulate::{

@@ -493,6 +493,15 @@ pub fn cage_from_outline(
     vertices: usize,
     offset: f64,
 ) -> Result<Vec<DVec2>> {
+    cage_around(&mesh::Coverage::of_image(image), vertices, offset)
+}
+
+/// [`cage_from_outline`] of the visible pixels `coverage` marks (for a picture read
+/// row by row, [`coverage_of_file`]).
+///
+/// # Errors
+/// As [`cage_from_outline`].
+pub fn cage_around(coverage: &mesh::Coverage, vertices: usize, offset: f64) -> Result<Vec<DVec2>> {
     ensure!(
         (3..=MAX_CAGE_VERTICES).contains(&vertices),
         "a cage needs 3 to {MAX_CAGE_VERTICES} vertices, not {vertices}"
@@ -501,7 +510,7 @@ pub fn cage_from_outline(
         offset.is_finite() && offset >= 0.0,
         "the cage's offset must be a number of pixels, not {offset}"
     );
-    let enclosure = match mesh::enclosing_ring(image, vertices, offset) {
+    let enclosure = match mesh::enclosing_ring_of(coverage, vertices, offset) {
         Err(mesh::MeshError::EmptyDomain) => {
             bail!("the picture has no visible pixel to put a cage around")
         }
@@ -511,6 +520,39 @@ pub fn cage_from_outline(
     split_longest_edges(&mut ring, vertices);
     lbc::Cage::new(ring.clone()).context("the outline does not make a simple cage")?;
     Ok(ring)
+}
+
+/// Which pixels of the picture at `path` are visible, read a row at a time (a PNG
+/// is never held whole: a 16384² one costs its 32 MB bitmap).
+///
+/// # Errors
+/// A missing, unreadable, corrupt or oversized picture, naming it.
+pub fn coverage_of_file(path: &std::path::Path) -> Result<mesh::Coverage> {
+    let mut reader = render::AlphaReader::open(path, &render::ImageLimits::default())
+        .map_err(|e| crate::read_error(e, "image"))?;
+    let (w, h) = reader.dimensions();
+    let mut coverage = mesh::Coverage::new(w, h);
+    let mut alpha = Vec::with_capacity(w as usize);
+    let mut y = 0;
+    while reader.next_row(&mut alpha)? {
+        coverage.set_row(y, &alpha);
+        y += 1;
+    }
+    Ok(coverage)
+}
+
+/// Whether `ring` is the `width × height` picture's rectangle (its four corners,
+/// and any other vertices on its edges).
+pub fn is_whole_picture(ring: &[DVec2], width: u32, height: u32) -> bool {
+    let (w, h) = (f64::from(width), f64::from(height));
+    let on_edge = |p: &DVec2| p.x == 0.0 || p.y == 0.0 || p.x == w || p.y == h;
+    let corners = [
+        DVec2::ZERO,
+        DVec2::new(w, 0.0),
+        DVec2::new(w, h),
+        DVec2::new(0.0, h),
+    ];
+    ring.iter().all(on_edge) && corners.iter().all(|c| ring.contains(c))
 }
 
 /// How far outside a `width × height` picture's visible pixels a cage from its outline

@@ -46,7 +46,7 @@ pub const MAX_RIG_BYTES: u64 = 8 << 20;
 pub const MAX_OBJ_BYTES: u64 = 1 << 30;
 
 /// The error for an input file that could not be read, naming it as `what`.
-fn read_error(error: render::RenderError, what: &str) -> anyhow::Error {
+pub(crate) fn read_error(error: render::RenderError, what: &str) -> anyhow::Error {
     match error {
         render::RenderError::NotFound { path } => {
             anyhow!("cannot read {what} {}: no such file", path.display())
@@ -168,15 +168,56 @@ pub fn error_line(error: &anyhow::Error) -> String {
     line
 }
 
-/// `path` relative to `folder` when it lies inside it, else absolute: how a rig file
-/// names its picture, relative to the rig's own folder.
+/// `path` relative to `folder` (with `..` where it lies outside it), or absolute when
+/// the two share nothing but the root: how a rig file names its picture, relative to the rig's own
+/// folder. `.` and `..` in either are resolved as written (links are not followed).
+///
+/// ```
+/// use std::path::Path;
+/// let rel = |p, f| pipeline::relative_path(Path::new(p), Path::new(f));
+/// assert_eq!(rel("/art/cat.png", "/art"), Path::new("cat.png"));
+/// assert_eq!(rel("/art/pics/cat.png", "/art/rigs"), Path::new("../pics/cat.png"));
+/// assert_eq!(rel("/art/./x/../cat.png", "/art/rigs/"), Path::new("../cat.png"));
+/// assert_eq!(rel("/home/cat.png", "/tmp/rigs"), Path::new("/home/cat.png"));
+/// ```
 pub fn relative_path(path: &Path, folder: &Path) -> std::path::PathBuf {
-    let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
-    let (path, folder) = (absolute(path), absolute(folder));
-    match path.strip_prefix(&folder) {
-        Ok(relative) => relative.to_path_buf(),
-        Err(_) => path,
+    use std::path::{Component, PathBuf};
+    let resolved = |p: &Path| {
+        let absolute = std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+        let mut out = PathBuf::new();
+        for part in absolute.components() {
+            match part {
+                Component::CurDir => {}
+                Component::ParentDir => {
+                    out.pop();
+                }
+                other => out.push(other),
+            }
+        }
+        out
+    };
+    let (path, folder) = (resolved(path), resolved(folder));
+    let shared = path
+        .components()
+        .zip(folder.components())
+        .take_while(|(a, b)| a == b)
+        .count();
+    // Sharing no more than the root (or a drive): the absolute path says it better.
+    let roots = path
+        .components()
+        .take_while(|c| matches!(c, Component::RootDir | Component::Prefix(_)))
+        .count();
+    if shared <= roots {
+        return path;
     }
+    let mut relative = PathBuf::new();
+    for _ in folder.components().skip(shared) {
+        relative.push("..");
+    }
+    for part in path.components().skip(shared) {
+        relative.push(part);
+    }
+    relative
 }
 
 /// Target vertex count of the mesh when neither the project nor the command says.

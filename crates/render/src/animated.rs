@@ -4,7 +4,7 @@
 //! result is put in place atomically at the end.
 
 use std::borrow::Cow;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::fs::{self, File};
 use std::io::{self, BufWriter, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
@@ -13,6 +13,7 @@ use image::RgbaImage;
 use rayon::prelude::*;
 
 use crate::atomic::Replacement;
+use crate::files::is_frame_name;
 use crate::{Picture, RenderError, write_png};
 
 /// What an animation is written as.
@@ -123,12 +124,15 @@ impl AnimationFormat {
 ///
 /// A [`PngSequence`](AnimationFormat::PngSequence) writes and syncs each frame to
 /// a temporary file beside its name as it comes, and renames them all into place
-/// at `finish`, then removes files `frame_<5 or more digits>.png` left over from
-/// an earlier sequence (a longer one, or one numbered with more digits), so that the
-/// directory holds exactly this animation. Each file is replaced atomically; the
-/// set of them only nearly so (a crash during the renames leaves a mix). The
-/// directory is created if missing (not its parent), and removed again if the
-/// writer is dropped unfinished.
+/// at `finish`. The directory remembers which frames the writer put there (in a
+/// small hidden list, `.c2warp-frames`), so that a later sequence into it removes
+/// the frames of the earlier one it does not replace (a longer one, or one numbered
+/// with more digits) and the directory holds exactly this animation; a frame file
+/// (`frame_<digits>.png`) the writer did not put there is never replaced or
+/// removed: such a directory is refused. Each file is replaced atomically; the set
+/// of them only nearly so (a crash during the renames leaves a mix). The directory
+/// is created if missing (not its parent), and removed again if the writer is
+/// dropped unfinished.
 ///
 /// Timing: animated PNG gives every frame the delay `num / den` seconds (each at
 /// most 65535) closest to `1 / fps`; animated WebP (milliseconds) and GIF
@@ -810,6 +814,8 @@ struct SequenceSink {
     frames: usize,
     /// Digits in a frame's number: 5, or as many as the last number needs.
     digits: usize,
+    /// The frames an earlier sequence of the writer's left in the directory.
+    earlier: Vec<String>,
     /// The frames written so far, waiting to be renamed into place.
     written: Vec<Replacement>,
     /// Whether `create` made the directory (removed again if abandoned).
@@ -837,52 +843,115 @@ impl SequenceSink {
             }
         };
         let digits = (frames - 1).to_string().len().max(5);
+        let earlier = if created_dir {
+            Vec::new()
+        } else {
+            let earlier = read_frame_list(dir);
+            refuse_other_frames(dir, &earlier)?;
+            earlier
+        };
         Ok(Self {
             dir: dir.to_owned(),
             frames,
             digits,
+            earlier,
             written: Vec::new(),
             created_dir,
             finished: false,
         })
     }
 
-    /// Removes files `frame_<5 or more digits>.png` that are not this animation's
-    /// frames.
-    fn remove_stale(&self) -> Result<(), RenderError> {
-        let list_error = |source| RenderError::Io {
-            path: self.dir.clone(),
-            action: "list",
-            source,
-        };
-        for entry in fs::read_dir(&self.dir).map_err(list_error)? {
-            let entry = entry.map_err(list_error)?;
-            let name = entry.file_name();
-            let Some(number) = name
-                .to_str()
-                .and_then(|name| name.strip_prefix("frame_"))
-                .and_then(|name| name.strip_suffix(".png"))
-            else {
-                continue;
-            };
-            // Only names this writer could have made: 5 digits or more.
-            if number.len() < 5 || !number.bytes().all(|b| b.is_ascii_digit()) {
+    /// The file name of frame `index`.
+    fn frame_name(&self, index: usize) -> String {
+        format!("frame_{index:0width$}.png", width = self.digits)
+    }
+
+    /// Removes the frames of the earlier sequence that this one did not replace, then
+    /// records this one's.
+    fn replace_frame_list(&self) -> Result<(), RenderError> {
+        let ours: HashSet<String> = (0..self.frames).map(|i| self.frame_name(i)).collect();
+        for name in &self.earlier {
+            if ours.contains(name) {
                 continue;
             }
-            let ours = number.len() == self.digits
-                && number.parse::<usize>().is_ok_and(|n| n < self.frames);
-            if ours || entry.file_type().is_ok_and(|kind| kind.is_dir()) {
-                continue;
+            let stale = self.dir.join(name);
+            match fs::symlink_metadata(&stale) {
+                Ok(meta) if meta.is_file() => {}
+                _ => continue,
             }
-            let stale = entry.path();
             fs::remove_file(&stale).map_err(|source| RenderError::Io {
                 path: stale.clone(),
                 action: "remove the stale frame",
                 source,
             })?;
         }
-        Ok(())
+        let mut list = String::from(FRAME_LIST_HEADER);
+        list.push('\n');
+        for index in 0..self.frames {
+            list.push_str(&self.frame_name(index));
+            list.push('\n');
+        }
+        crate::write_atomic(&self.dir.join(FRAME_LIST), list.as_bytes())
     }
+}
+
+/// The hidden file in a PNG sequence's directory that lists the frames the writer
+/// put there, one name a line after [`FRAME_LIST_HEADER`].
+const FRAME_LIST: &str = ".c2warp-frames";
+/// The first line of [`FRAME_LIST`].
+const FRAME_LIST_HEADER: &str = "# frames c2warp wrote here; a later sequence replaces them";
+
+/// The frame names `dir`'s [`FRAME_LIST`] holds (none when there is no list, or it
+/// is not one).
+fn read_frame_list(dir: &Path) -> Vec<String> {
+    let Ok(text) = fs::read_to_string(dir.join(FRAME_LIST)) else {
+        return Vec::new();
+    };
+    let mut lines = text.lines();
+    if lines.next() != Some(FRAME_LIST_HEADER) {
+        return Vec::new();
+    }
+    lines
+        .filter(|name| is_frame_name(name))
+        .map(str::to_owned)
+        .collect()
+}
+
+/// Refuses a directory holding a frame file (`frame_<digits>.png`) that is not in
+/// `earlier`, the writer's own list: it would be replaced, or left among the new
+/// frames.
+fn refuse_other_frames(dir: &Path, earlier: &[String]) -> Result<(), RenderError> {
+    let list_error = |source| RenderError::Io {
+        path: dir.to_owned(),
+        action: "list",
+        source,
+    };
+    let earlier: HashSet<&str> = earlier.iter().map(String::as_str).collect();
+    let mut others: Vec<String> = Vec::new();
+    for entry in fs::read_dir(dir).map_err(list_error)? {
+        let name = entry.map_err(list_error)?.file_name();
+        if let Some(name) = name.to_str()
+            && is_frame_name(name)
+            && !earlier.contains(name)
+        {
+            others.push(name.to_owned());
+        }
+    }
+    others.sort();
+    let Some(first) = others.first() else {
+        return Ok(());
+    };
+    let more = match others.len() {
+        1 => String::new(),
+        n => format!(" and {} more", n - 1),
+    };
+    Err(animation_error(
+        dir,
+        format!(
+            "the folder holds {first}{more}, which no earlier animation of this program \
+             wrote there; choose an empty folder, or move those frames away"
+        ),
+    ))
 }
 
 /// Creates the directory `dir` (not its parents); true when done.
@@ -910,9 +979,7 @@ fn create_dir(dir: &Path) -> Result<bool, RenderError> {
 
 impl FrameSink for SequenceSink {
     fn push(&mut self, index: usize, frame: &Picture) -> Result<(), RenderError> {
-        let path = self
-            .dir
-            .join(format!("frame_{index:0width$}.png", width = self.digits));
+        let path = self.dir.join(self.frame_name(index));
         let (replacement, mut file) = Replacement::begin(&path)?;
         write_png(&mut file, frame, &path)?;
         replacement.seal(file)?;
@@ -925,7 +992,7 @@ impl FrameSink for SequenceSink {
             frame.publish()?;
         }
         self.finished = true;
-        self.remove_stale()
+        self.replace_frame_list()
     }
 }
 

@@ -5,6 +5,7 @@ use std::fs::{self, File, OpenOptions};
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Mutex, MutexGuard, PoisonError};
 
 use image::codecs::png::PngEncoder;
 use image::{ExtendedColorType, ImageEncoder, ImageError, RgbaImage};
@@ -15,7 +16,7 @@ use crate::{Picture, RenderError, Rgba16Image};
 /// the complete new one, never a partial write.
 ///
 /// The data goes to a uniquely named temporary file in the same directory
-/// (`.<name>.<pid>-<n>.tmp`), which is flushed to disk and then renamed over
+/// (`.<name>.c2warp-<pid>-<n>.tmp`), which is flushed to disk and then renamed over
 /// `path`. An existing target keeps its permissions. On any error the
 /// temporary file is removed and an existing `path` is left untouched.
 ///
@@ -155,29 +156,113 @@ struct TempFile {
 
 impl Drop for TempFile {
     fn drop(&mut self) {
+        let mut live = live_temporaries();
         if !self.renamed {
             // Best effort: the original error is the one worth reporting.
             let _ = fs::remove_file(&self.path);
         }
+        if let Some(i) = live.iter().position(|p| *p == self.path) {
+            live.swap_remove(i);
+        }
     }
 }
 
-/// Creates a new, uniquely named file in `dir` for replacing `target`.
+/// What marks a temporary file as this program's: `.<name>.c2warp-<pid>-<n>.tmp`.
+const TEMP_MARK: &str = ".c2warp-";
+
+/// The temporary files this process has open now, to be removed if it is
+/// interrupted ([`remove_temporary_files`]). Files are created and forgotten under
+/// this lock.
+fn live_temporaries() -> MutexGuard<'static, Vec<PathBuf>> {
+    static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+    LIVE.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// Removes every temporary file of an atomic write in progress in this process
+/// (see [`write_atomic`]) and keeps any other from being created: for a signal
+/// handler that is about to end the process (Ctrl-C, `SIGTERM`), so that an
+/// interrupted run leaves no temporary file behind and every target as it was.
+///
+/// A write that starts after this call waits forever: call it only on the way out.
+pub fn remove_temporary_files() {
+    let mut live = live_temporaries();
+    for path in live.drain(..) {
+        let _ = fs::remove_file(path);
+    }
+    // Hold the lock until the process ends: no new temporary file can appear.
+    std::mem::forget(live);
+}
+
+/// Removes, once per directory and process, temporary files of this program that a
+/// run which no longer exists left in `dir` (killed before it could clean up).
+/// Only names of the form `.<name>.c2warp-<pid>-<n>.tmp` whose process is gone are
+/// removed (Linux: no `/proc/<pid>`; elsewhere nothing is removed).
+fn remove_stale_temporaries(dir: &Path, live: &[PathBuf]) {
+    static SWEPT: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+    let mut swept = SWEPT.lock().unwrap_or_else(PoisonError::into_inner);
+    if swept.iter().any(|d| d == dir) {
+        return;
+    }
+    swept.push(dir.to_owned());
+    let Ok(entries) = fs::read_dir(dir) else {
+        return;
+    };
+    let own = std::process::id();
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(pid) = name.to_str().and_then(temporary_owner) else {
+            continue;
+        };
+        let path = entry.path();
+        let gone = if pid == own {
+            !live.contains(&path)
+        } else {
+            !process_exists(pid)
+        };
+        if gone && entry.file_type().is_ok_and(|kind| kind.is_file()) {
+            let _ = fs::remove_file(&path);
+        }
+    }
+}
+
+/// The process that made the temporary file `name`, if it is one of this program's.
+fn temporary_owner(name: &str) -> Option<u32> {
+    let rest = name.strip_prefix('.')?.strip_suffix(".tmp")?;
+    let (_, tail) = rest.rsplit_once(TEMP_MARK)?;
+    let (pid, n) = tail.split_once('-')?;
+    n.parse::<u64>().ok()?;
+    pid.parse().ok()
+}
+
+/// Whether process `pid` is running (always true where that cannot be told).
+fn process_exists(pid: u32) -> bool {
+    if cfg!(target_os = "linux") {
+        Path::new("/proc").join(pid.to_string()).exists()
+    } else {
+        true
+    }
+}
+
+/// Creates a new, uniquely named file in `dir` for replacing `target`, after
+/// removing temporary files that earlier runs left there.
 fn create_temp(dir: &Path, target: &Path, name: &str) -> Result<(TempFile, File), RenderError> {
     static COUNTER: AtomicU64 = AtomicU64::new(0);
     // Keep the name well below the usual 255-byte limit.
     let stem: String = name.chars().take(100).collect();
     let pid = std::process::id();
     let mut last_error = None;
+    let mut live = live_temporaries();
+    remove_stale_temporaries(dir, &live);
     for _ in 0..64 {
         let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-        let candidate = dir.join(format!(".{stem}.{pid}-{n}.tmp"));
+        let candidate = dir.join(format!(".{stem}{TEMP_MARK}{pid}-{n}.tmp"));
         match OpenOptions::new()
             .write(true)
             .create_new(true)
             .open(&candidate)
         {
             Ok(file) => {
+                live.push(candidate.clone());
                 return Ok((
                     TempFile {
                         path: candidate,

@@ -53,6 +53,26 @@ pub enum RenderError {
         dir: PathBuf,
     },
 
+    /// An output that would replace one of the command's inputs (see
+    /// [`refuse_input_as_output`](crate::refuse_input_as_output)).
+    #[error(
+        "will not write {}: {}; choose another output",
+        output.display(),
+        if *folder {
+            format!("the frames would replace {}, one of the inputs", input.display())
+        } else {
+            format!("it is {}, one of the inputs", input.display())
+        }
+    )]
+    OutputIsInput {
+        /// The output asked for.
+        output: PathBuf,
+        /// The input it would replace, as given.
+        input: PathBuf,
+        /// Whether the output is a folder of frames holding the input.
+        folder: bool,
+    },
+
     /// The path names no file (empty, `/`, or ending in `..`).
     #[error("{}: not a file path", path.display())]
     InvalidPath {

@@ -160,6 +160,90 @@ pub(crate) fn human_bytes(n: u64) -> String {
     }
 }
 
+/// Whether `a` and `b` name the same existing file: the same device and inode on Unix
+/// (so symbolic links, hard links and `..` are seen through), the same canonical path
+/// elsewhere. A path that does not exist is no file at all.
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    let (Ok(ma), Ok(mb)) = (fs::metadata(a), fs::metadata(b)) else {
+        return false;
+    };
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        ma.dev() == mb.dev() && ma.ino() == mb.ino()
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = (ma, mb);
+        matches!((fs::canonicalize(a), fs::canonicalize(b)), (Ok(x), Ok(y)) if x == y)
+    }
+}
+
+/// Whether `name` is one a PNG sequence's frame could have: `frame_`, 5 digits or
+/// more, `.png`.
+pub(crate) fn is_frame_name(name: &str) -> bool {
+    name.strip_prefix("frame_")
+        .and_then(|rest| rest.strip_suffix(".png"))
+        .is_some_and(|digits| digits.len() >= 5 && digits.bytes().all(|b| b.is_ascii_digit()))
+}
+
+/// Refuses to write `output` when that would replace one of `inputs`: when it is the
+/// same file as an input ([`same_file`]: through links and `..`), or, for a directory
+/// (a PNG sequence's), when an input is a frame file (`frame_<5+ digits>.png`) in it. An
+/// output that does not exist yet, or `-` (standard output), replaces nothing.
+///
+/// Commands call it before any work, so that no run ever writes over what it reads.
+///
+/// # Errors
+/// [`RenderError::OutputIsInput`] naming the output and the input.
+///
+/// # Example
+/// ```
+/// # let dir = tempfile::tempdir()?;
+/// let picture = dir.path().join("cat.png");
+/// std::fs::write(&picture, b"...")?;
+/// let through_dots = dir.path().join("sub/../cat.png");
+/// std::fs::create_dir(dir.path().join("sub"))?;
+/// assert!(render::refuse_input_as_output(&through_dots, &[&picture]).is_err());
+/// assert!(render::refuse_input_as_output(&dir.path().join("out.png"), &[&picture]).is_ok());
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn refuse_input_as_output(output: &Path, inputs: &[&Path]) -> Result<(), RenderError> {
+    if output.as_os_str() == "-" {
+        return Ok(());
+    }
+    let is_dir = fs::metadata(output).is_ok_and(|meta| meta.is_dir());
+    for &input in inputs {
+        let clash = if is_dir {
+            let in_it = input
+                .parent()
+                .map(|p| {
+                    if p.as_os_str().is_empty() {
+                        Path::new(".")
+                    } else {
+                        p
+                    }
+                })
+                .is_some_and(|parent| same_file(parent, output));
+            in_it
+                && input
+                    .file_name()
+                    .and_then(|n| n.to_str())
+                    .is_some_and(is_frame_name)
+        } else {
+            same_file(output, input)
+        };
+        if clash {
+            return Err(RenderError::OutputIsInput {
+                output: output.to_owned(),
+                input: input.to_owned(),
+                folder: is_dir,
+            });
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -27,6 +27,7 @@
 
 #![warn(missing_docs)]
 
+mod alpha;
 mod animated;
 mod atomic;
 mod composite;
@@ -42,11 +43,12 @@ mod sample;
 mod view;
 mod warp;
 
+pub use alpha::AlphaReader;
 pub use animated::{AnimationFormat, AnimationWriter};
-pub use atomic::{PngPixels, save_png_atomic, write_atomic, write_png};
+pub use atomic::{PngPixels, remove_temporary_files, save_png_atomic, write_atomic, write_png};
 pub use composite::{over, over16};
 pub use error::RenderError;
-pub use files::{open_regular_file, read_regular_file};
+pub use files::{open_regular_file, read_regular_file, refuse_input_as_output, same_file};
 pub use gpu::{Affine, GpuContext, SkinnedMesh};
 pub use image_io::{ImageLimits, decode_image, decode_picture, load_image, load_picture};
 pub use mesh::WarpMesh;

@@ -320,12 +320,14 @@ fn png_sequence_round_trip_replaces_a_longer_one() {
     let dir = tempfile::tempdir().expect("tempdir");
     let frames_dir = dir.path().join("frames");
     fs::create_dir(&frames_dir).expect("mkdir");
-    // An earlier, longer sequence, and files that are not frames.
+    // An earlier, longer sequence of the writer's, and files that are not frames.
     let old = Picture::from(random_image(3, 3, 99));
-    for i in 0..5 {
-        save_png_atomic(&frames_dir.join(format!("frame_{i:05}.png")), &old).expect("old");
+    let format = AnimationFormat::PngSequence;
+    let mut writer = AnimationWriter::create(&frames_dir, format, 3, 3, 5, FPS).expect("old");
+    for _ in 0..5 {
+        writer.push(&old).expect("old frame");
     }
-    save_png_atomic(&frames_dir.join("frame_000007.png"), &old).expect("old");
+    writer.finish().expect("old sequence");
     fs::write(frames_dir.join("frame_1.png"), b"mine").expect("other");
     fs::write(frames_dir.join("notes.txt"), b"mine").expect("other");
 
@@ -345,7 +347,7 @@ fn png_sequence_round_trip_replaces_a_longer_one() {
     let before = listing(&frames_dir);
     assert_eq!(
         before.iter().filter(|n| !n.starts_with('.')).count(),
-        8,
+        7,
         "{before:?}"
     );
     assert_eq!(
@@ -357,6 +359,7 @@ fn png_sequence_round_trip_replaces_a_longer_one() {
     assert_eq!(
         listing(&frames_dir),
         [
+            ".c2warp-frames",
             "frame_00000.png",
             "frame_00001.png",
             "frame_00002.png",
@@ -380,6 +383,29 @@ fn png_sequence_round_trip_replaces_a_longer_one() {
 }
 
 #[test]
+fn png_sequence_never_replaces_or_removes_frames_it_did_not_write() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let frames_dir = dir.path().join("frames");
+    fs::create_dir(&frames_dir).expect("mkdir");
+    // Someone else's frames: one the new sequence would replace, one it would leave.
+    fs::write(frames_dir.join("frame_00000.png"), b"theirs").expect("theirs");
+    fs::write(frames_dir.join("frame_00030.png"), b"theirs").expect("theirs");
+    let error = AnimationWriter::create(&frames_dir, AnimationFormat::PngSequence, 4, 4, 3, FPS)
+        .err()
+        .expect("a folder of other frames is refused");
+    let message = error.to_string();
+    assert!(
+        message.contains("frame_00000.png and 1 more") && message.contains("empty folder"),
+        "{message}"
+    );
+    assert_eq!(listing(&frames_dir), ["frame_00000.png", "frame_00030.png"]);
+    assert_eq!(
+        fs::read(frames_dir.join("frame_00030.png")).expect("kept"),
+        b"theirs"
+    );
+}
+
+#[test]
 fn png_sequence_directory_is_created_and_removed_if_abandoned() {
     let dir = tempfile::tempdir().expect("tempdir");
     let frames_dir = dir.path().join("new");
@@ -393,7 +419,8 @@ fn png_sequence_directory_is_created_and_removed_if_abandoned() {
     assert!(listing(dir.path()).is_empty());
 
     write(&frames_dir, AnimationFormat::PngSequence, &frames).expect("write");
-    assert_eq!(listing(&frames_dir).len(), 3);
+    // Three frames and the list of them.
+    assert_eq!(listing(&frames_dir).len(), 4);
 
     let orphan = dir.path().join("no").join("such");
     let error = AnimationWriter::create(&orphan, AnimationFormat::PngSequence, 4, 4, 3, FPS)
@@ -409,9 +436,12 @@ fn png_sequence_directory_is_created_and_removed_if_abandoned() {
 fn an_unfinished_sequence_leaves_the_old_one() {
     let dir = tempfile::tempdir().expect("tempdir");
     let old = Picture::from(random_image(4, 4, 7));
-    for i in 0..3 {
-        save_png_atomic(&dir.path().join(format!("frame_{i:05}.png")), &old).expect("old");
-    }
+    write(
+        dir.path(),
+        AnimationFormat::PngSequence,
+        &[old.clone(), old.clone(), old],
+    )
+    .expect("old");
     let before: Vec<Vec<u8>> = listing(dir.path())
         .iter()
         .map(|name| fs::read(dir.path().join(name)).expect("read"))
@@ -428,7 +458,7 @@ fn an_unfinished_sequence_leaves_the_old_one() {
         .iter()
         .map(|name| fs::read(dir.path().join(name)).expect("read"))
         .collect();
-    assert_eq!(listing(dir.path()).len(), 3);
+    assert_eq!(listing(dir.path()).len(), 4);
     assert_eq!(after, before);
 }
 

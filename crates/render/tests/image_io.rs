@@ -654,3 +654,76 @@ impl FifoLike for fs::FileType {
         std::os::unix::fs::FileTypeExt::is_fifo(self)
     }
 }
+
+#[test]
+fn an_output_that_is_an_input_is_refused_through_links_and_dots() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let picture = dir.path().join("cat.png");
+    fs::write(&picture, b"picture").expect("write");
+    fs::create_dir(dir.path().join("sub")).expect("mkdir");
+    let refused = |output: &Path| {
+        let err = render::refuse_input_as_output(output, &[Path::new("rig.json"), &picture])
+            .expect_err("the output is the picture");
+        assert!(matches!(err, RenderError::OutputIsInput { .. }), "{err}");
+        let message = err.to_string();
+        assert!(
+            message.contains("cat.png, one of the inputs") && !message.contains('\n'),
+            "{message}"
+        );
+    };
+    refused(&picture);
+    refused(&dir.path().join("sub/../cat.png"));
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink(&picture, dir.path().join("link.png")).expect("symlink");
+        refused(&dir.path().join("link.png"));
+        fs::hard_link(&picture, dir.path().join("hard.png")).expect("hard link");
+        refused(&dir.path().join("hard.png"));
+    }
+    // Other outputs, a new file and standard output replace nothing.
+    for fine in ["other.png", "-", "sub"] {
+        let output = if fine == "-" {
+            Path::new("-").to_path_buf()
+        } else {
+            dir.path().join(fine)
+        };
+        render::refuse_input_as_output(&output, &[&picture]).expect("not an input");
+    }
+    // A folder of frames refuses an input that is one of its frames.
+    let frame = dir.path().join("sub/frame_00000.png");
+    fs::write(&frame, b"frame").expect("write");
+    let err = render::refuse_input_as_output(&dir.path().join("sub/"), &[&frame])
+        .expect_err("the frames would replace their input");
+    assert!(err.to_string().contains("frames would replace"), "{err}");
+    assert_eq!(fs::read(&picture).expect("kept"), b"picture");
+}
+
+#[test]
+fn temporary_files_of_dead_runs_are_removed_by_the_next_write_there() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    // A run that was killed (no such process: above Linux's largest pid), one that is
+    // still running (this test), and files that are not this program's.
+    let dead = ".old.png.c2warp-4294967-0.tmp";
+    let running = format!(".old.png.c2warp-{}-999.tmp", std::process::id());
+    let alive_pid = String::from(".old.png.c2warp-1-0.tmp");
+    let theirs = [
+        ".old.png.1234-0.tmp",
+        "notes.c2warp-1-0.tmp",
+        ".x.c2warp-9-y.tmp",
+    ];
+    for name in [dead, &running, &alive_pid].into_iter().chain(theirs) {
+        fs::write(dir.path().join(name), b"partial").expect("write");
+    }
+    write_atomic(&dir.path().join("new.json"), b"{}").expect("write");
+    let mut left = leftovers(dir.path(), &["new.json"]);
+    left.sort();
+    let mut expected: Vec<String> = theirs.iter().map(|s| (*s).to_owned()).collect();
+    if cfg!(target_os = "linux") {
+        // pid 1 is running; this process's own leftover is not one of its live files.
+        expected.push(alive_pid);
+    } else {
+        expected.extend([dead.to_owned(), running, alive_pid]);
+    }
+    expected.sort();
+    assert_eq!(left, expected);
+}

@@ -161,6 +161,10 @@ impl EditorApp {
             AnimationFormat::PngSequence => path.with_extension(""),
             _ => path,
         };
+        if let Err(e) = self.refuse_sources(&output) {
+            return self.error(&e);
+        }
+        let Some(doc) = &self.doc else { return };
         let image = doc.image.clone();
         let picture = doc
             .deep

@@ -102,6 +102,11 @@ impl EditorApp {
     /// Writes the project to `path` atomically (a failure leaves any old file intact).
     pub fn save_to(&mut self, path: &Path) {
         let Some(doc) = &mut self.doc else { return };
+        // Saving over the project itself is what Save does; over the picture, never.
+        let picture: Vec<&Path> = doc.image_path.as_deref().into_iter().collect();
+        if let Err(e) = render::refuse_input_as_output(path, &picture) {
+            return self.error(&anyhow::Error::from(e));
+        }
         let project = doc.project_for_saving(Some(path));
         match render::write_atomic(path, project.to_json().as_bytes()) {
             Ok(()) => {
@@ -139,10 +144,14 @@ impl EditorApp {
     /// The export of the current document to `path`, ready to run anywhere; it writes
     /// nothing once `cancel` is set.
     pub(super) fn export_work(
-        &self,
+        &mut self,
         path: PathBuf,
         cancel: CancelFlag,
     ) -> Option<impl FnOnce() -> Outcome + Send + 'static> {
+        if let Err(e) = self.refuse_sources(&path) {
+            self.error(&e);
+            return None;
+        }
         let doc = self.doc.as_ref()?;
         let project = doc.project_for_saving(None);
         let image = doc.image.clone();
@@ -170,6 +179,18 @@ impl EditorApp {
                 ms: clock.elapsed().as_secs_f64() * 1e3,
             }
         })
+    }
+
+    /// Refuses an export to `path` that would replace the document's picture or its
+    /// project file (through links and `..` too).
+    pub(super) fn refuse_sources(&self, path: &Path) -> Result<()> {
+        let Some(doc) = &self.doc else { return Ok(()) };
+        let sources: Vec<&Path> = [doc.image_path.as_deref(), doc.project_path.as_deref()]
+            .into_iter()
+            .flatten()
+            .collect();
+        render::refuse_input_as_output(path, &sources)?;
+        Ok(())
     }
 
     pub(super) fn suggested_name(&self, extension: &str) -> String {
