@@ -365,6 +365,21 @@ pub fn prepare_with_progress(
         mesh.mesh.triangles,
         metric(project.metric, mesh.is_convex),
     )?;
+    // A saved virtual handle sits on a vertex of this mesh; one off the shape was not
+    // saved from it, and is refused as a handle off the shape is.
+    if let Some((i, p)) = project
+        .virtual_handles
+        .iter()
+        .enumerate()
+        .find(|(_, p)| domain.locate(DVec2::from(**p)).is_none())
+    {
+        bail!(
+            "virtual handle {i} at ({}, {}) lies outside the shape; leave out \
+             \"virtual_handles\" to have them placed afresh",
+            p[0],
+            p[1]
+        );
+    }
     let virtual_handles: Vec<VirtualHandle> = project
         .virtual_handles
         .iter()
@@ -881,6 +896,26 @@ mod tests {
         );
         // Refused before meshing: the build itself would take minutes.
         assert!(clock.elapsed().as_secs_f64() < 10.0);
+    }
+
+    #[test]
+    fn a_virtual_handle_off_the_shape_is_refused_as_a_handle_off_it_is() {
+        let image = image::RgbaImage::from_fn(60, 40, |x, _| {
+            image::Rgba([90, 90, 90, if x < 30 { 255 } else { 0 }])
+        });
+        let mut project = Project::from_json(
+            r#"{"version":1,"density":400,"handles":[{"type":"point","rest":[10,20]}]}"#,
+        )
+        .expect("a rig");
+        for off in [[-500.0, -500.0], [50.0, 20.0]] {
+            project.virtual_handles = vec![[20.0, 20.0], off];
+            let error = prepare(&image, &project, None).err().expect("refused");
+            let line = error_line(&error);
+            assert!(
+                line.contains("virtual handle 1 at") && line.contains("outside the shape"),
+                "{line}"
+            );
+        }
     }
 
     #[test]
