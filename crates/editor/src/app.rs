@@ -58,6 +58,11 @@ pub struct EditorApp {
     pub(crate) needs_fit: bool,
     /// The view is as the last fit left it (no pan or zoom since).
     pub(crate) view_fitted: bool,
+    /// The window's size last frame: a change of it (a resize) is told apart from the
+    /// panels around the canvas changing.
+    pub(crate) window_size: Option<egui::Vec2>,
+    /// Frames left in which a fresh fit follows the panels' first layout.
+    pub(crate) fit_settling: u8,
     /// The active tool.
     pub tool: Tool,
     /// The selected handle.
@@ -182,6 +187,8 @@ impl EditorApp {
             viewport: Viewport::default(),
             needs_fit: true,
             view_fitted: false,
+            window_size: None,
+            fit_settling: 0,
             tool: Tool::Puppet,
             selected: None,
             handles: HandleTool::default(),

@@ -11,27 +11,16 @@ use crate::app::{EditorApp, Tool};
 use crate::scene::MeshCallback;
 use crate::tool::CanvasTool;
 
+/// Frames after a requested fit during which the fit follows the panels being laid
+/// out around the canvas.
+const FIT_SETTLING_FRAMES: u8 = 4;
+
 impl EditorApp {
     /// Lays out the canvas in the remaining space, handles its input, and paints it.
     pub(crate) fn canvas_ui(&mut self, ui: &mut Ui) {
         let (rect, response) = ui.allocate_exact_size(ui.available_size(), Sense::click_and_drag());
         response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "Canvas"));
-        let resized = self.viewport.canvas.size() != rect.size();
-        self.viewport.canvas = rect;
-        // A fitted view stays fitted when the window changes size (the first frames of
-        // a new window, a maximise), until the user pans or zooms.
-        // Not in the middle of a drag: the picture would move under the pointer.
-        if (self.needs_fit
-            || (resized
-                && self.view_fitted
-                && !self.handles.dragging()
-                && !self.perform.dragging()))
-            && let Some(doc) = &self.doc
-        {
-            self.viewport.fit([doc.image.width(), doc.image.height()]);
-            self.needs_fit = false;
-            self.view_fitted = true;
-        }
+        self.place_canvas(rect, ui.ctx().content_rect().size());
         if !self.is_busy() {
             self.canvas_input(ui, &response);
         }
@@ -154,6 +143,44 @@ impl EditorApp {
             );
         } else if !self.is_busy() {
             self.hover_weights(ui, &response);
+        }
+    }
+
+    /// Takes the canvas's rectangle for this frame, keeping the picture where the hand
+    /// expects it: when the window changes size, a fitted view is fitted again (its
+    /// centre stays the centre) and any other keeps the image point under the canvas's
+    /// centre; when only the panels around the canvas change (the window as it was),
+    /// nothing moves on screen. Nothing moves during a drag either.
+    fn place_canvas(&mut self, rect: egui::Rect, window: egui::Vec2) {
+        let old = self.viewport.canvas;
+        let window_resized = self.window_size.is_some_and(|w| w != window);
+        self.window_size = Some(window);
+        self.viewport.canvas = rect;
+        // The first frames after a fit lay the panels out: the fit follows them.
+        let settling = self.fit_settling > 0;
+        self.fit_settling = self.fit_settling.saturating_sub(1);
+        if old.size() == rect.size() && old.min == rect.min && !self.needs_fit {
+            return;
+        }
+        let dragging = self.handles.dragging() || self.perform.dragging();
+        let refit = (window_resized || settling) && self.view_fitted && !dragging;
+        if self.needs_fit || refit {
+            if let Some(doc) = &self.doc {
+                self.viewport.fit([doc.image.width(), doc.image.height()]);
+                if self.needs_fit {
+                    self.fit_settling = FIT_SETTLING_FRAMES;
+                }
+                self.needs_fit = false;
+                self.view_fitted = true;
+            }
+            return;
+        }
+        if window_resized && !dragging {
+            // The image point under the old centre goes under the new one.
+            self.viewport.origin += (rect.size() - old.size()) * 0.5;
+        } else {
+            // The same screen position for every image point.
+            self.viewport.origin -= rect.min - old.min;
         }
     }
 

@@ -552,3 +552,49 @@ fn no_save_or_export_replaces_the_picture_or_the_project() {
     h.state_mut().save_to(&project);
     assert!(!h.state().message.clone().expect("a message").is_error);
 }
+
+#[test]
+fn the_canvas_never_moves_under_the_hand() {
+    // 1024 points wide: the narrowest window the layout is made for.
+    let mut h = editor_with(Box::new(NoDesktop), false);
+    h.set_size(Vec2::new(1024.0, 720.0));
+    h.run();
+    let place = |h: &Harness<'_, EditorApp>| {
+        let v = h.state().viewport;
+        (v.canvas, v.to_screen(DVec2::new(300.0, 300.0)))
+    };
+    let (canvas, point) = place(&h);
+    // The time shown grows from 0 to hours, frames to five digits, the rate to three
+    // decimals, keys appear: no panel changes size, nothing moves.
+    h.state_mut().set_key();
+    for time in [0.75, 10.0, 133.25, 3599.9] {
+        h.state_mut().set_time(time);
+        h.run();
+        assert_eq!(place(&h), (canvas, point), "at {time} s");
+    }
+    h.state_mut().set_fps(23.976);
+    h.state_mut().set_key();
+    h.run();
+    assert_eq!(place(&h), (canvas, point), "a rate of 23.976");
+    // A window resize keeps the image point under the canvas's centre there (a view
+    // the user panned, so not fitted).
+    let corner = h.state().viewport.canvas.max - Vec2::new(10.0, 10.0);
+    support::drag(
+        &mut h,
+        corner,
+        corner - Vec2::new(30.0, 12.0),
+        Modifiers::NONE,
+    );
+    let centre = |h: &Harness<'_, EditorApp>| {
+        let v = h.state().viewport;
+        v.to_image(v.canvas.center())
+    };
+    let under = centre(&h);
+    h.set_size(Vec2::new(1300.0, 900.0));
+    h.run();
+    assert!(
+        centre(&h).distance(under) < 0.5,
+        "{under} -> {}",
+        centre(&h)
+    );
+}

@@ -85,12 +85,12 @@ fn an_editing_session() {
     h.run();
     assert_eq!(translate(&handles(&h)[0]), moved, "redo");
 
-    // Alt-drag rotates.
+    // Alt-drag rotates (near the centre, by as much as the drag is long).
     let now = at(&h, 470.0, 200.0);
     drag(
         &mut h,
         now + Vec2::new(4.0, 0.0),
-        now + Vec2::new(0.0, 4.0),
+        now + Vec2::new(0.0, 16.0),
         Modifiers::ALT,
     );
     match handles(&h)[0] {
@@ -390,6 +390,71 @@ fn alt_drag_turns_a_pin_from_its_centre_or_anywhere_on_its_ring() {
         Modifiers::NONE,
     );
     assert_ne!(h.state().viewport.origin, origin);
+}
+
+#[test]
+fn scaling_and_turning_change_by_the_length_of_the_drag_and_never_pan() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    click_label(&mut h, "Clear all handles");
+    click_label(&mut h, "Add point");
+    let pin = at(&h, 440.0, 238.0);
+    click_at(&mut h, pin);
+    click_label(&mut h, "Select");
+    h.state_mut().selected = None;
+    let pose = |h: &Harness<'_, EditorApp>| match handles(h)[0] {
+        HandleSpec::Point { rotate, scale, .. } => (rotate, scale),
+        HandleSpec::Bar { .. } => unreachable!(),
+    };
+    let origin = h.state().viewport.origin;
+    // Shift-drag 20 points out from the centre: a little larger (2^(20/100) at most),
+    // not twenty times.
+    drag(&mut h, pin, pin + Vec2::new(20.0, 0.0), Modifiers::SHIFT);
+    let (_, scale) = pose(&h);
+    assert!(scale > 1.0 && scale < 1.2, "{scale}");
+    // From 6 points off the centre, the same: bounded by the drag's length.
+    drag(
+        &mut h,
+        pin + Vec2::new(6.0, 0.0),
+        pin + Vec2::new(26.0, 0.0),
+        Modifiers::SHIFT,
+    );
+    let (_, twice) = pose(&h);
+    assert!(
+        twice / scale > 1.1 && twice / scale < 1.16,
+        "{scale} -> {twice}"
+    );
+    // Back towards the centre shrinks it.
+    drag(
+        &mut h,
+        pin + Vec2::new(20.0, 0.0),
+        pin + Vec2::new(8.0, 0.0),
+        Modifiers::SHIFT,
+    );
+    assert!(pose(&h).1 < twice, "{:?}", pose(&h));
+    // A short turn near the centre is a small one (6 points out, 5 across).
+    let (before, _) = pose(&h);
+    drag(
+        &mut h,
+        pin + Vec2::new(6.0, 0.0),
+        pin + Vec2::new(6.0, 5.0),
+        Modifiers::ALT,
+    );
+    let turned = pose(&h).0 - before;
+    assert!(turned > 0.1 && turned < 0.45, "{turned}");
+    // A Shift-drag from the ring of a handle that is not selected scales that handle
+    // and does not pan the view.
+    h.state_mut().selected = None;
+    h.run();
+    let scale = pose(&h).1;
+    drag(
+        &mut h,
+        pin + Vec2::new(0.0, 26.0),
+        pin + Vec2::new(0.0, 46.0),
+        Modifiers::SHIFT,
+    );
+    assert_eq!(h.state().viewport.origin, origin, "the view did not pan");
+    assert!(pose(&h).1 > scale * 1.1, "{scale} -> {:?}", pose(&h));
 }
 
 #[test]

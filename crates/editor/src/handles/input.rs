@@ -11,8 +11,16 @@ use crate::tool::{Host, Tool};
 
 /// How close the pointer must be to grab a handle, screen points.
 pub(super) const GRAB: f32 = 9.0;
-/// Radius of the rotation ring around the selected point handle, screen points.
+/// Radius of the rotation ring around a point handle (shown on the selected one and
+/// the one under the pointer), screen points.
 pub(super) const RING: f32 = 26.0;
+/// The shortest lever a turn or a scale is measured with, screen points: a drag that
+/// starts nearer a handle's centre turns and scales it as if it had started this far
+/// out (farther out, the turn follows the pointer around the centre).
+const LEVER: f32 = RING / 2.0;
+/// Screen points of drag, away from a handle's centre, that double its scale (towards
+/// it, halve it): scaling is exponential in the drag's length wherever it starts.
+const SCALE_DOUBLING: f64 = 100.0;
 
 impl HandleTool {
     /// This frame's pointer input (see [`crate::tool::CanvasTool::input`]).
@@ -162,12 +170,15 @@ impl HandleTool {
         }
     }
 
-    /// The handle under `pos` (screen), and which grip.
-    fn hit(&self, host: &dyn Host, pos: Pos2) -> Option<(usize, Grip)> {
+    /// The handle under `pos` (screen), and which grip: a handle itself (a point's
+    /// dot, a bar's ends or body), else the rotation ring of a point handle (every
+    /// point handle's ring shows when the pointer is over it, so a drag from it turns
+    /// that handle, and never pans).
+    pub(super) fn hit(&self, host: &dyn Host, pos: Pos2) -> Option<(usize, Grip)> {
         let doc = host.document()?;
         let viewport = host.viewport();
-        let selected = host.selected();
         let mut best: Option<(f32, usize, Grip)> = None;
+        let mut ring: Option<(f32, usize)> = None;
         let mut consider = |d: f32, i: usize, grip: Grip| {
             if d < GRAB && best.is_none_or(|(bd, _, _)| d < bd) {
                 best = Some((d, i, grip));
@@ -179,8 +190,9 @@ impl HandleTool {
                 HandleSpec::Point { .. } => {
                     let d = a.distance(pos);
                     consider(d, i, Grip::Move);
-                    if selected == Some(i) {
-                        consider((d - RING).abs(), i, Grip::Rotate);
+                    let off = (d - RING).abs();
+                    if off < GRAB && ring.is_none_or(|(bd, _)| off < bd) {
+                        ring = Some((off, i));
                     }
                 }
                 HandleSpec::Bar { .. } => {
@@ -192,6 +204,7 @@ impl HandleTool {
             }
         }
         best.map(|(_, i, g)| (i, g))
+            .or(ring.map(|(_, i)| (i, Grip::Rotate)))
     }
 
     /// The point handle a drag from `pos` with Alt held turns: the nearest one whose
@@ -281,15 +294,18 @@ impl HandleTool {
         });
     }
 
-    /// Moves the dragged handle so the grabbed point follows the pointer.
+    /// Moves the dragged handle so the grabbed point follows the pointer; a turn or a
+    /// scale changes by an amount proportional to the drag, wherever it started.
     fn drag_to(&mut self, host: &mut dyn Host, pointer: DVec2) {
         let Some(drag) = &mut self.drag else { return };
         let [a, b] = posed(&drag.start);
         let centre = (a + b) * 0.5;
-        if drag.grip == Grip::Rotate {
-            // A turn started on the centre has no direction yet: it is measured from
-            // where the pointer first is a few screen points away.
-            let near = 4.0 / f64::from(host.viewport().zoom.max(1e-6));
+        // Image pixels a screen point.
+        let pixel = 1.0 / f64::from(host.viewport().zoom.max(1e-6));
+        if matches!(drag.grip, Grip::Rotate | Grip::Scale) {
+            // A turn or a scale started on the centre has no direction yet: it is
+            // measured from where the pointer first is a few screen points away.
+            let near = 4.0 * pixel;
             if (drag.pointer - centre).length() < near {
                 if (pointer - centre).length() >= near {
                     drag.pointer = pointer;
@@ -298,9 +314,16 @@ impl HandleTool {
             }
         }
         let delta = pointer - drag.pointer;
-        let turn = angle_between(drag.pointer - centre, pointer - centre);
-        let stretch = ((pointer - centre).length() / (drag.pointer - centre).length().max(1e-9))
-            .clamp(0.05, 20.0);
+        // The lever a turn and a scale are measured with: from the centre to where the
+        // drag started, at least LEVER long, so that a short drag near the centre makes
+        // a small change, not a half turn.
+        let outwards = (drag.pointer - centre).normalize_or(DVec2::X);
+        let lever = outwards
+            * (drag.pointer - centre)
+                .length()
+                .max(f64::from(LEVER) * pixel);
+        let turn = angle_between(lever, lever + delta);
+        let stretch = (std::f64::consts::LN_2 * delta.dot(outwards) / pixel / SCALE_DOUBLING).exp();
         let handle = match (drag.start.clone(), drag.grip) {
             (
                 HandleSpec::Point {
@@ -337,10 +360,14 @@ impl HandleTool {
                         let r = DVec2::from_angle(turn);
                         [centre + r.rotate(a - centre), centre + r.rotate(b - centre)]
                     }
-                    Grip::Scale => [
-                        centre + (a - centre) * stretch,
-                        centre + (b - centre) * stretch,
-                    ],
+                    Grip::Scale => {
+                        // No shorter than a hundredth of a pixel.
+                        let stretch = stretch.max(0.01 / (b - a).length().max(1e-9));
+                        [
+                            centre + (a - centre) * stretch,
+                            centre + (b - centre) * stretch,
+                        ]
+                    }
                 };
                 HandleSpec::Bar {
                     rest,

@@ -31,12 +31,18 @@ impl HandleTool {
     ) {
         let host: &dyn Host = host;
         let alt = painter.ctx().input(|i| i.modifiers.alt);
-        // Alt over a point handle shows the ring a drag turns it by.
+        // The ring a drag turns (or, with Shift, scales) a point handle by shows on the
+        // handle under the pointer (with Alt, anywhere inside its ring).
         let turning = match &self.drag {
-            Some(drag) if drag.grip == Grip::Rotate => Some(drag.index),
-            _ => pointer
-                .filter(|_| alt && self.drag.is_none())
-                .and_then(|p| self.rotation_target(host, p)),
+            Some(drag) if matches!(drag.grip, Grip::Rotate | Grip::Scale) => Some(drag.index),
+            Some(_) => None,
+            None => pointer.and_then(|p| {
+                if alt {
+                    self.rotation_target(host, p)
+                } else {
+                    self.hit(host, p).map(|(i, _)| i)
+                }
+            }),
         };
         paint_overlays(host, painter, turning);
         if let (Some(a), Some(b)) = (self.bar_start, pointer) {

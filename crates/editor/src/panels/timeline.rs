@@ -10,168 +10,195 @@ use crate::app::EditorApp;
 const KEY: Color32 = Color32::from_rgb(250, 210, 40);
 const HELD: Color32 = Color32::from_rgb(240, 140, 40);
 const PLAYHEAD: Color32 = Color32::from_rgb(235, 60, 50);
+/// Width of the time shown (" 133.25 s · frame  3198"), screen points: fixed, so
+/// nothing moves as the time grows.
+const TIME_WIDTH: f32 = 200.0;
+/// Width of the rate field, screen points.
+const FIELD_WIDTH: f32 = 62.0;
 
 impl EditorApp {
     /// The timeline panel.
     pub(super) fn timeline_ui(&mut self, ui: &mut Ui) {
         let fps = self.fps();
         let time = self.timeline.time;
-        let at_key = self.key_index_at(time);
         let keys = self.keys().len();
-        ui.horizontal_wrapped(|ui| {
-            if ui
-                .button("⏮")
-                .on_hover_text("First key (Shift + ,)")
-                .clicked()
-            {
-                let first = self.keys().first().map_or(0.0, |k| k.time);
-                self.timeline.playing = None;
-                self.set_time(first);
-            }
-            if ui.button("⏴").on_hover_text("Previous frame (,)").clicked() {
-                self.step_frames(-1);
-            }
-            let playing = self.timeline.is_playing();
-            let label = if playing { "⏸ Pause" } else { "▶ Play" };
-            if ui
-                .add_enabled(keys >= 2 || playing, egui::Button::new(label))
-                .on_hover_text("Play the keys at the project's rate (Space)")
-                .clicked()
-            {
-                self.toggle_play();
-            }
-            if ui.button("⏵").on_hover_text("Next frame (.)").clicked() {
-                self.step_frames(1);
-            }
-            if ui
-                .button("⏭")
-                .on_hover_text("Last key (Shift + .)")
-                .clicked()
-            {
-                let last = self.keys().last().map_or(0.0, |k| k.time);
-                self.timeline.playing = None;
-                self.set_time(last);
-            }
-            ui.checkbox(&mut self.timeline.looping, "Loop");
-            ui.label(format!(
-                "{time:.2} s · frame {}",
-                (time * fps).round() as i64
-            ));
-            ui.separator();
-            if ui
-                .button("Set key")
-                .on_hover_text(
-                    "Key the pose shown at this time (I). Once keys exist, a pose changed at \
-                     any time is keyed there",
-                )
-                .clicked()
-            {
-                self.set_key();
-            }
-            if ui
-                .add_enabled(at_key.is_some(), egui::Button::new("Delete key"))
-                .clicked()
-            {
-                self.delete_key();
-            }
-            // Looked up again: the button above may have deleted the key.
-            let at_key = self.key_index_at(time);
-            let mut hold = at_key
-                .and_then(|i| self.keys().get(i))
-                .is_some_and(|k| k.hold);
-            if ui
-                .add_enabled(at_key.is_some(), egui::Checkbox::new(&mut hold, "Hold"))
-                .on_hover_text("Keep this key's pose until the next key (no in-between)")
-                .changed()
-            {
-                self.set_hold(hold);
-            }
-            if ui
-                .button("Copy pose")
-                .on_hover_text("Copy the pose shown, to paste as a key at another time")
-                .clicked()
-            {
-                self.copy_pose();
-            }
-            if ui
-                .add_enabled(
-                    self.timeline.clipboard.is_some(),
-                    egui::Button::new("Paste key"),
-                )
-                .clicked()
-            {
-                self.paste_key();
-            }
-            ui.separator();
-            let current = self
-                .doc
-                .as_ref()
-                .and_then(|d| d.project().animation.as_ref())
-                .map_or(Interpolation::Linear, |a| a.interpolation);
-            let mut chosen = current;
-            egui::ComboBox::from_id_salt("interpolation")
-                .selected_text(current.label())
-                .show_ui(ui, |ui| {
-                    for i in Interpolation::ALL {
-                        ui.selectable_value(&mut chosen, i, i.label());
-                    }
-                })
-                .response
-                .on_hover_text(
-                    "Between keys: straight lines, or smooth curves that ease in and out",
-                );
-            if chosen != current {
-                self.set_interpolation(chosen);
-            }
-            let mut rate = fps;
-            let response = ui.add(
-                egui::DragValue::new(&mut rate)
-                    .range(1.0..=project::animation::MAX_FPS)
-                    .speed(0.2)
-                    .max_decimals(3)
-                    .suffix(" fps"),
-            );
-            // Typed, or at the end of a drag: one undo step.
-            if rate != fps
-                && ((response.changed() && !response.dragged()) || response.drag_stopped())
-            {
-                self.set_fps(rate);
-            }
-            ui.checkbox(&mut self.timeline.onion, "Onion skin")
-                .on_hover_text("Show the previous and next keys' pictures ghosted behind");
-            ui.separator();
-            let recording = self.timeline.is_recording();
-            let record = egui::Button::selectable(recording, "⏺ Record").fill(if recording {
-                Color32::from_rgb(150, 30, 30)
-            } else {
-                Color32::TRANSPARENT
+        // Two rows of fixed contents and widths that never wrap (a narrow window
+        // scrolls them sideways), so the panel's height, and with it the canvas, never
+        // changes with the values shown.
+        egui::ScrollArea::horizontal()
+            .id_salt("timeline rows")
+            .show(ui, |ui| {
+                ui.horizontal(|ui| self.transport_row(ui, time, fps, keys));
+                ui.horizontal(|ui| self.keys_row(ui, fps));
             });
-            if ui
-                .add(record)
-                .on_hover_text(
-                    "Record the next drag (a handle, cage vertices, or the control cursor of \
-                     Perform): every frame of it becomes the animation from this time",
-                )
-                .clicked()
-            {
-                self.toggle_record();
-            }
-            ui.checkbox(&mut self.timeline.keep_every_frame, "Every frame")
-                .on_hover_text(
-                    "Keep a key per recorded frame instead of the fewest keys that replay \
-                     the take within the tolerance",
-                );
-            ui.add_enabled(
-                !self.timeline.keep_every_frame,
+        self.strip(ui);
+    }
+
+    /// The timeline's first row: transport, the time shown, and the key at it.
+    fn transport_row(&mut self, ui: &mut Ui, time: f64, fps: f64, keys: usize) {
+        let at_key = self.key_index_at(time);
+        if ui
+            .button("⏮")
+            .on_hover_text("First key (Shift + ,)")
+            .clicked()
+        {
+            let first = self.keys().first().map_or(0.0, |k| k.time);
+            self.timeline.playing = None;
+            self.set_time(first);
+        }
+        if ui.button("⏴").on_hover_text("Previous frame (,)").clicked() {
+            self.step_frames(-1);
+        }
+        let playing = self.timeline.is_playing();
+        let label = if playing { "⏸ Pause" } else { "▶ Play" };
+        if ui
+            .add_enabled(keys >= 2 || playing, egui::Button::new(label))
+            .on_hover_text("Play the keys at the project's rate (Space)")
+            .clicked()
+        {
+            self.toggle_play();
+        }
+        if ui.button("⏵").on_hover_text("Next frame (.)").clicked() {
+            self.step_frames(1);
+        }
+        if ui
+            .button("⏭")
+            .on_hover_text("Last key (Shift + .)")
+            .clicked()
+        {
+            let last = self.keys().last().map_or(0.0, |k| k.time);
+            self.timeline.playing = None;
+            self.set_time(last);
+        }
+        ui.checkbox(&mut self.timeline.looping, "Loop");
+        let shown = egui::RichText::new(format!(
+            "{time:>8.2} s · frame {:>6}",
+            (time * fps).round() as i64
+        ))
+        .monospace();
+        ui.add_sized(
+            [TIME_WIDTH, ui.spacing().interact_size.y],
+            egui::Label::new(shown).truncate(),
+        );
+        ui.separator();
+        if ui
+            .button("Set key")
+            .on_hover_text(
+                "Key the pose shown at this time (I). Once keys exist, a pose changed at \
+                 any time is keyed there",
+            )
+            .clicked()
+        {
+            self.set_key();
+        }
+        if ui
+            .add_enabled(at_key.is_some(), egui::Button::new("Delete key"))
+            .clicked()
+        {
+            self.delete_key();
+        }
+        // Looked up again: the button above may have deleted the key.
+        let at_key = self.key_index_at(time);
+        let mut hold = at_key
+            .and_then(|i| self.keys().get(i))
+            .is_some_and(|k| k.hold);
+        if ui
+            .add_enabled(at_key.is_some(), egui::Checkbox::new(&mut hold, "Hold"))
+            .on_hover_text("Keep this key's pose until the next key (no in-between)")
+            .changed()
+        {
+            self.set_hold(hold);
+        }
+    }
+
+    /// The timeline's second row: the clipboard, interpolation, rate, onion skin and
+    /// recording.
+    fn keys_row(&mut self, ui: &mut Ui, fps: f64) {
+        if ui
+            .button("Copy pose")
+            .on_hover_text("Copy the pose shown, to paste as a key at another time")
+            .clicked()
+        {
+            self.copy_pose();
+        }
+        if ui
+            .add_enabled(
+                self.timeline.clipboard.is_some(),
+                egui::Button::new("Paste key"),
+            )
+            .clicked()
+        {
+            self.paste_key();
+        }
+        ui.separator();
+        let current = self
+            .doc
+            .as_ref()
+            .and_then(|d| d.project().animation.as_ref())
+            .map_or(Interpolation::Linear, |a| a.interpolation);
+        let mut chosen = current;
+        egui::ComboBox::from_id_salt("interpolation")
+            .width(70.0)
+            .selected_text(current.label())
+            .show_ui(ui, |ui| {
+                for i in Interpolation::ALL {
+                    ui.selectable_value(&mut chosen, i, i.label());
+                }
+            })
+            .response
+            .on_hover_text("Between keys: straight lines, or smooth curves that ease in and out");
+        if chosen != current {
+            self.set_interpolation(chosen);
+        }
+        let mut rate = fps;
+        let response = ui.add_sized(
+            [FIELD_WIDTH, ui.spacing().interact_size.y],
+            egui::DragValue::new(&mut rate)
+                .range(1.0..=project::animation::MAX_FPS)
+                .speed(0.2)
+                .max_decimals(3)
+                .suffix(" fps"),
+        );
+        // Typed, or at the end of a drag: one undo step.
+        if rate != fps && ((response.changed() && !response.dragged()) || response.drag_stopped()) {
+            self.set_fps(rate);
+        }
+        ui.checkbox(&mut self.timeline.onion, "Onion skin")
+            .on_hover_text("Show the previous and next keys' pictures ghosted behind");
+        ui.separator();
+        let recording = self.timeline.is_recording();
+        let record = egui::Button::selectable(recording, "⏺ Record").fill(if recording {
+            Color32::from_rgb(150, 30, 30)
+        } else {
+            Color32::TRANSPARENT
+        });
+        if ui
+            .add(record)
+            .on_hover_text(
+                "Record the next drag (a handle, cage vertices, or the control cursor of \
+                 Perform): every frame of it becomes the animation from this time",
+            )
+            .clicked()
+        {
+            self.toggle_record();
+        }
+        ui.checkbox(&mut self.timeline.keep_every_frame, "Every frame")
+            .on_hover_text(
+                "Keep a key per recorded frame instead of the fewest keys that replay \
+                 the take within the tolerance",
+            );
+        ui.add_enabled_ui(!self.timeline.keep_every_frame, |ui| {
+            ui.add_sized(
+                [FIELD_WIDTH + 40.0, ui.spacing().interact_size.y],
                 egui::DragValue::new(&mut self.timeline.tolerance)
                     .range(0.05..=20.0)
                     .speed(0.05)
+                    .max_decimals(2)
                     .prefix("within ")
                     .suffix(" px"),
             )
             .on_hover_text("How far a recorded take's keys may stray from what was performed");
         });
-        self.strip(ui);
     }
 
     /// The strip: ruler, keys, time shown; scrubbing and moving keys.
