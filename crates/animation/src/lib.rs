@@ -20,6 +20,6 @@ mod record;
 mod spatial;
 mod time;
 
-pub use record::{DEFAULT_TOLERANCE, simplify};
+pub use record::{DEFAULT_TOLERANCE, resample, simplify};
 pub use spatial::SpatialBlend;
 pub use time::{frame_count, frame_times, pose_at, posed_at};

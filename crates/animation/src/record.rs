@@ -11,6 +11,51 @@ pub const DEFAULT_TOLERANCE: f64 = 0.5;
 /// radians in rotation (or `e` in scale) counts as `REACH · e` pixels.
 const REACH: f64 = 20.0;
 
+/// A performance's frames at `fps` from its timed `samples` (seconds since the
+/// take began, and the pose then; in time order): frame `k` is at `k / fps`, up to
+/// the last sample's time, its pose interpolated linearly (channel by channel, a bar
+/// turning the smaller way) between the samples either side of it. So a take follows
+/// the hand's timing however rarely it was sampled — a slow editor samples a pose per
+/// drawn frame — rather than holding each sample until the next one.
+///
+/// No samples give no frames; one gives one frame.
+pub fn resample(project: &Project, samples: &[(f64, Pose)], fps: f64) -> Vec<Pose> {
+    let Some(&(last, _)) = samples.last() else {
+        return Vec::new();
+    };
+    if samples.len() == 1 || !(fps.is_finite() && fps > 0.0) {
+        return vec![samples[0].1.clone()];
+    }
+    let layout = Layout::of(project);
+    let count = (last.max(0.0) * fps + 1e-9).floor() as usize + 1;
+    let (mut a, mut b) = (Vec::new(), Vec::new());
+    let mut at = 0;
+    (0..count)
+        .map(|k| {
+            let t = k as f64 / fps;
+            while at + 2 < samples.len() && samples[at + 1].0 <= t {
+                at += 1;
+            }
+            let ((ta, pa), (tb, pb)) = (&samples[at], &samples[at + 1]);
+            let u = if tb > ta {
+                ((t - ta) / (tb - ta)).clamp(0.0, 1.0)
+            } else {
+                1.0
+            };
+            if u == 0.0 {
+                return pa.clone();
+            }
+            if u == 1.0 {
+                return pb.clone();
+            }
+            layout.channels(pa, None, &mut a);
+            layout.channels(pb, Some(&a), &mut b);
+            let between: Vec<f64> = a.iter().zip(&b).map(|(a, b)| a + u * (b - a)).collect();
+            layout.pose(&between)
+        })
+        .collect()
+}
+
 /// The fewest keys (of `frames`, one pose per frame at `fps` from `start` seconds)
 /// that reproduce every frame within `tolerance` pixels under linear interpolation:
 /// Douglas–Peucker in time. The first and last frames are always keys; a tolerance

@@ -87,6 +87,9 @@ pub struct EditorApp {
     pub log_open: bool,
     /// A question waiting for an answer.
     pub pending: Option<Pending>,
+    /// What the unsaved-changes question was about, waiting for the save it asked for
+    /// (a project never saved first asks where).
+    pub(crate) after_save: Option<Pending>,
     pub(crate) allow_close: bool,
     /// The keyboard shortcuts window is open.
     pub help_open: bool,
@@ -200,6 +203,7 @@ impl EditorApp {
             message,
             log_open: false,
             pending: None,
+            after_save: None,
             allow_close: false,
             help_open: false,
             dialogs: Box::new(NativeDialogs::new()),
@@ -348,6 +352,8 @@ impl EditorApp {
         // The document changes under any gesture in progress: a drag ends here (as
         // its own undo step), so its handle index cannot go stale.
         self.end_gesture();
+        // Every action replaces the message (what this one says, if anything, follows).
+        self.message = None;
         if let (Edit::Settings(settings), Some(doc)) = (&edit, &self.doc) {
             if settings.density != doc.settings().density {
                 self.rebuild_in_background(*settings);
@@ -402,7 +408,8 @@ impl EditorApp {
                 }
                 let Some(doc) = &self.doc else { return false };
                 if doc.project() != &without_virtuals(&before) {
-                    self.history.push(before);
+                    let label = crate::history::describe_change(&before, doc.project());
+                    self.history.push(before, label);
                     self.dirty = true;
                 }
                 self.cage
@@ -640,12 +647,10 @@ impl EditorApp {
         } else {
             self.history.redo(current)
         };
-        let Some(target) = taken else { return };
-        let from = doc.project().clone();
-        let was_lbc = from.method.controls() == Controls::Cage;
+        let Some((target, what)) = taken else { return };
+        let was_lbc = doc.project().method.controls() == Controls::Cage;
         match doc.undo_to(target.clone()) {
             Ok(()) => {
-                let what = crate::history::describe_change(&from, doc.project());
                 self.dirty = true;
                 self.settings_draft = None;
                 self.cage
@@ -664,7 +669,7 @@ impl EditorApp {
                 ));
             }
             Err(e) => {
-                self.history.unpop(back, target);
+                self.history.unpop(back, (target, what));
                 self.error(&e);
             }
         }

@@ -6,53 +6,60 @@ use project::{HandleSpec, Project};
 /// Steps kept before the oldest is forgotten.
 const LIMIT: usize = 500;
 
+/// A state to go back (or forward) to, and what the step between it and the state
+/// after it did, in a few words ("a recorded take: 38 keys", "the pose of handle 2").
+pub type Step = (Project, String);
+
 /// The undo and redo stacks.
 #[derive(Default)]
 pub struct History {
-    undo: Vec<Project>,
-    redo: Vec<Project>,
+    undo: Vec<Step>,
+    redo: Vec<Step>,
 }
 
 impl History {
-    /// Records `before`, the state an edit is about to leave; clears the redo stack.
-    pub fn push(&mut self, before: Project) {
-        if self.undo.last() == Some(&before) {
+    /// Records `before`, the state an edit is about to leave, with what the edit does
+    /// (`label`); clears the redo stack.
+    pub fn push(&mut self, before: Project, label: String) {
+        if self.undo.last().is_some_and(|(last, _)| *last == before) {
             return;
         }
-        self.undo.push(before);
+        self.undo.push((before, label));
         if self.undo.len() > LIMIT {
             self.undo.remove(0);
         }
         self.redo.clear();
     }
 
-    /// The state to go back to from `current`, which becomes redoable.
-    pub fn undo(&mut self, current: Project) -> Option<Project> {
-        let previous = self.undo.pop()?;
-        self.redo.push(current);
-        Some(previous)
+    /// The state to go back to from `current`, which becomes redoable, and what the
+    /// step undone did.
+    pub fn undo(&mut self, current: Project) -> Option<Step> {
+        let (previous, label) = self.undo.pop()?;
+        self.redo.push((current, label.clone()));
+        Some((previous, label))
     }
 
-    /// The state to go forward to from `current`, which becomes undoable.
-    pub fn redo(&mut self, current: Project) -> Option<Project> {
-        let next = self.redo.pop()?;
-        self.undo.push(current);
-        Some(next)
+    /// The state to go forward to from `current`, which becomes undoable, and what the
+    /// step redone does.
+    pub fn redo(&mut self, current: Project) -> Option<Step> {
+        let (next, label) = self.redo.pop()?;
+        self.undo.push((current, label.clone()));
+        Some((next, label))
     }
 
     /// The state [`History::undo`] (`back`) or [`History::redo`] would go to, without
     /// going there.
     pub fn peek(&self, back: bool) -> Option<&Project> {
         if back {
-            self.undo.last()
+            self.undo.last().map(|(p, _)| p)
         } else {
-            self.redo.last()
+            self.redo.last().map(|(p, _)| p)
         }
     }
 
     /// Puts back a state taken by [`History::undo`] or [`History::redo`] that could not
     /// be applied, so neither stack loses it.
-    pub fn unpop(&mut self, undone: bool, taken: Project) {
+    pub fn unpop(&mut self, undone: bool, taken: Step) {
         if undone {
             self.redo.pop();
             self.undo.push(taken);
@@ -205,31 +212,33 @@ mod tests {
     }
 
     #[test]
-    fn undo_and_redo_walk_the_states() {
+    fn undo_and_redo_walk_the_states_and_name_the_steps() {
         let mut h = History::default();
-        h.push(state(0.1));
-        h.push(state(0.2));
+        let step = |a: f64, label: &str| (state(a), label.to_owned());
+        h.push(state(0.1), "first".into());
+        h.push(state(0.2), "second".into());
         assert_eq!(h.peek(true), Some(&state(0.2)));
         assert_eq!(h.peek(false), None);
-        assert_eq!(h.undo(state(0.3)), Some(state(0.2)));
+        assert_eq!(h.undo(state(0.3)), Some(step(0.2, "second")));
         assert_eq!(h.peek(false), Some(&state(0.3)));
-        assert_eq!(h.undo(state(0.2)), Some(state(0.1)));
+        assert_eq!(h.undo(state(0.2)), Some(step(0.1, "first")));
         assert_eq!(h.undo(state(0.1)), None);
-        assert_eq!(h.redo(state(0.1)), Some(state(0.2)));
-        assert_eq!(h.redo(state(0.2)), Some(state(0.3)));
+        // Redo names the same step the undo did.
+        assert_eq!(h.redo(state(0.1)), Some(step(0.2, "first")));
+        assert_eq!(h.redo(state(0.2)), Some(step(0.3, "second")));
         assert!(!h.can_redo());
-        h.undo(state(0.3));
-        h.push(state(0.2));
+        assert_eq!(h.undo(state(0.3)), Some(step(0.2, "second")));
+        h.push(state(0.2), "again".into());
         assert!(!h.can_redo(), "a new edit drops the redo stack");
     }
 
     #[test]
     fn a_failed_undo_is_put_back() {
         let mut h = History::default();
-        h.push(state(0.1));
+        h.push(state(0.1), "a step".into());
         let taken = h.undo(state(0.2)).expect("a step");
         h.unpop(true, taken);
         assert!(h.can_undo() && !h.can_redo());
-        assert_eq!(h.undo(state(0.2)), Some(state(0.1)));
+        assert_eq!(h.undo(state(0.2)), Some((state(0.1), "a step".to_owned())));
     }
 }

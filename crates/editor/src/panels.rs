@@ -165,6 +165,15 @@ impl eframe::App for EditorApp {
         self.log_window(&ctx);
         self.file_dialog_ui(&ctx);
         self.pending_modal(&ctx);
+        // A save the unsaved-changes question asked for, done or given up (its dialog
+        // cancelled, or the write failed): go on, or forget it.
+        if self.after_save.is_some() && self.file_dialog.is_none() && self.pending.is_none() {
+            if self.dirty {
+                self.after_save = None;
+            } else {
+                self.continue_after_save(&ctx);
+            }
+        }
         self.frame_ms = clock.elapsed().as_secs_f64() * 1e3;
     }
 }
@@ -222,6 +231,14 @@ impl EditorApp {
         let pressed = |modifiers, key| {
             ctx.input_mut(|i| i.consume_shortcut(&KeyboardShortcut::new(modifiers, key)))
         };
+        // Escape closes the windows open over the canvas first (and does nothing else).
+        let windows = self.help_open || self.log_open || self.animation_export.is_some();
+        if windows && pressed(Modifiers::NONE, Key::Escape) {
+            self.help_open = false;
+            self.log_open = false;
+            self.animation_export = None;
+            return;
+        }
         // Longer combinations first: Ctrl+Shift+Z must not read as Ctrl+Z.
         if pressed(ctrl_shift, Key::Z) || pressed(ctrl, Key::Y) {
             self.redo();

@@ -199,7 +199,13 @@ impl CanvasTool for PerformTool {
         {
             let at = host.viewport().to_image(pos);
             match drag.marker {
-                None => self.drive(host, at),
+                None => {
+                    for (pos, time) in crate::tool::drag_path(host, ui, pos) {
+                        host.set_pointer_time(time);
+                        let at = host.viewport().to_image(pos);
+                        self.drive(host, at);
+                    }
+                }
                 Some(i) => {
                     // Not a live pose (no take starts): the marker moves, kept apart
                     // from the others.

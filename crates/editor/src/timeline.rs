@@ -32,11 +32,18 @@ pub struct Timeline {
     pub keep_every_frame: bool,
     /// How far (pixels) a simplified take may stray from what was recorded.
     pub tolerance: f64,
+    /// The input's clock this frame (seconds): what a take's samples are timed by.
+    pub(crate) clock: f64,
+    /// When the primary button went down for the gesture under way (input clock): a
+    /// take starts then, not when the drag is first recognised.
+    pub(crate) pressed_at: Option<f64>,
 }
 
 impl Default for Timeline {
     fn default() -> Self {
         Self {
+            clock: 0.0,
+            pressed_at: None,
             time: 0.0,
             playing: None,
             looping: true,
@@ -62,17 +69,19 @@ pub(crate) enum Record {
     Taking(Box<Take>),
 }
 
-/// A take under way: every frame of a live drag, at the project's rate.
+/// A take under way: the poses of a live drag, each with when it was shown.
 #[derive(Clone, Debug)]
 pub(crate) struct Take {
-    /// When it started (wall clock).
-    pub started: Instant,
+    /// When it started, on the input's clock (seconds).
+    pub started: f64,
     /// The timeline's time at its start.
     pub from: f64,
     /// The rig file before the drag (the take is one undo step).
     pub before: Project,
-    /// One pose per frame so far.
-    pub frames: Vec<Pose>,
+    /// The poses so far, each with its time since the start (seconds), in order:
+    /// one per drawn frame that changed it. The take's frames are resampled from
+    /// them at the project's rate ([`animation::resample`]).
+    pub samples: Vec<(f64, Pose)>,
 }
 
 impl Timeline {

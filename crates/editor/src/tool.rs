@@ -89,6 +89,44 @@ pub(crate) trait Host {
     /// The edges of the C² weights' dual graph (rig node pairs), as the GPU frame last
     /// found them: found only while the dual graph is shown.
     fn dual_graph(&self) -> &[(u32, u32)];
+    /// Whether a take is being recorded: a drag then follows every pointer event of
+    /// the frame ([`drag_path`]), each at its own time, so the take has the hand's path
+    /// and timing however slowly the editor draws.
+    fn taking(&self) -> bool;
+    /// The time (seconds, on the input's clock) of the pointer event the next
+    /// [`Host::preview`] shows: a take samples the pose at it.
+    fn set_pointer_time(&mut self, time: f64);
+}
+
+/// Where a drag's pointer went this frame, each place with its time on the input's
+/// clock: with a take being recorded ([`Host::taking`]), every pointer move of the
+/// frame, their times spread evenly over the time since the last frame (events carry
+/// none of their own); else the latest place alone, at the frame's time.
+pub(crate) fn drag_path(host: &dyn Host, ui: &Ui, latest: Pos2) -> Vec<(Pos2, f64)> {
+    let (now, dt, moves) = ui.input(|i| {
+        let moves: Vec<Pos2> = i
+            .events
+            .iter()
+            .filter_map(|e| match e {
+                egui::Event::PointerMoved(p) => Some(*p),
+                _ => None,
+            })
+            .collect();
+        (i.time, f64::from(i.unstable_dt), moves)
+    });
+    if !host.taking() || moves.len() < 2 {
+        return vec![(latest, now)];
+    }
+    let n = moves.len() as f64;
+    let mut path: Vec<(Pos2, f64)> = moves
+        .into_iter()
+        .enumerate()
+        .map(|(k, p)| (p, now - dt + dt * (k + 1) as f64 / n))
+        .collect();
+    if let Some(last) = path.last_mut() {
+        *last = (latest, now);
+    }
+    path
 }
 
 /// A tool of the canvas.

@@ -506,3 +506,153 @@ fn a_cancelled_animation_export_writes_nothing() {
         .collect();
     assert_eq!(leftovers.len(), 1, "{leftovers:?}");
 }
+
+/// Records a take of handle 0 dragged along `path` (image pixels at `t` seconds, for
+/// one second; the hand's pointer events come at 240 a second) while the editor draws
+/// `fps` frames a second, and returns the project with its keys.
+fn record_path(fps: f64, path: impl Fn(f64) -> DVec2) -> project::Project {
+    let mut h = support::editor_with(Box::new(support::NoDesktop), false);
+    click_label(&mut h, "⏺ Record");
+    let screen = |h: &Harness<'_, EditorApp>, t: f64| {
+        let p = path(t);
+        at(h, p.x, p.y)
+    };
+    h.input_mut().time = Some(0.0);
+    h.hover_at(screen(&h, 0.0));
+    h.input_mut().time = Some(0.0);
+    let first = screen(&h, 0.0);
+    h.input_mut().events.push(egui::Event::PointerButton {
+        pos: first,
+        button: egui::PointerButton::Primary,
+        pressed: true,
+        modifiers: Modifiers::NONE,
+    });
+    h.step();
+    let events_per_frame = (240.0 / fps).round() as usize;
+    let frames = fps.round() as usize;
+    for frame in 1..=frames {
+        for k in 1..=events_per_frame {
+            let t = ((frame - 1) * events_per_frame + k) as f64 / 240.0;
+            let p = screen(&h, t);
+            h.input_mut().events.push(egui::Event::PointerMoved(p));
+        }
+        h.input_mut().time = Some(frame as f64 / fps);
+        h.step();
+    }
+    h.input_mut().time = Some(1.0 + 1.0 / fps);
+    let last = screen(&h, 1.0);
+    h.input_mut().events.push(egui::Event::PointerButton {
+        pos: last,
+        button: egui::PointerButton::Primary,
+        pressed: false,
+        modifiers: Modifiers::NONE,
+    });
+    h.step();
+    h.run();
+    h.state().document().expect("doc").project().clone()
+}
+
+#[test]
+fn a_take_plays_as_performed_however_slowly_the_editor_draws() {
+    let start =
+        editor::posed(&handles(&support::editor_with(Box::new(support::NoDesktop), false))[0])[0];
+    // A curved stroke at an uneven speed.
+    let path =
+        move |t: f64| start + DVec2::new(120.0 * t * t, 50.0 * (std::f64::consts::PI * t).sin());
+    let slow = record_path(5.0, path);
+    let fast = record_path(60.0, path);
+    let keys = |p: &project::Project| p.animation.as_ref().map_or(0, |a| a.keys.len());
+    assert!(
+        keys(&slow) >= 3 && keys(&fast) >= 3,
+        "{} / {}",
+        keys(&slow),
+        keys(&fast)
+    );
+    // Replayed frame by frame, both takes follow the hand: the same place at the same
+    // time within the tolerance (0.5 px each) and the hand's own sampling.
+    let (mut worst, mut off_hand): (f64, f64) = (0.0, 0.0);
+    for i in 0..=48 {
+        let t = f64::from(i) / 48.0 * 0.95;
+        let (a, b) = (animation::posed_at(&slow, t), animation::posed_at(&fast, t));
+        let (a, b) = (
+            editor::posed(&a.handles[0])[0],
+            editor::posed(&b.handles[0])[0],
+        );
+        worst = worst.max(a.distance(b));
+        // Where the hand was then (the handle follows the pointer from where it was
+        // pressed, the picture's pixels a little off the screen's).
+        off_hand = off_hand.max(a.distance(path(t)));
+    }
+    eprintln!("replays differ by {worst:.2} px, slow one off the hand by {off_hand:.2} px");
+    assert!(worst < 1.5, "the replays differ by up to {worst:.2} px");
+    assert!(
+        off_hand < 1.5,
+        "the slow replay strays {off_hand:.2} px from the hand"
+    );
+}
+
+#[test]
+fn every_action_replaces_the_message_and_undo_names_the_take() {
+    let mut h = support::editor_with(Box::new(support::NoDesktop), false);
+    let text = |h: &Harness<'_, EditorApp>| {
+        h.state()
+            .message
+            .as_ref()
+            .map(|m| (m.text.clone(), m.is_error))
+    };
+    // A refusal in red, then a drag that works: the red line goes.
+    click_label(&mut h, "Add bar");
+    let p = at(&h, 20.0, 20.0);
+    drag(&mut h, p, p + egui::Vec2::new(40.0, 0.0), Modifiers::NONE);
+    assert!(text(&h).is_some_and(|(_, red)| red), "{:?}", text(&h));
+    click_label(&mut h, "Puppet");
+    drag_handle(&mut h, 0, DVec2::new(10.0, 5.0));
+    assert!(!text(&h).is_some_and(|(_, red)| red), "{:?}", text(&h));
+    // Keys: the automatic ones say so too, each in turn.
+    click_label(&mut h, "Set key");
+    assert!(
+        text(&h).is_some_and(|(t, _)| t.contains("(1 key)")),
+        "{:?}",
+        text(&h)
+    );
+    step(&mut h, 6);
+    drag_handle(&mut h, 1, DVec2::new(8.0, 0.0));
+    assert!(
+        text(&h).is_some_and(|(t, _)| t == "key set at 0.25 s (2 keys)"),
+        "{:?}",
+        text(&h)
+    );
+    // A recorded take is one step, and undo and redo say which.
+    click_label(&mut h, "⏺ Record");
+    let from = handle_at(&h, 2);
+    let (a, b) = (at(&h, from.x, from.y), at(&h, from.x + 30.0, from.y + 20.0));
+    // Stepped, not run: a take keeps the editor drawing.
+    let press = |h: &mut Harness<'_, EditorApp>, pos, pressed| {
+        h.event(egui::Event::PointerButton {
+            pos,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: Modifiers::NONE,
+        });
+        h.step();
+    };
+    h.hover_at(a);
+    h.step();
+    press(&mut h, a, true);
+    for i in 1..=8 {
+        h.hover_at(a + (b - a) * (i as f32 / 8.0));
+        h.step();
+    }
+    press(&mut h, b, false);
+    h.run();
+    let count = keys(&h).len();
+    assert!(count >= 2, "{:?}", text(&h));
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    let (undone, _) = text(&h).expect("a message");
+    assert!(undone.starts_with("undone: a recorded take: "), "{undone}");
+    h.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
+    h.run();
+    let (redone, _) = text(&h).expect("a message");
+    assert_eq!(redone, undone.replace("undone", "redone"));
+}

@@ -513,7 +513,8 @@ fn undoing_out_of_lbc_leaves_the_cage_tool_and_says_what_it_undid() {
     assert_eq!(h.state().tool, Tool::Puppet);
     let message = h.state().message.clone().expect("a message");
     assert!(message.text.starts_with("undone: "), "{message:?}");
-    assert!(message.text.contains("the cage removed"), "{message:?}");
+    // It names the step undone: the one that made the cage.
+    assert!(message.text.contains("a cage"), "{message:?}");
     assert!(!message.text.contains("drag a vertex"), "{message:?}");
     // Redo comes back to LBC and its tool.
     h.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);

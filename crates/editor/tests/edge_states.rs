@@ -269,7 +269,7 @@ fn without_a_desktop_dialog_the_built_in_one_saves_exports_and_opens() {
     h.run();
     click_label(&mut h, "Open");
     assert!(h.state().pending.is_some(), "unsaved changes: asks first");
-    click_label(&mut h, "Discard changes");
+    click_label(&mut h, "Discard");
     settle(&mut h);
     assert_eq!(handles(&h).len(), 1, "{:?}", h.state().message);
     assert_eq!(

@@ -146,7 +146,7 @@ const LABELS: &[&str] = &[
     "Fold-overs",
     "Weights under cursor",
     "Cancel",
-    "Discard changes",
+    "Discard",
     "Replace",
     "Save",
     "Open",

@@ -161,7 +161,7 @@ fn an_editing_session() {
     click_label(&mut h, "Open project…");
     // Unsaved changes: the editor asks first.
     assert!(h.state().pending.is_some());
-    click_label(&mut h, "Discard changes");
+    click_label(&mut h, "Discard");
     settle(&mut h);
     assert_eq!(handles(&h), saved.handles, "{:?}", h.state().message);
     assert!(!h.state().is_dirty());
@@ -210,13 +210,58 @@ fn unsaved_changes_can_be_kept() {
     let mut h = editor(dir.path());
     click_label(&mut h, "Reset pose");
     assert!(h.state().is_dirty());
-    h.state_mut().request_open(lizard);
+    h.state_mut().request_open(lizard.clone());
     h.run();
     assert!(h.state().pending.is_some());
     click_label(&mut h, "Cancel");
     assert!(h.state().pending.is_none());
     assert_eq!(handles(&h).len(), 7, "the work is still there");
     assert!(h.state().document().is_some_and(|d| d.image_path.is_none()));
+    // Escape is Cancel too.
+    h.state_mut().request_open(lizard.clone());
+    h.run();
+    assert!(h.state().pending.is_some());
+    h.key_press(Key::Escape);
+    h.run();
+    assert!(h.state().pending.is_none());
+    assert_eq!(handles(&h).len(), 7);
+    // Save: the project is saved (its dialog answered with a file in `dir`), then the
+    // picture opens.
+    h.state_mut().request_open(lizard.clone());
+    h.run();
+    click_label(&mut h, "Save");
+    settle(&mut h);
+    let saved = std::fs::read_to_string(dir.path().join("project.json")).expect("saved");
+    assert_eq!(
+        Project::from_json(&saved).expect("a project").handles.len(),
+        7,
+        "the work was saved"
+    );
+    assert_eq!(
+        h.state().document().and_then(|d| d.image_path.clone()),
+        Some(lizard),
+        "then the picture opened"
+    );
+}
+
+#[test]
+fn escape_closes_the_windows_over_the_canvas() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    h.key_press(Key::F1);
+    h.run();
+    assert!(h.state().help_open);
+    h.state_mut().log_open = true;
+    h.state_mut().selected = Some(0);
+    h.run();
+    h.key_press(Key::Escape);
+    h.run();
+    assert!(!h.state().help_open && !h.state().log_open);
+    // Only the windows: the selection stays until the next Escape.
+    assert_eq!(h.state().selected, Some(0));
+    h.key_press(Key::Escape);
+    h.run();
+    assert_eq!(h.state().selected, None);
 }
 
 #[test]
@@ -476,10 +521,11 @@ fn undo_redo_and_method_switches_say_what_they_did() {
     assert!(text(&h).starts_with("added a point handle"), "{}", text(&h));
     h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
     h.run();
-    assert_eq!(text(&h), "undone: 1 handle removed");
+    // Undo and redo name the step they undid or redid.
+    assert_eq!(text(&h), "undone: 1 handle added");
     h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
     h.run();
-    assert_eq!(text(&h), "undone: the method: C² weights");
+    assert_eq!(text(&h), "undone: the method: ARAP");
     h.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
     h.run();
     assert_eq!(text(&h), "redone: the method: ARAP");

@@ -92,6 +92,8 @@ impl EditorApp {
 
     /// Advances playback and a take by the wall clock; called once a frame.
     pub(crate) fn tick(&mut self, ctx: &egui::Context) {
+        (self.timeline.clock, self.timeline.pressed_at) =
+            ctx.input(|i| (i.time, i.pointer.press_start_time()));
         if self.is_busy() {
             self.timeline.playing = None;
         }
@@ -118,7 +120,8 @@ impl EditorApp {
             self.show_current_time();
             ctx.request_repaint();
         }
-        self.sample_take();
+        // A take samples each pose a drag shows (every frame of it, holding still too),
+        // at the time of its pointer event; nothing to do here but keep drawing.
         if self.timeline.is_taking() {
             ctx.request_repaint();
         }
@@ -280,10 +283,34 @@ impl EditorApp {
         if doc.project().animation.as_ref() == Some(&animation) {
             return;
         }
+        let (before_keys, count) = (doc.keys().len(), animation.keys.len());
         if let Err(e) = doc.apply(Edit::Animation(Some(Box::new(animation)))) {
             self.error(&e.context("cannot key the pose"));
         } else {
             self.timeline.time = time;
+            let keys = if count == 1 { "key" } else { "keys" };
+            self.info(if count > before_keys {
+                format!("key set at {time:.2} s ({count} {keys})")
+            } else {
+                format!("key at {time:.2} s changed ({count} {keys})")
+            });
+        }
+    }
+
+    /// Ends an action that changed the document from `before` as one undo step named
+    /// `label` (else by what changed), keying the pose it left when keys exist. Every
+    /// action replaces the message: one that says nothing clears the last.
+    pub(crate) fn record_step(&mut self, before: project::Project, label: Option<String>) {
+        self.message = None;
+        // With keys, the pose the action left is keyed at the time shown (this step).
+        self.autokey(&before);
+        if let Some(doc) = &self.doc
+            && doc.project() != &without_virtuals(&before)
+        {
+            let label =
+                label.unwrap_or_else(|| crate::history::describe_change(&before, doc.project()));
+            self.history.push(before, label);
+            self.dirty = true;
         }
     }
 
@@ -328,28 +355,40 @@ impl EditorApp {
         }
         let Some(doc) = &self.doc else { return };
         let from = snap(self.timeline.time, self.fps());
+        // The take starts when the button went down, at the pose before the drag (the
+        // drag is recognised a few points of movement later).
+        let before = doc.snapshot();
+        let clock = self.timeline.clock;
+        let started = self
+            .timeline
+            .pressed_at
+            .filter(|&t| t <= clock)
+            .unwrap_or(clock);
+        let first = Pose::of(&before);
         self.timeline.record = Record::Taking(Box::new(Take {
-            started: Instant::now(),
+            started,
             from,
-            before: doc.snapshot(),
-            frames: vec![Pose::of(doc.project())],
+            samples: vec![(0.0, first)],
+            before,
         }));
     }
 
-    /// Adds the frames the wall clock has passed since the take's last to it (each
-    /// the pose shown now), and moves the time shown along.
-    fn sample_take(&mut self) {
-        let fps = self.fps();
+    /// Adds the pose shown now to the take, timed by the input's clock (the pointer's
+    /// time this frame), and moves the time shown along.
+    pub(crate) fn sample_take(&mut self) {
+        let clock = self.timeline.clock;
         let Some(doc) = &self.doc else { return };
         let Record::Taking(take) = &mut self.timeline.record else {
             return;
         };
-        let due = (take.started.elapsed().as_secs_f64() * fps).floor() as usize + 1;
+        let since = (clock - take.started).max(0.0);
         let pose = Pose::of(doc.project());
-        while take.frames.len() < due {
-            take.frames.push(pose.clone());
+        match take.samples.last_mut() {
+            // The same instant (several changes in one frame): the latest pose.
+            Some((t, last)) if *t >= since => *last = pose,
+            _ => take.samples.push((since, pose)),
         }
-        self.timeline.time = take.from + (take.frames.len() - 1) as f64 / fps;
+        self.timeline.time = take.from + since;
     }
 
     /// The live drag of a take ended: its frames become keys from the take's start
@@ -369,8 +408,9 @@ impl EditorApp {
         } else {
             self.timeline.tolerance
         };
-        let taken = animation::simplify(doc.project(), &take.frames, take.from, fps, tolerance);
-        let to = take.from + (take.frames.len() - 1) as f64 / fps;
+        let frames = animation::resample(doc.project(), &take.samples, fps);
+        let taken = animation::simplify(doc.project(), &frames, take.from, fps, tolerance);
+        let to = take.from + (frames.len() - 1) as f64 / fps;
         let mut animation = doc.project().animation.clone().unwrap_or_default();
         animation
             .keys
@@ -380,10 +420,14 @@ impl EditorApp {
         animation.keys.sort_by(|a, b| a.time.total_cmp(&b.time));
         let result = doc.apply(Edit::Animation(Some(Box::new(animation))));
         self.timeline.time = to;
-        let frames = take.frames.len();
+        let frames = frames.len();
         match result {
             Ok(()) => {
-                Host::record(self, take.before);
+                let label = format!(
+                    "a recorded take: {count} key{}",
+                    if count == 1 { "" } else { "s" }
+                );
+                self.record_step(take.before, Some(label));
                 self.info(format!(
                     "recorded {frames} frames ({:.2} s) as {count} keys",
                     (frames - 1) as f64 / fps

@@ -2,6 +2,7 @@
 //! that hand a tool its host.
 
 use super::*;
+use crate::timeline::Record;
 
 impl Host for EditorApp {
     fn document(&self) -> Option<&Document> {
@@ -35,26 +36,29 @@ impl Host for EditorApp {
     fn preview(&mut self, project: Project) {
         // A drag takes over from playback.
         self.timeline.playing = None;
+        // A live drag: recording, when armed, starts with it (from the pose before
+        // it), and samples every pose it shows.
+        self.start_take();
         let Some(doc) = &mut self.doc else { return };
         if let Err(e) = doc.restore(project) {
             self.error(&e);
         }
-        // A live drag: recording, when armed, starts with it.
-        self.start_take();
+        self.sample_take();
+    }
+
+    fn taking(&self) -> bool {
+        self.timeline.is_taking() || matches!(self.timeline.record, Record::Armed)
+    }
+
+    fn set_pointer_time(&mut self, time: f64) {
+        self.timeline.clock = time;
     }
 
     fn record(&mut self, before: Project) {
         if self.end_take() {
             return;
         }
-        // With keys, the pose the drag left is keyed at the time shown (this step).
-        self.autokey(&before);
-        if let Some(doc) = &self.doc
-            && doc.project() != &without_virtuals(&before)
-        {
-            self.history.push(before);
-            self.dirty = true;
-        }
+        self.record_step(before, None);
     }
 
     fn solve_cage(&mut self, key: CageKey) {

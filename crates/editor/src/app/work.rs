@@ -270,13 +270,7 @@ impl EditorApp {
             .doc
             .as_ref()
             .is_some_and(|d| d.method().controls() == Controls::Cage);
-        let history = match &cause {
-            Rebuild::History { back } => self.doc.as_ref().map(|old| {
-                let what = crate::history::describe_change(old.project(), doc.project());
-                format!("{}: {what}; ", if *back { "undone" } else { "redone" })
-            }),
-            Rebuild::Edit { .. } => None,
-        };
+        let mut history = None;
         let mut kept = Ok(());
         if let Some(old) = &self.doc {
             kept = doc.keep_solutions_of(old);
@@ -285,12 +279,19 @@ impl EditorApp {
             doc.pose_version = old.pose_version + 1;
             let current = old.snapshot();
             match cause {
-                Rebuild::Edit { before } => self.history.push(*before),
-                Rebuild::History { back: true } => {
-                    self.history.undo(current);
+                Rebuild::Edit { before } => {
+                    let label = crate::history::describe_change(&before, doc.project());
+                    self.history.push(*before, label);
                 }
-                Rebuild::History { back: false } => {
-                    self.history.redo(current);
+                Rebuild::History { back } => {
+                    let step = if back {
+                        self.history.undo(current)
+                    } else {
+                        self.history.redo(current)
+                    };
+                    history = step.map(|(_, what)| {
+                        format!("{}: {what}; ", if back { "undone" } else { "redone" })
+                    });
                 }
             }
         }

@@ -29,7 +29,11 @@ impl CageTool {
         {
             let at = host.viewport().to_image(pos);
             if self.drag.is_some() {
-                self.drag_to(host, at);
+                for (pos, time) in crate::tool::drag_path(host, ui, pos) {
+                    host.set_pointer_time(time);
+                    let at = host.viewport().to_image(pos);
+                    self.drag_to(host, at);
+                }
             } else if let Some((_, end, _)) = &mut self.boxing {
                 *end = at;
             }

@@ -60,8 +60,11 @@ impl HandleTool {
             && !host.panning()
             && let Some(pos) = response.interact_pointer_pos()
         {
-            let at = host.viewport().to_image(pos);
-            self.drag_to(host, at);
+            for (pos, time) in crate::tool::drag_path(host, ui, pos) {
+                host.set_pointer_time(time);
+                let at = host.viewport().to_image(pos);
+                self.drag_to(host, at);
+            }
         }
         let stopped = response.drag_stopped();
         if stopped && let Some(drag) = self.drag.take() {

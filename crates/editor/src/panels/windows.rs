@@ -163,6 +163,7 @@ impl EditorApp {
             return;
         };
         let mut answer = None;
+        let unsaved = matches!(pending, Pending::Open(_) | Pending::Close);
         let (heading, question, yes) = match &pending {
             Pending::Replace(_, path) => (
                 "Replace file?",
@@ -171,38 +172,75 @@ impl EditorApp {
             ),
             Pending::Open(_) | Pending::Close => (
                 "Unsaved changes",
-                "The current project has changes that are not saved. Discard them?".to_owned(),
-                "Discard changes",
+                "The current project has changes that are not saved. Save them first?".to_owned(),
+                "Discard",
             ),
         };
         egui::Modal::new(egui::Id::unique("question")).show(ctx, |ui| {
             ui.heading(heading);
             ui.label(question);
             ui.horizontal(|ui| {
-                if ui.button(yes).clicked() {
-                    answer = Some(true);
+                if unsaved && ui.button("Save").clicked() {
+                    answer = Some(Answer::Save);
                 }
-                if ui.button("Cancel").clicked() {
-                    answer = Some(false);
+                if ui.button(yes).clicked() {
+                    answer = Some(Answer::Go);
+                }
+                if ui.button("Cancel").on_hover_text("Escape").clicked() {
+                    answer = Some(Answer::Cancel);
                 }
             });
         });
         match answer {
-            Some(true) => {
+            Some(Answer::Save) => {
                 self.pending = None;
-                match pending {
-                    Pending::Open(path) => self.open_in_background(path),
-                    Pending::Replace(action, path) => self.file_chosen(action, path),
-                    Pending::Close => {
-                        self.allow_close = true;
-                        ctx.send_viewport_cmd(egui::ViewportCommand::Close);
-                    }
-                }
+                // Saved where it was, the question's action follows at once; a project
+                // never saved asks where first, and follows when it is saved there.
+                self.after_save = Some(pending);
+                self.save();
+                self.continue_after_save(ctx);
             }
-            Some(false) => self.pending = None,
+            Some(Answer::Go) => {
+                self.pending = None;
+                self.go_on(pending, ctx);
+            }
+            Some(Answer::Cancel) => self.pending = None,
             None => {}
         }
     }
+
+    /// Does what a question was asked for, now that it is answered.
+    pub(crate) fn go_on(&mut self, pending: Pending, ctx: &egui::Context) {
+        match pending {
+            Pending::Open(path) => self.open_in_background(path),
+            Pending::Replace(action, path) => self.file_chosen(action, path),
+            Pending::Close => {
+                self.allow_close = true;
+                ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+            }
+        }
+    }
+
+    /// After a save the unsaved-changes question asked for: once nothing is unsaved,
+    /// what the question was about goes on; a save that failed (or is still waiting
+    /// for its file dialog) keeps it waiting.
+    pub(crate) fn continue_after_save(&mut self, ctx: &egui::Context) {
+        if !self.dirty
+            && let Some(pending) = self.after_save.take()
+        {
+            self.go_on(pending, ctx);
+        }
+    }
+}
+
+/// How the question was answered.
+enum Answer {
+    /// Save, then go on (unsaved changes).
+    Save,
+    /// Go on: discard the changes, or replace the file.
+    Go,
+    /// Do nothing.
+    Cancel,
 }
 
 /// How far a cage's solve has come, 0 to 1: the share of the way (in orders of
