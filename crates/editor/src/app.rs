@@ -90,6 +90,8 @@ pub struct EditorApp {
     /// What the unsaved-changes question was about, waiting for the save it asked for
     /// (a project never saved first asks where).
     pub(crate) after_save: Option<Pending>,
+    /// Whether this document was told what MLS does on a cut-out.
+    pub(crate) mls_warned: bool,
     pub(crate) allow_close: bool,
     /// The keyboard shortcuts window is open.
     pub help_open: bool,
@@ -204,6 +206,7 @@ impl EditorApp {
             log_open: false,
             pending: None,
             after_save: None,
+            mls_warned: false,
             allow_close: false,
             help_open: false,
             dialogs: Box::new(NativeDialogs::new()),
@@ -568,7 +571,19 @@ impl EditorApp {
             if self.tool == Tool::Cage {
                 self.set_tool(Tool::Puppet);
             }
-            self.info(format!("{}: {}", method.label(), method.about()));
+            let cut_out = self
+                .doc
+                .as_ref()
+                .is_some_and(|d| !d.rig().domain().is_convex());
+            if method == Method::Mls && cut_out && !self.mls_warned {
+                // Once a document: the one surprise MLS has in store on a cut-out.
+                self.mls_warned = true;
+                self.info(
+                    "MLS on a cut-out: its distances are straight lines, not paths inside                      the shape, so a pin moved far from a part it does not hold, across a                      gap, pulls a needle out of that part; pin the parts, or use ARAP or C²                      weights, which keep to the shape",
+                );
+            } else {
+                self.info(format!("{}: {}", method.label(), method.about()));
+            }
         }
     }
 

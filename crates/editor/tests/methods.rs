@@ -469,3 +469,21 @@ fn mls_fit_and_alpha_are_settings_of_the_rig_and_undo() {
     h.run();
     assert_eq!(positions(&h), rigid);
 }
+
+#[test]
+fn mls_on_a_cut_out_says_once_what_it_does_across_gaps() {
+    let mut h = support::editor_with(Box::new(support::NoDesktop), false);
+    let text = |h: &Harness<'_, EditorApp>| {
+        h.state()
+            .message
+            .as_ref()
+            .map(|m| m.text.clone())
+            .unwrap_or_default()
+    };
+    click_label(&mut h, "MLS");
+    assert!(text(&h).starts_with("MLS on a cut-out"), "{}", text(&h));
+    assert!(text(&h).contains("needle"), "{}", text(&h));
+    click_label(&mut h, "C² weights");
+    click_label(&mut h, "MLS");
+    assert!(!text(&h).contains("cut-out"), "said once: {}", text(&h));
+}

@@ -90,6 +90,24 @@ fn a_mirrored_mesh_is_all_fold_over() {
 }
 
 #[test]
+fn positions_that_fold_the_mesh_show_the_fold_over_too() {
+    // What ARAP and MLS upload: positions, here the quad mirrored left to right.
+    let scene = Scene::new(IDENTITY);
+    let mirrored = [
+        Vec2::new(8.0, 0.0),
+        Vec2::new(0.0, 0.0),
+        Vec2::new(0.0, 8.0),
+        Vec2::new(8.0, 8.0),
+    ];
+    scene
+        .view
+        .set_positions(scene.gpu.queue(), &mirrored)
+        .expect("positions");
+    assert_eq!(count(&scene.draw(Overlay::None, false), green), 256);
+    assert_eq!(count(&scene.draw(Overlay::None, true), red), 256);
+}
+
+#[test]
 fn a_new_pose_moves_the_mesh() {
     let scene = Scene::new(IDENTITY);
     // Half the image width to the right: the left half of the target stays empty.

@@ -185,6 +185,7 @@ impl EditorApp {
                 self.doc = Some(doc);
                 self.history.clear();
                 self.dirty = false;
+                self.mls_warned = false;
                 self.selected = None;
                 self.timeline = crate::timeline::Timeline::default();
                 self.perform = crate::perform::PerformTool::default();
