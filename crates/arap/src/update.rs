@@ -95,23 +95,45 @@ impl Compiled {
     /// # Errors
     /// As [`Compiled::update`]; `out` is left unchanged on error.
     pub fn update_into(&self, targets: &[DVec2], out: &mut Deformation) -> Result<(), ArapError> {
-        if targets.len() != self.constrained.len() {
-            return Err(ArapError::TargetCount {
-                got: targets.len(),
-                expected: self.constrained.len(),
-            });
-        }
-        if let Some(constraint) = targets.iter().position(|t| !t.is_finite()) {
-            return Err(ArapError::NonFiniteTarget { constraint });
+        self.update_split_into(targets, targets, out)
+    }
+
+    /// [`Compiled::update_into`] with the constrained vertices at `targets` in step
+    /// two (the final result) but at `step_one` in step one: for a constraint added
+    /// where a solve already put its vertices — pinned at their step-one and final
+    /// positions, it leaves both steps' answers as they were (each step's minimiser
+    /// over fewer free vertices is the one it had).
+    ///
+    /// # Errors
+    /// As [`Compiled::update`], for either list; `out` is left unchanged on error.
+    pub fn update_split_into(
+        &self,
+        step_one: &[DVec2],
+        targets: &[DVec2],
+        out: &mut Deformation,
+    ) -> Result<(), ArapError> {
+        for list in [step_one, targets] {
+            if list.len() != self.constrained.len() {
+                return Err(ArapError::TargetCount {
+                    got: list.len(),
+                    expected: self.constrained.len(),
+                });
+            }
+            if let Some(constraint) = list.iter().position(|t| !t.is_finite()) {
+                return Err(ArapError::NonFiniteTarget { constraint });
+            }
         }
         let mesh = &*self.mesh;
         out.step_one.clear();
         out.step_one.extend_from_slice(&mesh.rest);
-        for (&v, &t) in self.constrained.iter().zip(targets) {
+        for (&v, &t) in self.constrained.iter().zip(step_one) {
             out.step_one[v as usize] = t;
         }
         let (Some(one), Some(two)) = (&self.step_one, &self.step_two) else {
             out.positions.clone_from(&out.step_one);
+            for (&v, &t) in self.constrained.iter().zip(targets) {
+                out.positions[v as usize] = t;
+            }
             return Ok(());
         };
         let scratch = &mut out.scratch;
@@ -122,7 +144,7 @@ impl Compiled {
                 let r1 = &mut scratch.step_one;
                 r1.clone_from(&self.step_one_rhs);
                 for c in &self.couplings {
-                    r1[c.free as usize] -= c.g.mul(targets[c.constraint as usize]);
+                    r1[c.free as usize] -= c.g.mul(step_one[c.constraint as usize]);
                 }
                 factor.solve_in_place(r1, &mut scratch.work);
                 for (&v, &p) in self.free.iter().zip(r1.iter()) {
@@ -130,10 +152,10 @@ impl Compiled {
                 }
             }
             StepOne::Product { base, columns } => {
-                let k = targets.len();
+                let k = step_one.len();
                 for ((&v, &u0), row) in self.free.iter().zip(base).zip(columns.chunks_exact(k)) {
                     let mut u = u0;
-                    for (c, &q) in row.iter().zip(targets) {
+                    for (c, &q) in row.iter().zip(step_one) {
                         u += c.mul(q);
                     }
                     out.step_one[v as usize] = u;
@@ -169,6 +191,9 @@ impl Compiled {
         two.solve_in_place(r2, &mut scratch.work);
 
         out.positions.clone_from(&out.step_one);
+        for (&v, &t) in self.constrained.iter().zip(targets) {
+            out.positions[v as usize] = t;
+        }
         for (&v, &p) in self.free.iter().zip(r2.iter()) {
             out.positions[v as usize] = p;
         }

@@ -98,3 +98,53 @@ fn painted_region_distorts_less() {
         "painted {painted}, unpainted {plain}"
     );
 }
+
+#[test]
+fn pins_added_where_a_solve_put_their_vertices_change_nothing() {
+    // The bar bent: its right end raised and moved in.
+    let (mesh, ends) = bar();
+    let registration = Registration::new(&mesh.rest, &mesh.triangles).expect("registers");
+    let targets = [
+        DVec2::new(0.0, 0.0),
+        DVec2::new(0.0, 4.0),
+        DVec2::new(18.0, 9.0),
+        DVec2::new(17.0, 13.0),
+    ];
+    let before = registration
+        .compile(&ends, None)
+        .and_then(|c| c.update(&targets))
+        .expect("poses");
+    // Pin a middle cell's corners (and, a few at a time, more) where the solve put
+    // them: step one's vertices at step one's answer, the final ones at the final one.
+    let id = |i: u32, j: u32| j * 25 + i;
+    for added in [
+        vec![id(12, 2)],
+        vec![id(8, 1), id(9, 1), id(8, 2), id(9, 2)],
+    ] {
+        let mut pinned = ends.to_vec();
+        pinned.extend(&added);
+        let compiled = registration.compile(&pinned, None).expect("compiles");
+        let order = compiled.constrained().to_vec();
+        let at =
+            |list: &[DVec2]| -> Vec<DVec2> { order.iter().map(|&v| list[v as usize]).collect() };
+        let mut after = arap::Deformation::default();
+        compiled
+            .update_split_into(&at(&before.step_one), &at(&before.positions), &mut after)
+            .expect("poses");
+        let worst = |a: &[DVec2], b: &[DVec2]| {
+            a.iter()
+                .zip(b)
+                .map(|(p, q)| p.distance(*q))
+                .fold(0.0, f64::max)
+        };
+        assert!(worst(&after.step_one, &before.step_one) < 1e-9);
+        assert!(worst(&after.positions, &before.positions) < 1e-9);
+        // Pinned at the final answer in both steps instead, the answer moves: step one
+        // needs its own.
+        let mut both = arap::Deformation::default();
+        compiled
+            .update_into(&at(&before.positions), &mut both)
+            .expect("poses");
+        assert!(worst(&both.positions, &before.positions) > 1e-3);
+    }
+}

@@ -1,12 +1,19 @@
-//! How much the picture jumps when a handle is inserted into a posed rig, as the editor
-//! inserts it (the picture point under the click, the pose's local rotation and
-//! scale there): the largest move of a mesh vertex outside the new handle's own cell,
-//! before against after, over insertions at fixed random places.
+//! How much the picture moves when a handle is inserted into a posed rig, or one is
+//! removed from it, as the editor does it (an insertion: the picture point under the
+//! click, the pose's local rotation and scale there).
 //!
-//! `cargo run --release -p editor --example insertion_jump -- [c2|arap] [INSERTIONS]`
+//! For each insertion (points, then bars, at fixed random places, each undone before
+//! the next) and each removal (every handle of the rig, each undone before the next):
+//! the largest move of a mesh vertex of the picture anywhere, and outside the new
+//! (removed) handle's neighbourhood — farther from it than twice the distance to its
+//! nearest other handle at rest (for an insertion under C², outside its own Voronoi
+//! cell too: the figure the paper's insertion is measured by).
+//!
+//! `cargo run --release -p editor --example insertion_jump -- [c2|arap|mls] [lizard|giraffe|spider] [INSERTIONS]`
+//! (`HOLDS=off`: ARAP's new pins hold nothing, as before they did)
 
 use glam::DVec2;
-use project::{HandleSpec, Method};
+use project::{HandleSpec, Method, Project};
 
 use editor::{Document, Edit};
 
@@ -20,18 +27,83 @@ impl Rng {
         self.0 ^= self.0 >> 27;
         self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
     }
+
+    fn unit(&mut self) -> f64 {
+        (self.next() >> 11) as f64 / (1u64 << 53) as f64
+    }
 }
 
-/// One insertion's jump, in pixels: outside the new handle's own cell, and near it
-/// (within twice the distance from it to its nearest node).
-type Jump = (f64, f64);
+/// One change's moves, in pixels: anywhere, away from the handle, and (insertions
+/// under C²) outside the new handle's own cell.
+#[derive(Clone, Copy, Default)]
+struct Jump {
+    anywhere: f64,
+    away: f64,
+    outside_cell: f64,
+}
+
+/// The largest moves between `before` and `after` (the picture's mesh), away from
+/// `at` (rest) beyond `reach`, and outside the vertices in `own`.
+fn jump(
+    before: &[DVec2],
+    after: &[DVec2],
+    rest: &[DVec2],
+    at: &[DVec2],
+    reach: f64,
+    own: &dyn Fn(usize) -> bool,
+) -> Jump {
+    let mut j = Jump::default();
+    for (i, (a, b)) in before.iter().zip(after).enumerate() {
+        let d = a.distance(*b);
+        j.anywhere = j.anywhere.max(d);
+        let near = at
+            .iter()
+            .any(|p| geometry::point_segment_distance(rest[i], *p, *p) < reach);
+        if !near {
+            j.away = j.away.max(d);
+        }
+        if !own(i) {
+            j.outside_cell = j.outside_cell.max(d);
+        }
+    }
+    j
+}
+
+/// The rest points of a handle (a point's, a bar's two ends and its middle).
+fn rest_points(h: &HandleSpec) -> Vec<DVec2> {
+    match *h {
+        HandleSpec::Point { rest, .. } => vec![DVec2::from(rest)],
+        HandleSpec::Bar { rest, .. } => {
+            let (a, b) = (DVec2::from(rest[0]), DVec2::from(rest[1]));
+            vec![a, (a + b) * 0.5, b]
+        }
+    }
+}
+
+/// Twice the distance from handle `i` to its nearest other handle, at rest.
+fn reach(project: &Project, i: usize) -> f64 {
+    let mine = rest_points(&project.handles[i]);
+    let nearest = project
+        .handles
+        .iter()
+        .enumerate()
+        .filter(|&(j, _)| j != i)
+        .flat_map(|(_, h)| rest_points(h))
+        .flat_map(|p| mine.iter().map(move |q| p.distance(*q)))
+        .fold(f64::INFINITY, f64::min);
+    2.0 * nearest.min(1e6)
+}
 
 /// The jumps of `insertions` point handles (and as many bars) inserted one at a time
-/// (each undone before the next) into `doc`'s posed rig, in pixels.
-fn jumps(doc: &mut Document, insertions: usize) -> (Vec<Jump>, Vec<Jump>) {
+/// (each undone before the next) into `doc`'s posed rig.
+fn insertion_jumps(doc: &mut Document, insertions: usize) -> (Vec<Jump>, Vec<Jump>) {
     let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
     let (mut points, mut bars) = (Vec::new(), Vec::new());
     let mut tries = 0;
+    let diagonal = {
+        let (w, h) = doc.image.dimensions();
+        f64::from(w).hypot(f64::from(h))
+    };
     while (points.len() < insertions || bars.len() < insertions) && tries < 50 * insertions {
         tries += 1;
         let n = doc.rig().domain().len();
@@ -42,7 +114,8 @@ fn jumps(doc: &mut Document, insertions: usize) -> (Vec<Jump>, Vec<Jump>) {
         let bar = points.len() >= insertions;
         let added = if bar {
             let (a, b) = (deformed[v], deformed[w]);
-            if a.distance(b) > 80.0 || a.distance(b) < 20.0 {
+            let length = a.distance(b);
+            if length > 0.1 * diagonal || length < 0.025 * diagonal {
                 continue;
             }
             editor_bar(doc, a, b)
@@ -52,9 +125,16 @@ fn jumps(doc: &mut Document, insertions: usize) -> (Vec<Jump>, Vec<Jump>) {
         if !added {
             continue;
         }
+        if std::env::var("HOLDS").is_ok_and(|v| v == "off") {
+            // How it was before ARAP's pins held what they are placed on.
+            let mut project = doc.project().clone();
+            project.holds.clear();
+            doc.restore(project).expect("without holds");
+        }
         let after = doc.deformed().to_vec();
+        let project = doc.project().clone();
+        let new = project.handles.len() - 1;
         let rig = doc.rig();
-        let new = doc.project().handles.len() - 1;
         let own: Vec<u32> = (0..rig.nodes().len())
             .filter(|&k| {
                 rig.owner_handle(k) == Some(new)
@@ -62,63 +142,59 @@ fn jumps(doc: &mut Document, insertions: usize) -> (Vec<Jump>, Vec<Jump>) {
             })
             .map(|k| k as u32)
             .collect();
-        let cells = rig.cells();
-        let (jump, at) = deformed
-            .iter()
-            .zip(&after)
-            .enumerate()
-            .filter(|(i, _)| !own.contains(&cells[*i]))
-            .map(|(i, (a, b))| (a.distance(*b), i))
-            .fold((0.0, 0), |m, x| if x.0 > m.0 { x } else { m });
-        if std::env::var("WHERE").is_ok() {
-            // Where the largest move is, how far from the new handle.
-            let rest = rig.domain().positions();
-            let node = rig.nodes()[own[0] as usize].vertex as usize;
-            eprintln!(
-                "jump {jump:.1} at {:.0?}, {:.0} px from the new handle; virtual {} -> {}",
-                rest[at],
-                rest[at].distance(rest[node]),
-                snapshot.virtual_handles.len(),
-                rig.virtual_vertices().len()
-            );
-        }
-        // Near the new handle: within twice the distance from it to its nearest node.
-        let rest = rig.domain().positions();
-        let node = rest[rig.nodes()[own[0] as usize].vertex as usize];
-        let reach = rig
-            .nodes()
-            .iter()
-            .enumerate()
-            .filter(|(k, _)| !own.contains(&(*k as u32)))
-            .map(|(_, n)| rest[n.vertex as usize].distance(node))
-            .fold(f64::INFINITY, f64::min);
-        let near = deformed
-            .iter()
-            .zip(&after)
-            .enumerate()
-            .filter(|(i, _)| !own.contains(&cells[*i]) && rest[*i].distance(node) < 2.0 * reach)
-            .map(|(_, (a, b))| a.distance(*b))
-            .fold(0.0, f64::max);
+        let cells = rig.cells().to_vec();
+        let rest = rig.domain().positions().to_vec();
+        let j = jump(
+            &deformed,
+            &after,
+            &rest,
+            &rest_points(&project.handles[new]),
+            reach(&project, new),
+            &|i| own.contains(&cells[i]),
+        );
         if bar {
-            bars.push((jump, near));
+            bars.push(j);
         } else {
-            points.push((jump, near));
+            points.push(j);
         }
         doc.undo_to(snapshot).expect("undo");
     }
     (points, bars)
 }
 
+/// The jumps of removing each of `doc`'s handles from its posed rig (each undone).
+fn removal_jumps(doc: &mut Document) -> Vec<Jump> {
+    let count = doc.project().handles.len();
+    let mut jumps = Vec::new();
+    for i in 0..count {
+        let project = doc.project().clone();
+        let before = doc.deformed().to_vec();
+        let snapshot = doc.snapshot();
+        if doc.apply(Edit::Remove(i)).is_err() {
+            continue;
+        }
+        let after = doc.deformed().to_vec();
+        let rest = doc.rig().domain().positions().to_vec();
+        let j = jump(
+            &before,
+            &after,
+            &rest,
+            &rest_points(&project.handles[i]),
+            reach(&project, i),
+            &|_| false,
+        );
+        jumps.push(j);
+        doc.undo_to(snapshot).expect("undo");
+    }
+    jumps
+}
+
 /// What `EditorApp::add_point` does.
 fn editor_point(doc: &mut Document, at: DVec2) -> bool {
-    let Some((rest, rotate, scale)) = doc.unwarp(at) else {
+    let Some((rest, _, _)) = doc.unwarp(at) else {
         return false;
     };
-    let (rotate, scale) = if std::env::var("TRIANGLE").is_ok() {
-        (rotate, scale)
-    } else {
-        doc.local_pose(rest, at)
-    };
+    let (rotate, scale) = doc.local_pose(rest, at);
     let handle = HandleSpec::Point {
         rest: rest.to_array(),
         translate: (at - rest).to_array(),
@@ -142,48 +218,84 @@ fn editor_bar(doc: &mut Document, a: DVec2, b: DVec2) -> bool {
     doc.apply(Edit::Add(handle)).is_ok()
 }
 
-fn summary(name: &str, jumps: Vec<Jump>) {
-    let mut v: Vec<f64> = jumps.iter().map(|j| j.0).collect();
-    let mut n: Vec<f64> = jumps.iter().map(|j| j.1).collect();
-    n.sort_by(f64::total_cmp);
-    if !n.is_empty() {
-        let at = |q: f64| n[((n.len() - 1) as f64 * q).round() as usize];
-        println!(
-            "  {name} near the new handle: median {:.2} px, p90 {:.2} px, largest {:.2} px",
-            at(0.5),
-            at(0.9),
-            at(1.0)
-        );
+/// Median, 90th percentile and largest of `values`.
+fn spread(mut values: Vec<f64>) -> String {
+    if values.is_empty() {
+        return "none".to_owned();
     }
-    v.sort_by(f64::total_cmp);
-    if v.is_empty() {
-        println!("  {name}: none");
-        return;
-    }
-    let at = |q: f64| v[((v.len() - 1) as f64 * q).round() as usize];
-    println!(
-        "  {name} ({}): median {:.2} px, p90 {:.2} px, largest {:.2} px",
-        v.len(),
-        at(0.5),
-        at(0.9),
-        at(1.0)
+    values.sort_by(f64::total_cmp);
+    let at = |q: f64| values[((values.len() - 1) as f64 * q).round() as usize];
+    format!("{:.2} / {:.2} / {:.2}", at(0.5), at(0.9), at(1.0))
+}
+
+fn summary(name: &str, jumps: &[Jump], cells: bool) {
+    let pick = |f: fn(&Jump) -> f64| spread(jumps.iter().map(f).collect());
+    print!(
+        "  {name} ({}): anywhere {} px; away {} px",
+        jumps.len(),
+        pick(|j| j.anywhere),
+        pick(|j| j.away)
     );
+    if cells {
+        print!("; outside its cell {} px", pick(|j| j.outside_cell));
+    }
+    println!("   (median / p90 / largest)");
+}
+
+/// A document on `name`'s picture with a posed rig: the lizard's sample rig, or seven
+/// point handles spread over the shape and moved, turned and scaled a little.
+fn document(name: &str) -> anyhow::Result<Document> {
+    if name == "lizard" {
+        return Document::built_in();
+    }
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../assets")
+        .join(format!("{name}.png"));
+    let image = pipeline::load_image(&path)?;
+    let mut doc = Document::new(image, Some(path), Project::default())?;
+    let diagonal = {
+        let (w, h) = doc.image.dimensions();
+        f64::from(w).hypot(f64::from(h))
+    };
+    let mut rng = Rng(0x51_7cc1_b727_220a);
+    let rest = doc.rig().domain().positions().to_vec();
+    let mut placed: Vec<DVec2> = Vec::new();
+    while placed.len() < 7 {
+        let p = rest[(rng.next() % rest.len() as u64) as usize];
+        if placed.iter().all(|q| q.distance(p) > 0.15 * diagonal) {
+            placed.push(p);
+        }
+    }
+    for p in placed {
+        let offset = DVec2::new(rng.unit() - 0.5, rng.unit() - 0.5) * 0.12 * diagonal;
+        doc.apply(Edit::Add(HandleSpec::Point {
+            rest: p.to_array(),
+            translate: offset.to_array(),
+            rotate: (rng.unit() - 0.5) * 0.6,
+            scale: 1.0,
+            depth: 0,
+        }))?;
+    }
+    Ok(doc)
 }
 
 fn main() -> anyhow::Result<()> {
-    let method = match std::env::args().nth(1).as_deref() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let method = match args.first().map(String::as_str) {
         Some("arap") => Method::Arap,
+        Some("mls") => Method::Mls,
         _ => Method::C2,
     };
-    let insertions: usize = std::env::args()
-        .nth(2)
-        .and_then(|n| n.parse().ok())
-        .unwrap_or(24);
-    let mut doc = Document::built_in()?;
+    let picture = args.get(1).map_or("lizard", String::as_str);
+    let insertions: usize = args.get(2).and_then(|n| n.parse().ok()).unwrap_or(24);
+    let mut doc = document(picture)?;
     doc.apply(Edit::Method(method))?;
-    let (points, bars) = jumps(&mut doc, insertions);
-    println!("built-in lizard, posed, {}:", method.label());
-    summary("points", points);
-    summary("bars", bars);
+    let (points, bars) = insertion_jumps(&mut doc, insertions);
+    let removals = removal_jumps(&mut doc);
+    let c2 = method == Method::C2;
+    println!("{picture}, posed, {}:", method.label());
+    summary("points inserted", &points, c2);
+    summary("bars inserted", &bars, c2);
+    summary("handles removed", &removals, false);
     Ok(())
 }

@@ -399,15 +399,17 @@ impl Document {
                     }
                 }
                 project.handles.push(handle);
+                // Placed in a posed state, it holds the picture where it is (ARAP).
+                let index = project.handles.len() - 1;
+                if let Some(hold) = self.deformer().hold(&project, index) {
+                    project.holds.push(hold);
+                }
             }
             Edit::Remove(index) => {
                 if index >= project.handles.len() {
                     bail!("there is no handle {index}");
                 }
-                project.handles.remove(index);
-                if let Some(animation) = &mut project.animation {
-                    animation.remove_handle(index);
-                }
+                project.remove_handle(index);
             }
             Edit::Pose(index, handle) => match project.handles.get_mut(index) {
                 Some(slot) if same_rest(slot, &handle) => *slot = handle,
@@ -416,6 +418,7 @@ impl Document {
             },
             Edit::Clear => {
                 project.handles.clear();
+                project.holds.clear();
                 if let Some(animation) = &mut project.animation {
                     animation.poses_mut().for_each(|pose| pose.handles.clear());
                 }
@@ -424,6 +427,8 @@ impl Document {
                 for h in &mut project.handles {
                     *h = at_rest(h);
                 }
+                // At rest, nothing is held away from it.
+                project.holds.clear();
             }
             Edit::Settings(settings) => settings.write_to(&mut project),
             Edit::Method(method)

@@ -206,6 +206,11 @@ pub struct ArapRig {
     rigidity: Vec<f64>,
     /// The pinned ARAP vertices, each with the handle that pins it, by vertex.
     pins: Vec<(u32, usize)>,
+    /// What handles placed in a posed state hold (the rig file's `holds`).
+    holds: Vec<project::Hold>,
+    /// For each pin, where its handle holds it in its own frame (final, step one)
+    /// when the handle holds the picture as it was placed; `None`: its rest position.
+    held: Vec<Option<(DVec2, DVec2)>>,
     compiled: Arc<arap::Compiled>,
     pose: arap::Deformation,
     /// The picture's vertices in the current pose (with ARAP on the picture's own
@@ -305,7 +310,9 @@ impl ArapRig {
             handles: handles.to_vec(),
             strokes: rigidity_strokes.to_vec(),
             rigidity,
+            held: vec![None; pins.len()],
             pins,
+            holds: Vec::new(),
             compiled,
             pose: arap::Deformation::default(),
             positions: Vec::new(),
@@ -334,13 +341,15 @@ impl ArapRig {
     ) -> Result<Self> {
         let handles = crate::handles(project);
         let (domain, strokes) = (rig.domain().clone(), &project.rigidity);
-        match picture {
+        let mut arap = match picture {
             Some(picture) => {
                 let options = ArapOptions::for_picture(project, picture);
-                Self::with_own_mesh(picture, domain, &handles, strokes, options)
+                Self::with_own_mesh(picture, domain, &handles, strokes, options)?
             }
-            None => Self::new(domain, &handles, strokes, ArapOptions::of(project, None)),
-        }
+            None => Self::new(domain, &handles, strokes, ArapOptions::of(project, None))?,
+        };
+        arap.set_handles_and_holds(&handles, &project.holds)?;
+        Ok(arap)
     }
 
     /// The picture's mesh at rest (what is drawn).
@@ -424,20 +433,44 @@ impl ArapRig {
         &self.strokes
     }
 
-    /// Takes new handles: a new pose of the same pins only updates; other pins
-    /// recompile. On error nothing changes.
+    /// Takes new handles (the holds kept): a new pose of the same pins only updates;
+    /// other pins recompile. On error nothing changes.
     ///
     /// # Errors
     /// Handles that cannot be pinned (non-finite, off the mesh), or a failed
     /// factorisation.
     pub fn set_handles(&mut self, handles: &[Handle]) -> Result<()> {
+        let holds = self.holds.clone();
+        self.set_handles_and_holds(handles, &holds)
+    }
+
+    /// Takes new handles and what those placed in a posed state hold (a rig file's
+    /// `holds`, whose indices name `handles`): a new pose of the same pins and holds
+    /// only updates; other pins recompile. On error nothing changes.
+    ///
+    /// # Errors
+    /// As [`ArapRig::set_handles`].
+    pub fn set_handles_and_holds(
+        &mut self,
+        handles: &[Handle],
+        holds: &[project::Hold],
+    ) -> Result<()> {
         let pins = pins(
             self.arap_mesh(),
             &self.registration,
             handles,
             self.options.pin_radius,
         )?;
-        let old = std::mem::replace(&mut self.handles, handles.to_vec());
+        let held = if pins == self.pins && holds == self.holds {
+            self.held.clone()
+        } else {
+            held_places(self.arap_mesh(), &pins, holds)
+        };
+        let old = (
+            std::mem::replace(&mut self.handles, handles.to_vec()),
+            std::mem::replace(&mut self.holds, holds.to_vec()),
+            std::mem::replace(&mut self.held, held),
+        );
         let result = if pins == self.pins {
             self.update()
         } else {
@@ -458,23 +491,74 @@ impl ArapRig {
             }
         };
         if result.is_err() {
-            self.handles = old;
+            (self.handles, self.holds, self.held) = old;
             // The previous pose stands; recompute it so the buffers match it.
             let _ = self.update();
         }
         result
     }
 
+    /// What handle `index` of `handles` (just placed, in the pose the rig shows now)
+    /// must hold so that the picture stays where it is: the ARAP vertices it pins,
+    /// where the current solve puts them (both steps' answers), in the handle's own
+    /// frame. `None` when the current solve has them where the handle's pose takes
+    /// their rest positions anyway (at rest, or a pose the handle follows exactly).
+    ///
+    /// # Errors
+    /// Handles that cannot be pinned.
+    pub fn hold_for(&self, handles: &[Handle], index: usize) -> Result<Option<project::Hold>> {
+        let Some(handle) = handles.get(index) else {
+            return Ok(None);
+        };
+        let Some(inverse) = handle_affine(handle).and_then(invert) else {
+            return Ok(None);
+        };
+        let pins = pins(
+            self.arap_mesh(),
+            &self.registration,
+            handles,
+            self.options.pin_radius,
+        )?;
+        let rest = self.arap_mesh().positions();
+        let (final_now, one_now) = (&self.pose.positions, &self.pose.step_one);
+        let mut hold = project::Hold {
+            handle: index,
+            rest: Vec::new(),
+            at: Vec::new(),
+            step_one: Vec::new(),
+        };
+        // How far from its rest place a point may be before it counts as held away.
+        let tiny = 1e-9 * self.arap_mesh().mean_edge_length().max(1.0);
+        let mut away = false;
+        for &(v, h) in &pins {
+            let v = v as usize;
+            if h != index || v >= final_now.len() || v >= one_now.len() {
+                continue;
+            }
+            let at = inverse.transform_point2(final_now[v]);
+            let one = inverse.transform_point2(one_now[v]);
+            away |= at.distance(rest[v]) > tiny || one.distance(rest[v]) > tiny;
+            hold.rest.push(rest[v].to_array());
+            hold.at.push(at.to_array());
+            hold.step_one.push(one.to_array());
+        }
+        Ok(away.then_some(hold))
+    }
+
     /// Poses the compiled system for the current handles, and the picture with it.
     fn update(&mut self) -> Result<()> {
         let clock = Instant::now();
         let positions = self.arap_mesh().positions();
-        let targets: Vec<DVec2> = self
-            .pins
-            .iter()
-            .map(|&(v, h)| handle_map(&self.handles[h], positions[v as usize]))
-            .collect();
-        self.compiled.update_into(&targets, &mut self.pose)?;
+        let (mut one, mut targets) = (Vec::new(), Vec::new());
+        for (&(v, h), held) in self.pins.iter().zip(&self.held) {
+            let handle = &self.handles[h];
+            let rest = positions[v as usize];
+            let (at, at_one) = held.unwrap_or((rest, rest));
+            targets.push(handle_map(handle, at));
+            one.push(handle_map(handle, at_one));
+        }
+        self.compiled
+            .update_split_into(&one, &targets, &mut self.pose)?;
         match &self.control {
             Some(control) => control.follow(&self.pose.positions, &mut self.positions),
             None => self.positions.clone_from(&self.pose.positions),
@@ -503,7 +587,7 @@ impl Deformer for ArapRig {
         }
         let before = (self.strokes.clone(), self.handles.clone());
         self.set_rigidity(&project.rigidity)?;
-        if let Err(e) = self.set_handles(&crate::handles(project)) {
+        if let Err(e) = self.set_handles_and_holds(&crate::handles(project), &project.holds) {
             // Leave it as it was: the old rigidity with the old handles.
             let _ = self.set_rigidity(&before.0);
             return Err(e);
@@ -517,6 +601,12 @@ impl Deformer for ArapRig {
 
     fn output(&self) -> Output<'_> {
         Output::Positions(&self.positions)
+    }
+
+    fn hold(&self, project: &Project, index: usize) -> Option<project::Hold> {
+        self.hold_for(&crate::handles(project), index)
+            .ok()
+            .flatten()
     }
 
     fn weights(&self, _listing: WeightsListing) -> Result<serde_json::Value> {
@@ -620,6 +710,104 @@ pub fn handle_map(handle: &Handle, p: DVec2) -> DVec2 {
             Similarity::from_segments(c, rest, pose).apply(c, p)
         }
     }
+}
+
+/// A handle's map ([`handle_map`]) as an affine transform of the plane (`None` for a
+/// bar whose posed ends coincide).
+fn handle_affine(handle: &Handle) -> Option<glam::DAffine2> {
+    match *handle {
+        Handle::Point { rest, transform } => Some(transform.to_affine(rest)),
+        Handle::Bar { rest, pose } => {
+            let c = (rest[0] + rest[1]) * 0.5;
+            Some(Similarity::from_segments(c, rest, pose).to_affine(c))
+        }
+    }
+}
+
+/// `map`'s inverse, when it has one.
+fn invert(map: glam::DAffine2) -> Option<glam::DAffine2> {
+    let det = map.matrix2.determinant();
+    (det.is_finite() && det.abs() > 1e-300).then(|| map.inverse())
+}
+
+/// For each of `pins`, where its handle holds it (final, step one), from `holds`: the
+/// hold's own entry for the vertex at that rest position, or — on another mesh of
+/// ARAP's (a new `arap.density`) — the affine map that best fits the hold's points,
+/// applied to the vertex's rest position. `None` for a handle that holds nothing.
+fn held_places(
+    mesh: &Domain,
+    pins: &[(u32, usize)],
+    holds: &[project::Hold],
+) -> Vec<Option<(DVec2, DVec2)>> {
+    let positions = mesh.positions();
+    let key = |p: [f64; 2]| (p[0].to_bits(), p[1].to_bits());
+    let mut by_handle: std::collections::HashMap<usize, HeldLookup> = Default::default();
+    for hold in holds {
+        let entries = hold
+            .rest
+            .iter()
+            .enumerate()
+            .map(|(i, &r)| (key(r), i))
+            .collect();
+        let fit = |to: &[[f64; 2]]| fit_affine(&hold.rest, to);
+        by_handle.insert(
+            hold.handle,
+            HeldLookup {
+                entries,
+                hold,
+                fits: (fit(&hold.at), fit(&hold.step_one)),
+            },
+        );
+    }
+    pins.iter()
+        .map(|&(v, h)| {
+            let lookup = by_handle.get(&h)?;
+            let rest = positions[v as usize];
+            match lookup.entries.get(&key(rest.to_array())) {
+                Some(&i) => Some((
+                    DVec2::from(lookup.hold.at[i]),
+                    DVec2::from(lookup.hold.step_one[i]),
+                )),
+                None => Some((
+                    lookup.fits.0.transform_point2(rest),
+                    lookup.fits.1.transform_point2(rest),
+                )),
+            }
+        })
+        .collect()
+}
+
+/// A hold, looked up by its points' rest positions, with the affine fits of its
+/// points (final, step one) for vertices it does not list.
+struct HeldLookup<'a> {
+    entries: std::collections::HashMap<(u64, u64), usize>,
+    hold: &'a project::Hold,
+    fits: (glam::DAffine2, glam::DAffine2),
+}
+
+/// The affine map that takes `from` nearest `to` in least squares (a translation for
+/// fewer than three points or points on a line; the identity for none).
+fn fit_affine(from: &[[f64; 2]], to: &[[f64; 2]]) -> glam::DAffine2 {
+    let n = from.len().min(to.len());
+    if n == 0 {
+        return glam::DAffine2::IDENTITY;
+    }
+    let mean =
+        |pts: &[[f64; 2]]| pts[..n].iter().map(|&p| DVec2::from(p)).sum::<DVec2>() / n as f64;
+    let (cf, ct) = (mean(from), mean(to));
+    // Normal equations of x ↦ A (x − cf) + ct.
+    let (mut xx, mut xy) = (glam::DMat2::ZERO, glam::DMat2::ZERO);
+    for (&f, &t) in from[..n].iter().zip(&to[..n]) {
+        let (f, t) = (DVec2::from(f) - cf, DVec2::from(t) - ct);
+        xx += glam::DMat2::from_cols(f * f.x, f * f.y);
+        xy += glam::DMat2::from_cols(t * f.x, t * f.y);
+    }
+    let linear = if xx.determinant().abs() > 1e-12 * (1.0 + xx.x_axis.x + xx.y_axis.y).powi(2) {
+        xy * xx.inverse()
+    } else {
+        glam::DMat2::IDENTITY
+    };
+    glam::DAffine2::from_mat2_translation(linear, ct - linear * cf)
 }
 
 /// The vertices of `mesh` the handles pin (see [`ArapRig`]), each with its handle,

@@ -542,7 +542,33 @@ pub struct Project {
     /// Key poses in time and on the canvas.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub animation: Option<Animation>,
+    /// What handles placed in a posed state hold (ARAP): the picture under each as it
+    /// was when it was placed, so that placing it moved nothing. See [`Hold`].
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub holds: Vec<Hold>,
 }
+
+/// What a handle placed in a posed state holds (ARAP): the points of ARAP's mesh it
+/// pins, with where the picture had them when it was placed — in the handle's own
+/// frame (its pose then undone), for step one's result and for the final one. While
+/// the handle is posed, each point is pinned to where the handle's pose takes its
+/// held place rather than its rest position; at the pose it was placed in, that is
+/// exactly where the picture was, so the solve's answer does not change.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Hold {
+    /// The handle (an index into [`Project::handles`]).
+    pub handle: usize,
+    /// The points' rest positions (ARAP's mesh vertices), image pixels.
+    pub rest: Vec<[f64; 2]>,
+    /// Where each was when the handle was placed, in the handle's frame.
+    pub at: Vec<[f64; 2]>,
+    /// The same for step one's result of the two-step solve (the scale-free fit).
+    pub step_one: Vec<[f64; 2]>,
+}
+
+/// The most points a [`Hold`] may list.
+pub const MAX_HOLD_POINTS: usize = 100_000;
 
 fn is_c2(method: &Method) -> bool {
     *method == Method::C2
@@ -571,6 +597,7 @@ impl Default for Project {
             mls: None,
             canvas: Canvas::Keep,
             animation: None,
+            holds: Vec::new(),
         }
     }
 }
@@ -638,6 +665,25 @@ fn field_prefix(path: &str) -> String {
 }
 
 impl Project {
+    /// Removes handle `index` with what belongs to it: its track in every key and its
+    /// hold (the holds of the handles after it are renumbered). Nothing happens for an
+    /// index past the end.
+    pub fn remove_handle(&mut self, index: usize) {
+        if index >= self.handles.len() {
+            return;
+        }
+        self.handles.remove(index);
+        if let Some(animation) = &mut self.animation {
+            animation.remove_handle(index);
+        }
+        self.holds.retain(|h| h.handle != index);
+        for hold in &mut self.holds {
+            if hold.handle > index {
+                hold.handle -= 1;
+            }
+        }
+    }
+
     /// Parses and validates (without an image size) a project from JSON text. A
     /// leading UTF-8 byte-order mark is ignored.
     ///
@@ -729,6 +775,40 @@ impl Project {
                 return bad(format!(
                     "virtual handle {i} was placed for handle {h}, but there are {} handles",
                     self.handles.len()
+                ));
+            }
+        }
+        let mut held = std::collections::BTreeSet::new();
+        for (i, hold) in self.holds.iter().enumerate() {
+            if hold.handle >= self.handles.len() || !held.insert(hold.handle) {
+                return bad(format!(
+                    "holds[{i}] names handle {}: there are {} handles, each held once at most",
+                    hold.handle,
+                    self.handles.len()
+                ));
+            }
+            let n = hold.rest.len();
+            if hold.at.len() != n || hold.step_one.len() != n || n > MAX_HOLD_POINTS {
+                return bad(format!(
+                    "holds[{i}]: rest, at and step_one must list the same points (at most \
+                     {MAX_HOLD_POINTS}), got {}, {} and {}",
+                    n,
+                    hold.at.len(),
+                    hold.step_one.len()
+                ));
+            }
+            let numbers = hold
+                .rest
+                .iter()
+                .chain(&hold.at)
+                .chain(&hold.step_one)
+                .flatten();
+            if numbers
+                .clone()
+                .any(|x| !x.is_finite() || x.abs() > MAX_POSE)
+            {
+                return bad(format!(
+                    "holds[{i}]: coordinates must be finite numbers within ±{MAX_POSE:e} pixels"
                 ));
             }
         }
@@ -911,6 +991,41 @@ impl Project {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn holds_are_checked_and_follow_their_handles() {
+        let text = r#"{"version":1,"handles":[
+            {"type":"point","rest":[10,10]},{"type":"point","rest":[30,10]},
+            {"type":"point","rest":[50,10]}],
+          "holds":[{"handle":1,"rest":[[30,10]],"at":[[31,12]],"step_one":[[31,11]]},
+                   {"handle":2,"rest":[[50,10]],"at":[[52,10]],"step_one":[[52,10]]}]}"#;
+        let mut project = Project::from_json(text).expect("a rig with holds");
+        assert_eq!(
+            Project::from_json(&project.to_json()).expect("round trip"),
+            project
+        );
+        project.remove_handle(1);
+        assert_eq!(project.holds.len(), 1);
+        assert_eq!(project.holds[0].handle, 1, "renumbered with its handle");
+        for (bad, says) in [
+            (
+                text.replace(r#""handle":2"#, r#""handle":7"#),
+                "names handle 7",
+            ),
+            (
+                text.replace(r#""handle":2"#, r#""handle":1"#),
+                "held once at most",
+            ),
+            (
+                text.replace("[[52,10]],\"step_one", "[],\"step_one"),
+                "same points",
+            ),
+            (text.replace("[[31,12]]", "[[31,1e300]]"), "finite numbers"),
+        ] {
+            let error = Project::from_json(&bad).expect_err(says).to_string();
+            assert!(error.contains(says), "{error}");
+        }
+    }
 
     fn sample() -> Project {
         Project {

@@ -157,6 +157,101 @@ fn a_handle_inserted_under_a_similarity_takes_it_and_nothing_moves() {
 }
 
 #[test]
+fn under_arap_a_pin_placed_in_a_bent_pose_holds_the_picture_where_it_is() {
+    let mut doc = document();
+    doc.apply(Edit::Method(Method::Arap)).expect("method");
+    doc.apply(Edit::Add(point(30.0, 24.0)))
+        .expect("a third pin");
+    // Bend it: one end pulled and turned, no similarity of the whole.
+    doc.apply(Edit::Pose(
+        1,
+        HandleSpec::Point {
+            rest: [50.0, 30.0],
+            translate: [6.0, 9.0],
+            rotate: 0.5,
+            scale: 1.0,
+            depth: 0,
+        },
+    ))
+    .expect("pose");
+    for (i, (x, y)) in [(36.0, 6.0), (14.0, 40.0), (44.0, 44.0)]
+        .into_iter()
+        .enumerate()
+    {
+        let before = doc.deformed().to_vec();
+        let at = DVec2::new(x, y);
+        let (rest, _, _) = doc.unwarp(at).expect("on the picture");
+        let (rotate, scale) = doc.local_pose(rest, at);
+        let new = HandleSpec::Point {
+            rest: rest.to_array(),
+            translate: (at - rest).to_array(),
+            rotate,
+            scale,
+            depth: 0,
+        };
+        doc.apply(Edit::Add(new)).expect("insert");
+        let jump = before
+            .iter()
+            .zip(doc.deformed())
+            .map(|(a, b)| a.distance(*b))
+            .fold(0.0, f64::max);
+        assert!(jump < 1e-6, "insertion {i}: the picture moved by {jump} px");
+        assert_eq!(
+            doc.project().holds.len(),
+            i + 1,
+            "it holds what is under it"
+        );
+        // Saved and reopened, it shows the same.
+        doc.check_reopens().expect("reopens as shown");
+    }
+    // The held pin follows its own motion afterwards.
+    let last = doc.project().handles.len() - 1;
+    let moved = match doc.project().handles[last].clone() {
+        HandleSpec::Point {
+            rest,
+            translate,
+            rotate,
+            scale,
+            depth,
+        } => HandleSpec::Point {
+            rest,
+            translate: [translate[0] + 4.0, translate[1]],
+            rotate,
+            scale,
+            depth,
+        },
+        bar => bar,
+    };
+    let before = doc.deformed().to_vec();
+    doc.apply(Edit::Pose(last, moved)).expect("pose");
+    let shift = before
+        .iter()
+        .zip(doc.deformed())
+        .map(|(a, b)| a.distance(*b))
+        .fold(0.0, f64::max);
+    assert!(shift > 3.0, "the held pin moves what it holds ({shift})");
+    // Removing a pin renumbers the holds after it; a reset lets go of them all.
+    doc.apply(Edit::Remove(3)).expect("remove");
+    assert_eq!(
+        doc.project()
+            .holds
+            .iter()
+            .map(|h| h.handle)
+            .collect::<Vec<_>>(),
+        [3, 4]
+    );
+    doc.apply(Edit::ResetPose).expect("reset");
+    assert!(doc.project().holds.is_empty());
+    let rest = doc.rig().domain().positions().to_vec();
+    let off = rest
+        .iter()
+        .zip(doc.deformed())
+        .map(|(a, b)| a.distance(*b))
+        .fold(0.0, f64::max);
+    assert!(off < 1e-9, "at rest after a reset ({off})");
+}
+
+#[test]
 fn a_new_handle_fits_the_pose_around_it_not_one_triangle() {
     // A picture sheared around the new handle: the pose there is no similarity, and
     // the fitted one is the least-squares similarity of the vertices within reach,
