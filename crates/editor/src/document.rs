@@ -14,7 +14,6 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use geometry::segment_distance;
 use glam::DVec2;
 use image::RgbaImage;
 use pipeline::cage::CageCoordinates;
@@ -390,7 +389,6 @@ impl Document {
         let mut project = self.project.clone();
         match edit {
             Edit::Add(handle) => {
-                self.check_room(&handle)?;
                 // Every key gets the new handle where its pose takes it.
                 let fitted = self.fit_into_keys(&handle)?;
                 if let Some(animation) = &mut project.animation {
@@ -513,29 +511,6 @@ impl Document {
         Ok(())
     }
 
-    /// Refuses a new handle closer to an existing one than two mesh edges: nodes one
-    /// edge apart leave no room for graded virtual handles between them, and Algorithm 1
-    /// would turn nearly every sample into a node.
-    fn check_room(&self, handle: &HandleSpec) -> Result<()> {
-        let room = 2.0 * self.rig.domain().mean_edge_length();
-        let segment = |h: &HandleSpec| match *h {
-            HandleSpec::Point { rest, .. } => [DVec2::from(rest); 2],
-            HandleSpec::Bar { rest, .. } => rest.map(DVec2::from),
-        };
-        let new = segment(handle);
-        for (i, other) in self.project.handles.iter().enumerate() {
-            let d = segment_distance(new, segment(other));
-            if d < room {
-                bail!(
-                    "too close to handle {}: at this mesh density handles need {room:.1} px \
-                     between them (raise the density for finer work)",
-                    i + 1
-                );
-            }
-        }
-        Ok(())
-    }
-
     /// Makes `project` (same picture) the document's rig file, updating the rig as
     /// cheaply as the difference allows: poses only, handles added or removed
     /// incrementally, a rebuild for new parameters, a re-mesh for a new density.
@@ -593,11 +568,25 @@ impl Document {
             .handles
             .iter()
             .map(HandleSpec::depth));
-        if new.density != old.density {
+        // Handles that crowd together refine the mesh around them (the C² paper's
+        // up-sampling): another set of crowded handles is another mesh.
+        let (w, h) = self.image.dimensions();
+        let refined =
+            |p: &Project| pipeline::crowding::refinement(p, w, h, Settings::of(p).density);
+        let refinement_changed = refined(&project) != refined(&self.project);
+        if new.density != old.density || refinement_changed {
             let mut with_virtuals = project.clone();
             if exact {
                 with_virtuals.virtual_handles = virtuals;
                 with_virtuals.virtual_placed_for = placed_for;
+            } else if new.density == old.density {
+                // The same lattice: the virtual handles stay where they were (those
+                // placed for a handle that is gone go with it), and Algorithm 1 adds
+                // what the new handles need.
+                (
+                    with_virtuals.virtual_handles,
+                    with_virtuals.virtual_placed_for,
+                ) = carried_virtuals(&self.snapshot(), &project);
             }
             self.rig = pipeline::prepare(&self.image, &with_virtuals, None)?.rig;
             self.mesh_version += 1;
@@ -800,6 +789,46 @@ pub(crate) fn locate(
         let eps = -1e-9;
         (u >= eps && v >= eps && w >= eps).then_some(([a, b, c], [u, v, w]))
     })
+}
+
+/// The virtual handles of `from` (a snapshot) that go on into `to`, a rig file for
+/// the same picture whose handles are `from`'s with some added or removed: every
+/// virtual handle, except those placed for a handle `to` no longer has, each naming
+/// its handle's index in `to`.
+fn carried_virtuals(from: &Project, to: &Project) -> (Vec<[f64; 2]>, Vec<Option<usize>>) {
+    // Old handle → new index, matching handles of the same rest geometry in order.
+    let mut next = 0;
+    let index: Vec<Option<usize>> = from
+        .handles
+        .iter()
+        .map(|h| {
+            let found = (next..to.handles.len()).find(|&j| same_rest(h, &to.handles[j]));
+            if let Some(j) = found {
+                next = j + 1;
+            }
+            found
+        })
+        .collect();
+    let mut kept = (Vec::new(), Vec::new());
+    for (i, &p) in from.virtual_handles.iter().enumerate() {
+        let placed = from.virtual_placed_for.get(i).copied().flatten();
+        match placed {
+            Some(h) => {
+                if let Some(j) = index.get(h).copied().flatten() {
+                    kept.0.push(p);
+                    kept.1.push(Some(j));
+                }
+            }
+            None => {
+                kept.0.push(p);
+                kept.1.push(None);
+            }
+        }
+    }
+    if kept.1.iter().all(Option::is_none) {
+        kept.1.clear();
+    }
+    kept
 }
 
 /// Whether two handles have the same kind and rest geometry.

@@ -36,6 +36,13 @@ pub struct MeshOptions {
     /// angles of the input (sharp outline corners, constraints close to each other).
     /// Clamped to `[0, 33]`; NaN means the default. Default 25.
     pub min_angle_deg: f64,
+    /// Points where the mesh is refined locally (the picture's handles that sit closer
+    /// together than its spacing, with rings around them): each becomes a vertex at
+    /// exactly its coordinates, and the lattice keeps clear of it, as a constraint point
+    /// does; one off the domain is left out. They play no part in the lattice's
+    /// spacing, so every lattice point away from them is where it is without them.
+    /// Default none.
+    pub refine: Vec<DVec2>,
 }
 
 impl Default for MeshOptions {
@@ -43,6 +50,7 @@ impl Default for MeshOptions {
         MeshOptions {
             target_vertices: 20_000,
             min_angle_deg: 25.0,
+            refine: Vec::new(),
         }
     }
 }
@@ -253,16 +261,32 @@ pub fn triangulate(
     }
 
     // --- Seed vertices, calibrating the spacing once -------------------------------
-    let mut seeds = Seeds::build(domain, constraints, &bands, s, extent);
+    let mut seeds = Seeds::build(domain, constraints, &[], &bands, s, extent);
     let n0 = seeds.vertices.len() as f64;
-    if opts.target_vertices > 0 && (n0 / target - 1.0).abs() > 0.03 && seeds.lattice_count > 0 {
+    let mut bands = bands;
+    let calibrate =
+        opts.target_vertices > 0 && (n0 / target - 1.0).abs() > 0.03 && seeds.lattice_count > 0;
+    if calibrate {
         // The boundary and constraints take vertices too; shrink or grow the lattice.
         let fixed = (seeds.vertices.len() - seeds.lattice_count) as f64;
         let want_lattice = (target - fixed).max(0.25 * target);
         let ratio = seeds.lattice_count as f64 / want_lattice;
         s *= ratio.sqrt().clamp(0.5, 2.0);
-        let bands = RingBands::new(domain.rings(), (s * 0.866).max(extent * 1e-9));
-        seeds = Seeds::build(domain, constraints, &bands, s, extent);
+        bands = RingBands::new(domain.rings(), (s * 0.866).max(extent * 1e-9));
+    }
+    // The refinement points inside the domain, finite ones only; seeded after the
+    // calibration, which they take no part in.
+    let refine: Vec<DVec2> = opts
+        .refine
+        .iter()
+        .copied()
+        .filter(|p| {
+            // One on the boundary itself would sit on a constraint edge: left out.
+            p.is_finite() && bands.contains(*p) && !bands.near_boundary(*p, 1e-9 * (1.0 + extent))
+        })
+        .collect();
+    if calibrate || !refine.is_empty() {
+        seeds = Seeds::build(domain, constraints, &refine, &bands, s, extent);
     }
 
     // --- Triangulate (spade), guarding against panics in the triangulator ---------
@@ -391,6 +415,7 @@ impl Seeds {
     fn build(
         domain: &Domain,
         constraints: &Constraints,
+        refine: &[DVec2],
         bands: &RingBands,
         s: f64,
         extent: f64,
@@ -516,6 +541,10 @@ impl Seeds {
 
         for &p in constraints.points {
             seeds.point_ids.push(add(&mut seeds.vertices, p));
+            clear.push([p, p]);
+        }
+        for &p in refine {
+            add(&mut seeds.vertices, p);
             clear.push([p, p]);
         }
         for (line, samples) in constraints.polylines.iter().zip(&samples) {

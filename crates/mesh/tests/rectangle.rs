@@ -162,6 +162,7 @@ fn degenerate_images() {
     let weird = MeshOptions {
         target_vertices: 0,
         min_angle_deg: f64::NAN,
+        refine: vec![DVec2::NAN, DVec2::new(-5.0, 1e300)],
     };
     mesh_image(&one, &o, &weird, &c)
         .unwrap()
@@ -171,6 +172,7 @@ fn degenerate_images() {
     let weird = MeshOptions {
         target_vertices: usize::MAX,
         min_angle_deg: 89.0,
+        refine: Vec::new(),
     };
     let t = mesh_image(&one, &o, &weird, &c).unwrap();
     t.mesh.sanity_check().unwrap();

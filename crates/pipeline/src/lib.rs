@@ -5,6 +5,7 @@ pub mod animate;
 pub mod arap;
 mod c2;
 pub mod cage;
+pub mod crowding;
 pub mod method;
 pub mod mls;
 pub mod order;
@@ -302,8 +303,9 @@ pub struct Prepared {
 ///
 /// **One rule gives the mesh and the rig from what the rig file holds**, so that the
 /// editor's view, its export, a reopened project and `c2warp render` of the saved file
-/// are one picture: the picture is meshed at its density alone (the handles play no
-/// part in the mesh, so handles added, moved or removed in the editor leave it as it
+/// are one picture: the picture is meshed at its density, refined only around handles
+/// that crowd together ([`crowding::refinement`], a function of the handles' rest
+/// places: handles posed, or added and removed away from others, leave the mesh as it
 /// is); each handle takes the vertex nearest its rest position (each bar sample, the
 /// vertex nearest it), as the editor's insertions do; the saved virtual handles take
 /// the vertices at their positions (a saved position is a vertex of this very mesh), and
@@ -349,8 +351,11 @@ pub fn prepare_with_progress(
         );
     }
     let handles = handles(project);
+    let (width, height) = image.dimensions();
     let options = MeshOptions {
         target_vertices,
+        // Refined where handles crowd together, so each has samples of its own.
+        refine: crowding::refinement(project, width, height, target_vertices),
         ..MeshOptions::default()
     };
     let mesh = mesh::mesh_image(

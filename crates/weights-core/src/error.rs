@@ -47,9 +47,24 @@ pub enum RigError {
         /// Rest y in pixels.
         y: f64,
     },
-    /// Two handles coincide, or fall on the same sample of the mesh.
-    #[error("handles {a} and {b} coincide (or fall on the same mesh sample); move them apart")]
+    /// Two handles closer than [`COINCIDENT`](crate::COINCIDENT): the same place.
+    #[error(
+        "handles {a} and {b} coincide (closer than {} px); move one of them",
+        crate::COINCIDENT
+    )]
     Coincident {
+        /// The first handle.
+        a: usize,
+        /// The second handle.
+        b: usize,
+    },
+    /// Two handles that take the same sample of the mesh (a mesh given as it is, too
+    /// coarse where they are; a picture's mesh is refined around close handles).
+    #[error(
+        "handles {a} and {b} fall on the same sample of the mesh; refine the mesh there \
+         or move them apart"
+    )]
+    SameSample {
         /// The first handle.
         a: usize,
         /// The second handle.

@@ -38,8 +38,8 @@ pub use domain::{Domain, Metric};
 pub use error::{DomainError, RigError};
 pub use geometry::Similarity;
 pub use rig::{
-    BuildTimings, Handle, MAX_BAR_PIECES, MAX_HANDLES, MAX_POSE, MAX_SCALE, MIN_SCALE, Node,
-    NodeKind, NodeRadii, Phase, Progress, Rig, RigOptions, RigStats, UpdateTimings, VirtualHandle,
-    bar_samples, bar_spacing,
+    BuildTimings, COINCIDENT, Handle, MAX_BAR_PIECES, MAX_HANDLES, MAX_POSE, MAX_SCALE, MIN_SCALE,
+    Node, NodeKind, NodeRadii, Phase, Progress, Rig, RigOptions, RigStats, UpdateTimings,
+    VirtualHandle, bar_samples, bar_spacing,
 };
 pub use virtual_handles::Placement;

@@ -1402,6 +1402,11 @@ fn check_options(o: &RigOptions) -> Result<(), RigError> {
 pub const MAX_POSE: f64 = 1e9;
 /// The smallest scale a point handle may have.
 pub const MIN_SCALE: f64 = 1e-9;
+
+/// Handles closer than this (pixels) are the same place, and refused
+/// ([`RigError::Coincident`]); any farther apart can be placed (a picture's mesh is
+/// refined around them).
+pub const COINCIDENT: f64 = 1e-6;
 /// The largest scale a point handle may have.
 pub const MAX_SCALE: f64 = 1e9;
 
@@ -1540,10 +1545,8 @@ fn real_nodes(
         });
     }
     check_handles(handles)?;
-    let (lo, hi) = domain.bounds();
-    let tiny = 1e-9 * (hi - lo).length().max(1.0);
     if let Some((a, b)) = closest_pair(handles)
-        .filter(|p| p.2 <= tiny)
+        .filter(|p| p.2 < COINCIDENT)
         .map(|p| (p.0, p.1))
     {
         return Err(RigError::Coincident { a, b });
@@ -1600,7 +1603,7 @@ fn real_nodes(
         }
         for n in own {
             if let Some(&j) = used.get(&n.vertex) {
-                return Err(RigError::Coincident { a: j, b: i });
+                return Err(RigError::SameSample { a: j, b: i });
             }
             used.insert(n.vertex, i);
             nodes.push(n);

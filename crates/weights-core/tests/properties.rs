@@ -457,7 +457,7 @@ fn degenerate_rigs_never_panic() {
                 Handle::point(DVec2::new(3.0, 3.0)),
                 Handle::point(DVec2::new(3.01, 3.0)),
             ],
-            Some(|e| matches!(e, RigError::Coincident { .. })),
+            Some(|e| matches!(e, RigError::SameSample { .. })),
         ),
         (
             "zero-length bar",

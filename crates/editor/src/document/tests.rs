@@ -45,11 +45,6 @@ fn a_rejected_edit_changes_nothing() {
         depth: 0,
     };
     assert!(doc.apply(Edit::Add(bar)).is_err(), "zero-length bar");
-    let close = doc.rig().domain().mean_edge_length();
-    assert!(
-        doc.apply(Edit::Add(point(10.0 + close, 10.0))).is_err(),
-        "too close"
-    );
     assert_eq!(doc.project(), &before);
     assert_eq!(doc.weights_version, version);
     assert_eq!(doc.rig().handles().len(), 2);
@@ -488,5 +483,53 @@ fn saved_projects_name_the_picture_relative_to_the_file() {
     assert_eq!(
         saved.image.as_deref(),
         Some(Path::new("/tmp/pictures/cat.png"))
+    );
+}
+
+#[test]
+fn handles_half_a_pixel_apart_are_placed_and_reopen_the_same() {
+    let mut doc = Document::built_in().expect("the lizard");
+    let before = doc.rig().domain().len();
+    // Beside the leg's pin (190, 470): 1 px, then 0.5 px from it, at rest and posed.
+    for (x, y) in [(191.0, 470.0), (190.0, 470.5)] {
+        doc.apply(Edit::Add(point(x, y)))
+            .expect("a crowded handle is placed");
+        doc.check_reopens()
+            .expect("reopens to the same mesh and rig");
+    }
+    assert!(
+        doc.rig().domain().len() > before,
+        "the mesh was refined there"
+    );
+    let deformed = doc.deformed().to_vec();
+    assert!(deformed.iter().all(|p| p.is_finite()));
+    // Each handle has its own sample, at its exact place.
+    let positions = doc.rig().domain().positions();
+    for h in &doc.project().handles[7..] {
+        let HandleSpec::Point { rest, .. } = h else {
+            unreachable!()
+        };
+        assert!(positions.contains(&DVec2::from(*rest)), "{rest:?}");
+    }
+    // Every method takes them.
+    for method in [Method::Arap, Method::Mls, Method::C2] {
+        doc.apply(Edit::Method(method)).expect("method");
+        assert!(doc.deformed().iter().all(|p| p.is_finite()), "{method:?}");
+    }
+    // Removing one of a crowded pair unrefines (the file's mesh again), and the far
+    // virtual handles stay.
+    doc.apply(Edit::Remove(8)).expect("remove");
+    doc.apply(Edit::Remove(7)).expect("remove");
+    assert_eq!(doc.rig().domain().len(), before);
+    doc.check_reopens().expect("reopens");
+    // Coincident handles are refused, saying so.
+    let error = doc
+        .apply(Edit::Add(point(190.0, 470.0 + 1e-7)))
+        .expect_err("coincident");
+    assert!(
+        error
+            .to_string()
+            .contains("coincide (closer than 0.000001 px)"),
+        "{error}"
     );
 }
