@@ -601,6 +601,11 @@ impl EditorApp {
         if lbc || self.tool == Tool::Cage {
             ui.heading("Cage");
             self.with_cage(|cage, host| cage.panel(host, ui));
+            // A cage begun from the panel (New cage, under the perform tool) is drawn
+            // with the cage tool.
+            if self.cage.draft().is_some() && self.tool != Tool::Cage {
+                self.set_tool(Tool::Cage);
+            }
             ui.separator();
         }
         if self.doc.as_ref().is_some_and(|d| d.method() == Method::Mls) {

@@ -363,7 +363,8 @@ impl Monkey {
                 self.frames(1);
                 "wait for the job".to_owned()
             }
-            97..=98 => self.perform(),
+            97 => self.perform(),
+            98 => self.pin_under_arap(),
             _ => {
                 let size = *self.rng.pick(&[
                     Vec2::new(1200.0, 800.0),
@@ -375,6 +376,58 @@ impl Monkey {
                 format!("window {size:?}")
             }
         }
+    }
+
+    /// A pin clicked onto the picture under ARAP, in whatever pose it is in (the walk
+    /// checks that it moves nothing): ARAP chosen if a handle method is in use, the
+    /// Puppet tool, a click on a vertex of the picture where it is shown.
+    fn pin_under_arap(&mut self) -> String {
+        let app = self.h.state();
+        let usable = !app.is_busy()
+            && app
+                .document()
+                .is_some_and(|d| d.method().controls() == project::Controls::Handles);
+        if !usable {
+            return "pin under ARAP (not now)".to_owned();
+        }
+        let arap = app
+            .document()
+            .is_some_and(|d| d.method() == project::Method::Arap);
+        if !arap {
+            if let Some(node) = self.h.query_all_by_label("ARAP").next() {
+                node.click();
+            }
+            // A large picture sets ARAP up on the worker.
+            let start = Instant::now();
+            self.frames(1);
+            while self.h.state().is_busy() && start.elapsed().as_secs() < 60 {
+                self.h.step();
+                std::thread::sleep(std::time::Duration::from_millis(5));
+            }
+            self.frames(1);
+            return "ARAP chosen".to_owned();
+        }
+        if self.h.state().tool != editor::Tool::Puppet {
+            self.h.key_press(Key::W);
+            self.frames(1);
+            return "the Puppet tool".to_owned();
+        }
+        let Some(doc) = self.h.state_mut().document_mut() else {
+            return "pin under ARAP (no picture)".to_owned();
+        };
+        let shown = doc.deformed().to_vec();
+        if shown.is_empty() {
+            return "pin under ARAP (no mesh)".to_owned();
+        }
+        let at = shown[self.rng.below(shown.len())];
+        let pos = self.h.state().viewport.to_screen(at);
+        self.h.hover_at(pos);
+        self.frames(1);
+        self.button(pos, egui::PointerButton::Primary, true, Modifiers::NONE);
+        self.frames(1);
+        self.button(pos, egui::PointerButton::Primary, false, Modifiers::NONE);
+        self.frames(2);
+        format!("pin under ARAP at {at}")
     }
 
     /// The perform tool: a pose marker placed (with the button or Ctrl + click), or the
@@ -657,8 +710,21 @@ fn walk(seed: u64, actions: usize) {
     let mut reopened = 0usize;
     // Actions taken with two keys or more, the most keys seen, actions with markers.
     let (mut keyed, mut most_keys, mut marked) = (0usize, 0usize, 0usize);
+    // Pins placed under ARAP, each checked to have moved nothing.
+    let mut held = 0usize;
     for step in 0..actions {
         let result = std::panic::catch_unwind(AssertUnwindSafe(|| {
+            // What the picture was, to check that a pin placed under ARAP (in any
+            // pose) moves nothing.
+            let before = monkey
+                .h
+                .state_mut()
+                .document_mut()
+                .filter(|d| d.method() == project::Method::Arap)
+                .map(|d| {
+                    let handles = d.project().handles.clone();
+                    (handles, d.mesh_version(), d.deformed().to_vec())
+                });
             let started = Instant::now();
             let what = monkey.act();
             slowest.push((started.elapsed().as_secs_f64(), what.clone()));
@@ -678,6 +744,25 @@ fn walk(seed: u64, actions: usize) {
                     .is_some_and(|a| !a.spatial_keys.is_empty())
             }));
             app.sanity_check()?;
+            if let (Some((handles, mesh, shown)), Some(doc)) =
+                (before, monkey.h.state_mut().document_mut())
+            {
+                let now = &doc.project().handles;
+                let placed = now.len() == handles.len() + 1 && now[..handles.len()] == handles[..];
+                if placed && doc.mesh_version() == mesh && doc.method() == project::Method::Arap {
+                    held += 1;
+                    let moved = shown
+                        .iter()
+                        .zip(doc.deformed())
+                        .map(|(a, b)| a.distance(*b))
+                        .fold(0.0, f64::max);
+                    anyhow::ensure!(
+                        moved <= 0.1,
+                        "a pin placed under ARAP moved the picture by {moved} px"
+                    );
+                }
+            }
+            let app = monkey.h.state();
             // Saved and reopened at random points, the project builds what is on screen.
             match app.document() {
                 Some(doc) if reopen && !app.is_busy() => {
@@ -738,7 +823,7 @@ fn walk(seed: u64, actions: usize) {
     );
     println!(
         "  with two keys or more: {keyed} actions (at most {most_keys} keys); with pose \
-         markers: {marked}"
+         markers: {marked}; pins placed under ARAP, none moving the picture: {held}"
     );
     slowest.sort_by(|a, b| b.0.total_cmp(&a.0));
     for (s, what) in slowest.iter().take(3) {

@@ -341,7 +341,10 @@ pub fn prepare_with_progress(
     }
     project.validate(Some(image.dimensions()))?;
     let target_vertices = density.or(project.density).unwrap_or(DEFAULT_DENSITY);
-    let most = MAX_VIRTUAL_PER_VERTEX.saturating_mul(target_vertices);
+    // Vertices added around crowded handles take virtual handles too.
+    let (width, height) = image.dimensions();
+    let refine = crowding::refinement(project, width, height, target_vertices);
+    let most = MAX_VIRTUAL_PER_VERTEX.saturating_mul(target_vertices + refine.len());
     if project.virtual_handles.len() > most {
         bail!(
             "the rig lists {} virtual handles, more than a mesh of about {target_vertices} \
@@ -351,11 +354,10 @@ pub fn prepare_with_progress(
         );
     }
     let handles = handles(project);
-    let (width, height) = image.dimensions();
     let options = MeshOptions {
         target_vertices,
         // Refined where handles crowd together, so each has samples of its own.
-        refine: crowding::refinement(project, width, height, target_vertices),
+        refine,
         ..MeshOptions::default()
     };
     let mesh = mesh::mesh_image(

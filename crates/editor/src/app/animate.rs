@@ -130,6 +130,9 @@ impl EditorApp {
     /// The animation with `change` made to it (starting from an empty one), applied
     /// as one undo step.
     fn change_animation(&mut self, change: impl FnOnce(&mut Animation)) -> bool {
+        // A drag (or a take) under way ends first, as its own step: the change is made
+        // to what it leaves.
+        self.end_gesture();
         let Some(doc) = &self.doc else { return false };
         let mut animation = doc.project().animation.clone().unwrap_or_default();
         change(&mut animation);
@@ -141,6 +144,9 @@ impl EditorApp {
 
     /// Keys the current pose at the timeline's time (one undo step).
     pub fn set_key(&mut self) {
+        // A drag (or a take) under way ends first, as its own step: the key holds the
+        // pose it leaves, at the time it leaves.
+        self.end_gesture();
         let Some(doc) = &self.doc else { return };
         let time = snap(self.timeline.time, self.fps());
         let animation = doc.keyed_at(time);
@@ -287,7 +293,13 @@ impl EditorApp {
         if let Err(e) = doc.apply(Edit::Animation(Some(Box::new(animation)))) {
             self.error(&e.context("cannot key the pose"));
         } else {
+            // Keyed at the frame (playback may have left the time between two): the
+            // keys' pose there is what shows.
+            let snapped = self.timeline.time != time;
             self.timeline.time = time;
+            if snapped {
+                self.show_current_time();
+            }
             let keys = if count == 1 { "key" } else { "keys" };
             self.info(if count > before_keys {
                 format!("key set at {time:.2} s ({count} {keys})")
@@ -408,7 +420,12 @@ impl EditorApp {
         } else {
             self.timeline.tolerance
         };
-        let frames = animation::resample(doc.project(), &take.samples, fps);
+        let mut frames = animation::resample(doc.project(), &take.samples, fps);
+        // The take ends on the pose shown when it ended (the release can come a little
+        // after the last frame's time): what the keys show there is what is on screen.
+        if let Some(last) = frames.last_mut() {
+            *last = Pose::of(doc.project());
+        }
         let taken = animation::simplify(doc.project(), &frames, take.from, fps, tolerance);
         let to = take.from + (frames.len() - 1) as f64 / fps;
         let mut animation = doc.project().animation.clone().unwrap_or_default();
