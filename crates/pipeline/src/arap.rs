@@ -455,12 +455,7 @@ impl ArapRig {
         handles: &[Handle],
         holds: &[project::Hold],
     ) -> Result<()> {
-        let pins = pins(
-            self.arap_mesh(),
-            &self.registration,
-            handles,
-            self.options.pin_radius,
-        )?;
+        let pins = self.pins_of(handles)?;
         let held = if pins == self.pins && holds == self.holds {
             self.held.clone()
         } else {
@@ -498,6 +493,16 @@ impl ArapRig {
         result
     }
 
+    /// The ARAP vertices `handles` pin on this rig's mesh, each with its handle.
+    fn pins_of(&self, handles: &[Handle]) -> Result<Vec<(u32, usize)>> {
+        pins(
+            self.arap_mesh(),
+            &self.registration,
+            handles,
+            self.options.pin_radius,
+        )
+    }
+
     /// What handle `index` of `handles` (just placed, in the pose the rig shows now)
     /// must hold so that the picture stays where it is: the ARAP vertices it pins,
     /// where the current solve puts them (both steps' answers), in the handle's own
@@ -513,12 +518,7 @@ impl ArapRig {
         let Some(inverse) = handle_affine(handle).and_then(invert) else {
             return Ok(None);
         };
-        let pins = pins(
-            self.arap_mesh(),
-            &self.registration,
-            handles,
-            self.options.pin_radius,
-        )?;
+        let pins = self.pins_of(handles)?;
         let rest = self.arap_mesh().positions();
         let (final_now, one_now) = (&self.pose.positions, &self.pose.step_one);
         let mut hold = project::Hold {
