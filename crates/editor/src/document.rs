@@ -573,7 +573,10 @@ impl Document {
         let (w, h) = self.image.dimensions();
         let refined =
             |p: &Project| pipeline::crowding::refinement(p, w, h, Settings::of(p).density);
-        let refinement_changed = refined(&project) != refined(&self.project);
+        // (A function of the handles' rest places and the density: a pose, every drag
+        // frame, leaves it as it is.)
+        let refinement_changed = (!same_rest || new.density != old.density)
+            && refined(&project) != refined(&self.project);
         if new.density != old.density || refinement_changed {
             let mut with_virtuals = project.clone();
             if exact {
