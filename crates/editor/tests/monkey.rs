@@ -355,12 +355,7 @@ impl Monkey {
             }
             93..=96 => {
                 // Let a running job finish (or not start anything).
-                let start = Instant::now();
-                while self.h.state().is_busy() && start.elapsed().as_secs() < 60 {
-                    self.h.step();
-                    std::thread::sleep(std::time::Duration::from_millis(5));
-                }
-                self.frames(1);
+                self.wait_for_job();
                 "wait for the job".to_owned()
             }
             97 => self.perform(),
@@ -376,6 +371,17 @@ impl Monkey {
                 format!("window {size:?}")
             }
         }
+    }
+
+    /// Steps the editor until its background job is done (a minute at most), then a
+    /// frame more.
+    fn wait_for_job(&mut self) {
+        let start = Instant::now();
+        while self.h.state().is_busy() && start.elapsed().as_secs() < 60 {
+            self.h.step();
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        }
+        self.frames(1);
     }
 
     /// A pin clicked onto the picture under ARAP, in whatever pose it is in (the walk
@@ -398,13 +404,8 @@ impl Monkey {
                 node.click();
             }
             // A large picture sets ARAP up on the worker.
-            let start = Instant::now();
             self.frames(1);
-            while self.h.state().is_busy() && start.elapsed().as_secs() < 60 {
-                self.h.step();
-                std::thread::sleep(std::time::Duration::from_millis(5));
-            }
-            self.frames(1);
+            self.wait_for_job();
             return "ARAP chosen".to_owned();
         }
         if self.h.state().tool != editor::Tool::Puppet {
