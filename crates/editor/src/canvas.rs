@@ -181,6 +181,21 @@ impl EditorApp {
         } else {
             // The same screen position for every image point.
             self.viewport.origin -= rect.min - old.min;
+            // Unless a fitted picture would no longer fit (a panel opened beside it):
+            // then it is fitted again, between gestures.
+            if let Some(doc) = &self.doc
+                && self.view_fitted
+                && !dragging
+            {
+                let (w, h) = doc.image.dimensions();
+                let far = self
+                    .viewport
+                    .to_screen(DVec2::new(f64::from(w), f64::from(h)));
+                let near = self.viewport.to_screen(DVec2::ZERO);
+                if !rect.expand(0.5).contains(near) || !rect.expand(0.5).contains(far) {
+                    self.viewport.fit([w, h]);
+                }
+            }
         }
     }
 
@@ -373,5 +388,43 @@ impl EditorApp {
         for ghost in &self.onion.ghosts {
             painter.image(ghost.id(), frame, uv, Color32::WHITE);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Where image pixel (300, 300) is on screen.
+    fn point(app: &EditorApp) -> egui::Pos2 {
+        app.viewport.to_screen(DVec2::new(300.0, 300.0))
+    }
+
+    #[test]
+    fn panels_keep_the_picture_in_place_unless_it_would_be_hidden() {
+        let mut app = EditorApp::headless(false);
+        let window = egui::vec2(1200.0, 800.0);
+        let canvas = egui::Rect::from_min_max(egui::pos2(273.0, 25.0), egui::pos2(1200.0, 690.0));
+        for _ in 0..=FIT_SETTLING_FRAMES {
+            app.place_canvas(canvas, window);
+        }
+        let fitted = point(&app);
+        // The timeline grows a row: nothing moves.
+        let shorter = egui::Rect::from_min_max(canvas.min, canvas.max - egui::vec2(0.0, 12.0));
+        app.place_canvas(shorter, window);
+        assert_eq!(point(&app), fitted);
+        // A panel opens on the right, over part of the picture: fitted again.
+        let narrower = egui::Rect::from_min_max(canvas.min, egui::pos2(900.0, 678.0));
+        app.place_canvas(narrower, window);
+        let v = app.viewport;
+        assert!(v.to_screen(DVec2::new(746.0, 669.0)).x <= 900.5, "{v:?}");
+        // Panned by the user, the view is theirs: a panel changes nothing.
+        app.view_fitted = false;
+        let before = point(&app);
+        app.place_canvas(
+            egui::Rect::from_min_max(canvas.min, egui::pos2(700.0, 678.0)),
+            window,
+        );
+        assert_eq!(point(&app), before);
     }
 }
