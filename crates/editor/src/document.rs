@@ -396,9 +396,14 @@ impl Document {
                         pose.handles.push(fit);
                     }
                 }
+                // Placed in a posed state, it holds the picture where it is: C² lays
+                // it over the weights it is placed on, ARAP pins what is under it.
+                let posed = project.is_posed();
                 project.handles.push(handle);
-                // Placed in a posed state, it holds the picture where it is (ARAP).
                 let index = project.handles.len() - 1;
+                if posed {
+                    project.overlaid.push(index);
+                }
                 if let Some(hold) = self.deformer().hold(&project, index) {
                     project.holds.push(hold);
                 }
@@ -417,6 +422,7 @@ impl Document {
             Edit::Clear => {
                 project.handles.clear();
                 project.holds.clear();
+                project.overlaid.clear();
                 if let Some(animation) = &mut project.animation {
                     animation.poses_mut().for_each(|pose| pose.handles.clear());
                 }
@@ -425,8 +431,12 @@ impl Document {
                 for h in &mut project.handles {
                     *h = at_rest(h);
                 }
-                // At rest, nothing is held away from it.
+                // At rest, nothing is held away from it; without keys, every handle
+                // joins the paper's weights again.
                 project.holds.clear();
+                if project.animation.as_ref().is_none_or(|a| a.keys.is_empty() && a.spatial_keys.is_empty()) {
+                    project.overlaid.clear();
+                }
             }
             Edit::Settings(settings) => settings.write_to(&mut project),
             Edit::Method(method)
@@ -558,6 +568,7 @@ impl Document {
         let new = Settings::of(&project);
         let handles = pipeline::handles(&project);
         let same_rest = project.handles.len() == self.project.handles.len()
+            && project.overlaid == self.project.overlaid
             && project
                 .handles
                 .iter()
@@ -605,11 +616,13 @@ impl Document {
                     })
                 })
                 .collect();
-            self.rig = Rig::with_placed_virtual_handles(
+            self.rig = Rig::with_overlaid(
                 domain.clone(),
                 handles,
+                &project.overlaid,
                 &placed,
                 pipeline::rig_options(&project)?,
+                &|_| {},
             )?;
         } else if new != old {
             let domain = self.rig.domain();
@@ -623,10 +636,18 @@ impl Document {
                     metric,
                 )?
             };
-            self.rig = Rig::new(domain, handles, pipeline::rig_options(&project)?)?;
+            self.rig = Rig::with_overlaid(
+                domain,
+                handles,
+                &project.overlaid,
+                &[],
+                pipeline::rig_options(&project)?,
+                &|_| {},
+            )?;
         } else {
-            if project.handles != self.project.handles {
-                self.rig.set_handles(handles)?;
+            if project.handles != self.project.handles || project.overlaid != self.project.overlaid
+            {
+                self.rig.set_handles_overlaid(handles, &project.overlaid)?;
             }
             if same_rest {
                 self.project = project;
@@ -710,32 +731,22 @@ impl Document {
             // No node: the picture is at rest.
             return (0.0, 1.0);
         };
-        let near = rig.domain().vertices_near_segment(rest, rest, reach);
-        let basis = &rig.options().basis;
-        let (mut dot, mut cross, mut norm) = (0.0, 0.0, 0.0);
-        for v in near {
-            let Some(&q) = deformed.get(v as usize) else {
-                continue;
-            };
-            let d = positions[v as usize] - rest;
-            let e = q - at;
-            let w = basis.eval(d.length() / reach);
-            dot += w * d.dot(e);
-            cross += w * d.perp_dot(e);
-            norm += w * d.length_squared();
-        }
-        if !(norm > 0.0 && dot.is_finite() && cross.is_finite()) {
+        // The same fit the rig gives a handle it lays over a posed picture, so that
+        // placing one moves nothing.
+        let Some((rotate, scale)) = weights_core::similarity_fit(
+            rig.domain(),
+            &rig.options().basis,
+            deformed,
+            rest,
+            at,
+            reach,
+        ) else {
+            // Nothing to fit, or folded flat there: keep the handle's own frame.
             return (0.0, 1.0);
-        }
-        let (a, b) = (dot / norm, cross / norm);
-        let scale = a.hypot(b);
-        if !(scale > 1e-6 && scale.is_finite()) {
-            // Folded flat there: keep the handle's own frame.
-            return (0.0, 1.0);
-        }
+        };
         let round = |x: f64, unit: f64| if (x - unit).abs() < 1e-9 { unit } else { x };
         (
-            round(b.atan2(a), 0.0),
+            round(rotate, 0.0),
             round(scale.clamp(project::MIN_SCALE, project::MAX_SCALE), 1.0),
         )
     }

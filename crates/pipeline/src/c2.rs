@@ -47,16 +47,22 @@ impl Deformer for Rig {
         if crate::rig_options(project)? != *self.options() {
             return Ok(Follow::NeedsSetup);
         }
-        self.set_handles(crate::handles(project))?;
+        self.set_handles_overlaid(crate::handles(project), &project.overlaid)?;
         Ok(Follow::Followed)
     }
 
     fn deformed(&self) -> Vec<DVec2> {
-        self.deform()
+        match self.overlaid_picture() {
+            Some(picture) => picture.to_vec(),
+            None => self.deform(),
+        }
     }
 
     fn output(&self) -> Output<'_> {
-        Output::Skinned(self)
+        match self.overlaid_picture() {
+            Some(picture) => Output::Positions(picture),
+            None => Output::Skinned(self),
+        }
     }
 
     fn weights(&self, listing: WeightsListing) -> Result<serde_json::Value> {

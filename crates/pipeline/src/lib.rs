@@ -398,9 +398,10 @@ pub fn prepare_with_progress(
             })
         })
         .collect();
-    let rig = Rig::with_progress(
+    let rig = Rig::with_overlaid(
         domain,
         handles,
+        &project.overlaid,
         &virtual_handles,
         rig_options(project)?,
         progress,
@@ -439,7 +440,10 @@ pub fn rig_on_mesh(
         match h {
             Handle::Point { rest, .. } => points.push(*rest),
             Handle::Bar { rest, .. } => points.extend(
-                weights_core::bar_samples(*rest, weights_core::bar_spacing(&handles, i))
+                weights_core::bar_samples(
+                    *rest,
+                    weights_core::bar_spacing_overlaid(&handles, &project.overlaid, i),
+                )
                     .into_iter()
                     .map(|(_, p)| p),
             ),
@@ -470,9 +474,10 @@ pub fn rig_on_mesh(
     )?;
     let metric = metric(project.metric, provisional.is_convex());
     let domain = Domain::new(mesh.vertices, mesh.triangles, metric)?;
-    Ok(Rig::with_progress(
+    Ok(Rig::with_overlaid(
         domain,
         handles,
+        &project.overlaid,
         &virtual_handles,
         rig_options(project)?,
         progress,

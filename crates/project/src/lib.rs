@@ -443,6 +443,21 @@ pub enum HandleSpec {
 }
 
 impl HandleSpec {
+    /// Whether the handle is away from its rest pose.
+    pub fn is_posed(&self) -> bool {
+        match *self {
+            Self::Point {
+                translate,
+                rotate,
+                scale,
+                ..
+            } => translate != [0.0; 2] || rotate != 0.0 || scale != 1.0,
+            Self::Bar { rest, pose, .. } => pose.is_some_and(|p| p != rest),
+        }
+    }
+}
+
+impl HandleSpec {
     /// The handle's overlap depth.
     pub fn depth(&self) -> i32 {
         match *self {
@@ -546,6 +561,11 @@ pub struct Project {
     /// was when it was placed, so that placing it moved nothing. See [`Hold`].
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub holds: Vec<Hold>,
+    /// Handles placed in a posed state (indices into `handles`, ascending), which the
+    /// C² weights lay over the weights they were placed on instead of re-partitioning
+    /// the shape, so that placing one moves nothing away from it.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub overlaid: Vec<usize>,
 }
 
 /// What a handle placed in a posed state holds (ARAP): the points of ARAP's mesh it
@@ -598,6 +618,7 @@ impl Default for Project {
             canvas: Canvas::Keep,
             animation: None,
             holds: Vec::new(),
+            overlaid: Vec::new(),
         }
     }
 }
@@ -682,6 +703,42 @@ impl Project {
                 hold.handle -= 1;
             }
         }
+        self.overlaid.retain(|&h| h != index);
+        for h in &mut self.overlaid {
+            if *h > index {
+                *h -= 1;
+            }
+        }
+    }
+
+    /// Whether the picture is posed anywhere: a handle away from rest now or in an
+    /// animation key. A handle placed then holds the picture where it is (ARAP's holds,
+    /// C²'s overlaid handles).
+    pub fn is_posed(&self) -> bool {
+        let posed = |h: &HandleSpec| h.is_posed();
+        self.handles.iter().any(posed)
+            || self.animation.as_ref().is_some_and(|a| {
+                a.keys
+                    .iter()
+                    .map(|k| &k.pose)
+                    .chain(a.spatial_keys.iter().map(|k| &k.pose))
+                    .any(|p| {
+                        p.handles.iter().zip(&self.handles).any(|(k, h)| match (k, h) {
+                            (
+                                HandlePose::Point {
+                                    translate,
+                                    rotate,
+                                    scale,
+                                },
+                                _,
+                            ) => *translate != [0.0; 2] || *rotate != 0.0 || *scale != 1.0,
+                            (HandlePose::Bar { pose }, HandleSpec::Bar { rest, .. }) => {
+                                pose != rest
+                            }
+                            (HandlePose::Bar { .. }, HandleSpec::Point { .. }) => false,
+                        })
+                    })
+            })
     }
 
     /// Parses and validates (without an image size) a project from JSON text. A
@@ -777,6 +834,16 @@ impl Project {
                     self.handles.len()
                 ));
             }
+        }
+        if let Some(i) = (0..self.overlaid.len()).find(|&i| {
+            self.overlaid[i] >= self.handles.len() || (i > 0 && self.overlaid[i] <= self.overlaid[i - 1])
+        }) {
+            return bad(format!(
+                "overlaid[{i}] names handle {}: the list must be ascending, each of the {} \
+                 handles at most once",
+                self.overlaid[i],
+                self.handles.len()
+            ));
         }
         let mut held = std::collections::BTreeSet::new();
         for (i, hold) in self.holds.iter().enumerate() {

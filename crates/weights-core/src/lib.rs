@@ -27,6 +27,7 @@ mod error;
 mod harmonic;
 mod ldl;
 mod nearest;
+mod overlay;
 mod queue;
 mod rig;
 mod virtual_handles;
@@ -40,6 +41,7 @@ pub use geometry::Similarity;
 pub use rig::{
     BuildTimings, COINCIDENT, Handle, MAX_BAR_PIECES, MAX_HANDLES, MAX_POSE, MAX_SCALE, MIN_SCALE,
     Node, NodeKind, NodeRadii, Phase, Progress, Rig, RigOptions, RigStats, UpdateTimings,
-    VirtualHandle, bar_samples, bar_spacing,
+    VirtualHandle, bar_samples, bar_spacing, bar_spacing_overlaid,
 };
+pub use overlay::similarity_fit;
 pub use virtual_handles::Placement;

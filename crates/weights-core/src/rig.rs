@@ -12,6 +12,7 @@ use crate::basis::Basis;
 use crate::domain::{Domain, Metric};
 use crate::error::RigError;
 use crate::harmonic::{Coefficients, Solved, dual_edges, harmonic_coordinates};
+use crate::overlay::Overlay;
 use crate::virtual_handles::{Placement, insert_virtual_handles};
 use crate::voronoi::{CellStats, NONE, Partition};
 use crate::weights::{Ball, Change, SampleSet, Weights, ball};
@@ -302,20 +303,49 @@ const PROGRESS_STEP: usize = 64;
 
 /// For each of the `old` handles, its index among `new` if it is there (the same rest
 /// geometry; equal handles are matched in order), `None` if it left.
-fn match_handles(old: &[Handle], new: &[Handle]) -> Vec<Option<usize>> {
-    // Rest geometry as bits (+ 0.0 makes −0 and 0 alike, as == has them).
+fn match_handles(
+    old: &[Handle],
+    new: &[Handle],
+    old_overlaid: &[bool],
+    new_overlaid: &[bool],
+) -> Vec<Option<usize>> {
+    // Rest geometry as bits (+ 0.0 makes −0 and 0 alike, as == has them); a handle
+    // that becomes overlaid, or stops being, leaves and arrives.
     let bits = |x: f64| (x + 0.0).to_bits();
-    let key = |h: &Handle| match *h {
-        Handle::Point { rest, .. } => (false, [bits(rest.x), bits(rest.y), 0, 0]),
-        Handle::Bar { rest: [a, b], .. } => (true, [bits(a.x), bits(a.y), bits(b.x), bits(b.y)]),
+    let key = |h: &Handle, overlaid: bool| match *h {
+        Handle::Point { rest, .. } => (false, overlaid, [bits(rest.x), bits(rest.y), 0, 0]),
+        Handle::Bar { rest: [a, b], .. } => {
+            (true, overlaid, [bits(a.x), bits(a.y), bits(b.x), bits(b.y)])
+        }
     };
-    let mut waiting: HashMap<(bool, [u64; 4]), std::collections::VecDeque<usize>> = HashMap::new();
+    let mut waiting: HashMap<(bool, bool, [u64; 4]), std::collections::VecDeque<usize>> =
+        HashMap::new();
     for (j, h) in new.iter().enumerate() {
-        waiting.entry(key(h)).or_default().push_back(j);
+        waiting
+            .entry(key(h, new_overlaid.get(j) == Some(&true)))
+            .or_default()
+            .push_back(j);
     }
     old.iter()
-        .map(|h| waiting.get_mut(&key(h)).and_then(|q| q.pop_front()))
+        .enumerate()
+        .map(|(i, h)| {
+            waiting
+                .get_mut(&key(h, old_overlaid.get(i) == Some(&true)))
+                .and_then(|q| q.pop_front())
+        })
         .collect()
+}
+
+/// `overlaid` (ascending handle indices) as a flag per handle.
+fn overlaid_flags(overlaid: &[usize], handles: usize) -> Result<Vec<bool>, RigError> {
+    let mut flags = vec![false; handles];
+    for &i in overlaid {
+        match flags.get_mut(i) {
+            Some(f) => *f = true,
+            None => return Err(RigError::NoSuchHandle { handle: i }),
+        }
+    }
+    Ok(flags)
 }
 
 /// Sizes of a rig.
@@ -391,6 +421,16 @@ pub struct Rig {
     /// handles from a build, or placed while handles only left, stay until crowded
     /// out.)
     placed_for: HashMap<u32, usize>,
+    /// Which handles are overlaid (placed in a posed state; see [`crate::overlay`]):
+    /// they take no part in the partition.
+    overlaid: Vec<bool>,
+    /// The overlaid handles' nodes and bumps.
+    overlay: Overlay,
+    /// The partition's nodes, then the overlay's: the nodes weights and transforms
+    /// are numbered over.
+    all_nodes: Vec<Node>,
+    /// With overlaid handles, the posed picture (what [`Rig::deform`] gives).
+    picture: Vec<DVec2>,
 }
 
 impl Rig {
@@ -484,7 +524,27 @@ impl Rig {
         options: RigOptions,
         progress: &(dyn Fn(Progress) + Sync),
     ) -> Result<Self, RigError> {
+        Self::with_overlaid(domain, handles, &[], virtual_handles, options, progress)
+    }
+
+    /// As [`Rig::with_progress`], with the handles `overlaid` (indices, ascending)
+    /// laid over the weights of the others instead of joining the partition: what a
+    /// handle placed in a posed state is, so that placing it moves nothing away from
+    /// it (see [`Rig::set_handles_overlaid`]).
+    ///
+    /// # Errors
+    /// As [`Rig::with_placed_virtual_handles`], an overlaid index that names no
+    /// handle, and an overlaid handle on the sample of another handle's node.
+    pub fn with_overlaid(
+        domain: Domain,
+        handles: Vec<Handle>,
+        overlaid: &[usize],
+        virtual_handles: &[VirtualHandle],
+        options: RigOptions,
+        progress: &(dyn Fn(Progress) + Sync),
+    ) -> Result<Self, RigError> {
         check_options(&options)?;
+        let overlaid = overlaid_flags(overlaid, handles.len())?;
         if virtual_handles.len() > domain.len() {
             return Err(RigError::TooManyVirtual {
                 count: virtual_handles.len(),
@@ -493,7 +553,8 @@ impl Rig {
         }
         domain.prepare();
         let resolution = domain.mean_edge_length();
-        let mut nodes = real_nodes(&domain, &handles, &options, resolution)?;
+        let (mut nodes, overlaid_nodes) =
+            real_nodes(&domain, &handles, &overlaid, &options, resolution)?;
         let mut taken: std::collections::HashSet<u32> = nodes.iter().map(|n| n.vertex).collect();
         let mut placed_for = HashMap::new();
         for (i, v) in virtual_handles.iter().enumerate() {
@@ -605,7 +666,19 @@ impl Rig {
             timings,
             update_timings: UpdateTimings::default(),
             placed_for,
+            overlaid,
+            overlay: Overlay::default(),
+            all_nodes: Vec::new(),
+            picture: Vec::new(),
         };
+        rig.overlay = Overlay::build(
+            &rig.domain,
+            &rig.options.basis,
+            &rig.handles,
+            &rig.nodes,
+            overlaid_nodes,
+        )?;
+        rig.all_nodes = rig.nodes.iter().chain(&rig.overlay.nodes).copied().collect();
         (rig.harmonic, rig.solved) = harmonic_of(
             &rig.domain,
             &rig.partition,
@@ -659,7 +732,39 @@ impl Rig {
     /// # Errors
     /// As [`Rig::new`]; the rig is unchanged on error.
     pub fn set_handles(&mut self, handles: Vec<Handle>) -> Result<(), RigError> {
-        let same_rest = handles.len() == self.handles.len()
+        // An overlaid handle stays overlaid while it is there, at the same rest place.
+        let mut overlaid: Vec<usize> = match_handles(
+            &self.handles,
+            &handles,
+            &vec![false; self.handles.len()],
+            &vec![false; handles.len()],
+        )
+        .into_iter()
+        .zip(&self.overlaid)
+        .filter_map(|(j, &o)| j.filter(|_| o))
+        .collect();
+        overlaid.sort_unstable();
+        self.set_handles_overlaid(handles, &overlaid)
+    }
+
+    /// Replaces the handles, with the handles `overlaid` (indices into `handles`,
+    /// ascending) laid over the others' weights: each takes its share from the weights
+    /// under its bump (the paper's support: the distance to the nearest node) instead
+    /// of joining the partition, so that nothing outside the bump changes. The handles
+    /// placed in a posed state are overlaid in the editor, so that placing one holds
+    /// the picture where it is.
+    ///
+    /// # Errors
+    /// As [`Rig::set_handles`], and an overlaid index that names no handle or a sample
+    /// that another handle's node takes; the rig is unchanged on error.
+    pub fn set_handles_overlaid(
+        &mut self,
+        handles: Vec<Handle>,
+        overlaid: &[usize],
+    ) -> Result<(), RigError> {
+        let flags = overlaid_flags(overlaid, handles.len())?;
+        let same_rest = flags == self.overlaid
+            && handles.len() == self.handles.len()
             && handles
                 .iter()
                 .zip(&self.handles)
@@ -682,12 +787,26 @@ impl Rig {
             return Ok(());
         }
         let clock = Instant::now();
-        let target = real_nodes(&self.domain, &handles, &self.options, self.resolution)?;
-        let kept = match_handles(&self.handles, &handles);
+        let (target, overlaid_nodes) =
+            real_nodes(&self.domain, &handles, &flags, &self.options, self.resolution)?;
+        let kept = match_handles(&self.handles, &handles, &self.overlaid, &flags);
         self.update_timings = UpdateTimings::default();
         self.update_timings.plan_ms = ms(clock);
         self.handles = handles;
+        self.overlaid = flags;
         self.apply(target, &kept);
+        let clock = Instant::now();
+        // (An overlaid sample on another handle's, the one error, was refused above.)
+        self.overlay = Overlay::build(
+            &self.domain,
+            &self.options.basis,
+            &self.handles,
+            &self.nodes,
+            overlaid_nodes,
+        )
+            .unwrap_or_default();
+        self.all_nodes = self.nodes.iter().chain(&self.overlay.nodes).copied().collect();
+        self.update_timings.weights_ms += ms(clock);
         let clock = Instant::now();
         self.update_affines();
         self.update_timings.transforms_ms += ms(clock);
@@ -1041,7 +1160,7 @@ impl Rig {
         }
         let positions = self.domain.positions();
         self.affines = self
-            .nodes
+            .all_nodes
             .iter()
             .enumerate()
             .map(|(k, n)| match self.group_of(n) {
@@ -1055,6 +1174,18 @@ impl Rig {
                 }
             })
             .collect();
+        self.picture = if self.overlay.is_empty() {
+            Vec::new()
+        } else {
+            self.deform()
+        };
+    }
+
+    /// The posed picture when handles are overlaid (it is no longer a blend of node
+    /// transforms at the rest positions: see [`Rig::set_handles_overlaid`]); `None`
+    /// otherwise, when [`Rig::weight_table`] and [`Rig::node_affines`] give it.
+    pub fn overlaid_picture(&self) -> Option<&[DVec2]> {
+        (!self.overlay.is_empty()).then_some(self.picture.as_slice())
     }
 
     /// Deformed positions of all samples.
@@ -1076,6 +1207,8 @@ impl Rig {
             &self.affines,
             out,
         );
+        self.overlay
+            .pose(&self.handles, self.domain.positions(), out);
     }
 
     /// Where the rest point `p` goes, interpolated barycentrically from the deformed
@@ -1095,7 +1228,19 @@ impl Rig {
     /// # Panics
     /// If `v` is not a sample index.
     pub fn weights(&self, v: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
-        self.weights.row(v, &self.partition.owner)
+        let base = self.weights.row(v, &self.partition.owner);
+        let overlaid = if !self.overlay.touches(v as u32) {
+            None
+        } else {
+            let mut row: Vec<(usize, f64)> = self.weights.row(v, &self.partition.owner).collect();
+            self.overlay.apply(v as u32, &mut row, self.nodes.len());
+            Some(row)
+        };
+        let (base, overlaid) = match overlaid {
+            Some(row) => (None, Some(row.into_iter())),
+            None => (Some(base), None),
+        };
+        base.into_iter().flatten().chain(overlaid.into_iter().flatten())
     }
 
     /// The normalised weights of every sample as compressed rows for a GPU to blend:
@@ -1134,15 +1279,21 @@ impl Rig {
     /// metric: for heat maps, isolines and tests.
     pub fn distances_from_node(&self, k: usize) -> Vec<f64> {
         let mut out = vec![f64::INFINITY; self.domain.len()];
-        for (v, d) in ball(&self.domain, self.nodes[k].vertex, f64::INFINITY) {
+        for (v, d) in ball(&self.domain, self.all_nodes[k].vertex, f64::INFINITY) {
             out[v as usize] = d;
         }
         out
     }
 
-    /// The weighted nodes.
+    /// The weighted nodes: the partition's, then the overlaid handles' samples.
     pub fn nodes(&self) -> &[Node] {
-        &self.nodes
+        &self.all_nodes
+    }
+
+    /// The overlaid handles (ascending): placed in a posed state, laid over the
+    /// others' weights (see [`Rig::set_handles_overlaid`]).
+    pub fn overlaid(&self) -> Vec<usize> {
+        (0..self.overlaid.len()).filter(|&i| self.overlaid[i]).collect()
     }
 
     /// The user handles.
@@ -1162,6 +1313,17 @@ impl Rig {
 
     /// Radii of node `k`.
     pub fn radii(&self, k: usize) -> NodeRadii {
+        if let Some(&r) = k
+            .checked_sub(self.nodes.len())
+            .and_then(|j| self.overlay.radii.get(j))
+        {
+            // An overlaid handle's sample has no cell: its support is r_h.
+            return NodeRadii {
+                r_d: 0.0,
+                r_h: r,
+                support: r,
+            };
+        }
         let s = self.partition.stats[k];
         NodeRadii {
             r_d: s.r_d,
@@ -1207,7 +1369,7 @@ impl Rig {
     /// The real handle a node belongs to: its own for points and bar samples, the one
     /// with the largest harmonic coordinate for a virtual handle.
     pub fn owner_handle(&self, k: usize) -> Option<usize> {
-        match self.nodes[k].kind {
+        match self.all_nodes[k].kind {
             NodeKind::Point { handle } | NodeKind::BarSample { handle, .. } => Some(handle),
             NodeKind::Boundary => None,
             NodeKind::Virtual => self.harmonic_coordinates(k).and_then(|c| {
@@ -1221,7 +1383,8 @@ impl Rig {
 
     /// Sizes.
     pub fn stats(&self) -> RigStats {
-        let count = |f: fn(&NodeKind) -> bool| self.nodes.iter().filter(|n| f(&n.kind)).count();
+        let count =
+            |f: fn(&NodeKind) -> bool| self.all_nodes.iter().filter(|n| f(&n.kind)).count();
         RigStats {
             samples: self.domain.len(),
             real_handles: self.handles.len(),
@@ -1273,6 +1436,9 @@ impl Rig {
     /// Whether the rig equals `other` node for node (up to node numbering) and weight
     /// for weight, bit for bit. For tests of incremental updates.
     pub fn same_weights_as(&self, other: &Rig) -> Result<(), String> {
+        if !self.overlay.same_as(&other.overlay) {
+            return Err("the overlaid handles' bumps differ".to_owned());
+        }
         self.weights.same_as(
             (&self.partition.node_vertex, &self.partition.owner),
             &other.weights,
@@ -1479,6 +1645,19 @@ pub fn bar_spacing(handles: &[Handle], bar: usize) -> f64 {
     spacing_of(own, nearest)
 }
 
+/// [`bar_spacing`] in a rig with the handles `overlaid` (ascending indices): a bar
+/// of the partition counts the partition's other handles; an overlaid bar those and
+/// the overlaid handles before it.
+pub fn bar_spacing_overlaid(handles: &[Handle], overlaid: &[usize], bar: usize) -> f64 {
+    let is_overlaid = |i: usize| overlaid.binary_search(&i).is_ok();
+    let own = segment_of(&handles[bar]);
+    let nearest = (0..handles.len())
+        .filter(|&j| j != bar && (!is_overlaid(j) || (is_overlaid(bar) && j < bar)))
+        .map(|j| segment_distance(own, segment_of(&handles[j])))
+        .fold(f64::INFINITY, f64::min);
+    spacing_of(own, nearest)
+}
+
 /// [`bar_spacing`] of the bar `own` with its nearest other handle `nearest` away.
 fn spacing_of(own: [DVec2; 2], nearest: f64) -> f64 {
     let length = (own[1] - own[0]).length();
@@ -1532,12 +1711,18 @@ fn segment_of(h: &Handle) -> [DVec2; 2] {
 /// The nodes of the handles (and of the pinned border), each on a sample: a point on
 /// the nearest corner of the triangle containing it, bars split into ⌈L/d⌉ pieces with
 /// d from [`bar_spacing`] (no smaller than the mean edge length).
+///
+/// Returns the partition's nodes, and apart the samples of the `overlaid` handles (in
+/// handle order). A bar is cut at its distance to the nearest handle that counts for
+/// it: for a partition bar the other partition handles; for an overlaid one those and
+/// the overlaid handles before it (so a handle placed later re-cuts nothing).
 fn real_nodes(
     domain: &Domain,
     handles: &[Handle],
+    overlaid: &[bool],
     options: &RigOptions,
     resolution: f64,
-) -> Result<Vec<Node>, RigError> {
+) -> Result<(Vec<Node>, Vec<Node>), RigError> {
     if handles.len() > MAX_HANDLES {
         return Err(RigError::TooManyHandles {
             count: handles.len(),
@@ -1563,10 +1748,24 @@ fn real_nodes(
             .unwrap_or(0);
         Ok(tri[best])
     };
-    // The nearest other handle of each bar, through a grid of the handles.
-    let segments: Vec<[DVec2; 2]> = handles.iter().map(segment_of).collect();
+    // The nearest other partition handle of each bar, through a grid of them.
+    let is_overlaid = |i: usize| overlaid.get(i) == Some(&true);
+    let base: Vec<usize> = (0..handles.len()).filter(|&i| !is_overlaid(i)).collect();
+    let segments: Vec<[DVec2; 2]> = base.iter().map(|&i| segment_of(&handles[i])).collect();
     let bars = crate::nearest::SegmentGrid::new(&segments);
+    let nearest = |i: usize| -> f64 {
+        if is_overlaid(i) {
+            let own = segment_of(&handles[i]);
+            (0..handles.len())
+                .filter(|&j| j != i && (!is_overlaid(j) || j < i))
+                .map(|j| segment_distance(own, segment_of(&handles[j])))
+                .fold(f64::INFINITY, f64::min)
+        } else {
+            bars.nearest(base.binary_search(&i).unwrap_or(0))
+        }
+    };
     let mut nodes: Vec<Node> = Vec::new();
+    let mut over: Vec<Node> = Vec::new();
     let mut used: HashMap<u32, usize> = HashMap::new();
     for (i, h) in handles.iter().enumerate() {
         let mut own: Vec<Node> = Vec::new();
@@ -1589,7 +1788,7 @@ fn real_nodes(
                         y: p.y,
                     });
                 }
-                let spacing = spacing_of(rest, bars.nearest(i)).max(resolution);
+                let spacing = spacing_of(rest, nearest(i)).max(resolution);
                 for (t, p) in bar_samples(rest, spacing) {
                     let v = snap(i, p)?;
                     if own.iter().all(|n| n.vertex != v) {
@@ -1606,11 +1805,16 @@ fn real_nodes(
                 return Err(RigError::SameSample { a: j, b: i });
             }
             used.insert(n.vertex, i);
-            nodes.push(n);
+            if is_overlaid(i) {
+                over.push(n);
+            } else {
+                nodes.push(n);
+            }
         }
     }
     if options.fixed_boundary {
-        let spacing = boundary_spacing(handles).max(resolution);
+        let partition_handles: Vec<Handle> = base.iter().map(|&i| handles[i].clone()).collect();
+        let spacing = boundary_spacing(&partition_handles).max(resolution);
         let positions = domain.positions();
         for ring in domain.boundary_loops() {
             let mut since = f64::INFINITY;
@@ -1629,5 +1833,5 @@ fn real_nodes(
             }
         }
     }
-    Ok(nodes)
+    Ok((nodes, over))
 }

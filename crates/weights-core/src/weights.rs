@@ -42,6 +42,21 @@ pub(crate) fn ball(domain: &Domain, source: u32, radius: f64) -> Vec<(u32, f64)>
     search(domain, source, radius, Known::Nothing, None).0
 }
 
+/// The distance from sample `source` to the nearest other sample `is_node` accepts
+/// (intrinsic metric; ∞ if none is reachable).
+pub(crate) fn nearest_node_distance(
+    domain: &Domain,
+    source: u32,
+    is_node: &dyn Fn(u32) -> bool,
+) -> f64 {
+    search(domain, source, f64::INFINITY, Known::Nothing, Some(is_node))
+        .0
+        .iter()
+        .filter(|&&(v, _)| v != source && is_node(v))
+        .map(|&(_, d)| d)
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// What a search already knows of the source's distance field.
 #[derive(Clone, Copy)]
 enum Known<'a> {
