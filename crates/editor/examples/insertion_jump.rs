@@ -164,8 +164,12 @@ fn insertion_jumps(doc: &mut Document, insertions: usize) -> (Vec<Jump>, Vec<Jum
         let positions = rig.domain().positions();
         let own_disc: Vec<(DVec2, f64)> = nodes
             .iter()
-            .filter(|&&k| k >= rig.cells().len().min(usize::MAX) || true)
-            .map(|&k| (positions[rig.nodes()[k].vertex as usize], rig.radii(k).support / 2.0))
+            .map(|&k| {
+                (
+                    positions[rig.nodes()[k].vertex as usize],
+                    rig.radii(k).support / 2.0,
+                )
+            })
             .collect();
         let own_cells: Vec<u32> = nodes.iter().map(|&k| k as u32).collect();
         let same_mesh = positions == rest.as_slice();
@@ -182,57 +186,6 @@ fn insertion_jumps(doc: &mut Document, insertions: usize) -> (Vec<Jump>, Vec<Jum
             reach(&project, new),
             &own,
         );
-        if std::env::var("FIT").is_ok() && same_mesh {
-            // What an affine fit of the new handle's transform (through its point)
-            // would leave.
-            let k0 = nodes[0];
-            let anchor = rest_points(&project.handles[new])[if bar { 1 } else { 0 }];
-            let centre_img = doc_point(&deformed, rig, anchor);
-            let mut share = vec![0.0; rest.len()];
-            for v in 0..rest.len() {
-                share[v] = doc.rig().weights(v).filter(|(k, _)| nodes.contains(k)).map(|e| e.1).sum();
-            }
-            let _ = k0;
-            let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
-            let (mut bx, mut by) = (DVec2::ZERO, DVec2::ZERO);
-            for v in 0..rest.len() {
-                let w = share[v] * share[v];
-                if w == 0.0 { continue; }
-                let d = rest[v] - anchor;
-                let t = deformed[v] - centre_img;
-                sxx += w * d.x * d.x; sxy += w * d.x * d.y; syy += w * d.y * d.y;
-                bx += w * d.x * t; by += w * d.y * t;
-            }
-            let det = sxx * syy - sxy * sxy;
-            let (ix, iy) = ((syy * bx - sxy * by) / det, (sxx * by - sxy * bx) / det);
-            let mut worst: f64 = 0.0;
-            for v in 0..rest.len() {
-                if share[v] == 0.0 || own(v) { continue; }
-                let d = rest[v] - anchor;
-                let a = centre_img + ix * d.x + iy * d.y;
-                worst = worst.max(share[v] * a.distance(deformed[v]));
-            }
-            // similarity through the anchor: z = Σ w conj(d) t / Σ w |d|²
-            let (mut re, mut im, mut nn) = (0.0, 0.0, 0.0);
-            for v in 0..rest.len() {
-                let w = share[v] * share[v];
-                if w == 0.0 { continue; }
-                let d = rest[v] - anchor;
-                let t = deformed[v] - centre_img;
-                re += w * (d.x * t.x + d.y * t.y);
-                im += w * (d.x * t.y - d.y * t.x);
-                nn += w * d.length_squared();
-            }
-            let (zr, zi) = (re / nn, im / nn);
-            let mut worst_s: f64 = 0.0;
-            for v in 0..rest.len() {
-                if share[v] == 0.0 || own(v) { continue; }
-                let d = rest[v] - anchor;
-                let a = centre_img + DVec2::new(zr * d.x - zi * d.y, zi * d.x + zr * d.y);
-                worst_s = worst_s.max(share[v] * a.distance(deformed[v]));
-            }
-            println!("fit: measured {:.2}, affine {:.2}, similarity {:.2}", j.outside_cell, worst, worst_s);
-        }
         if bar {
             bars.push(j);
         } else {
@@ -268,10 +221,6 @@ fn removal_jumps(doc: &mut Document) -> Vec<Jump> {
         doc.undo_to(snapshot).expect("undo");
     }
     jumps
-}
-
-fn doc_point(deformed: &[DVec2], rig: &weights_core::Rig, p: DVec2) -> DVec2 {
-    rig.deform_point(deformed, p).unwrap_or(p)
 }
 
 /// What `EditorApp::add_point` does.
@@ -351,15 +300,28 @@ fn document(name: &str) -> anyhow::Result<Document> {
             placed.push(p);
         }
     }
-    for p in placed {
-        let offset = DVec2::new(rng.unit() - 0.5, rng.unit() - 0.5) * 0.12 * diagonal;
+    // Placed at rest, then posed, as an artist rigs a picture.
+    for p in &placed {
         doc.apply(Edit::Add(HandleSpec::Point {
             rest: p.to_array(),
-            translate: offset.to_array(),
-            rotate: (rng.unit() - 0.5) * 0.6,
+            translate: [0.0; 2],
+            rotate: 0.0,
             scale: 1.0,
             depth: 0,
         }))?;
+    }
+    for (i, p) in placed.into_iter().enumerate() {
+        let offset = DVec2::new(rng.unit() - 0.5, rng.unit() - 0.5) * 0.12 * diagonal;
+        doc.apply(Edit::Pose(
+            i,
+            HandleSpec::Point {
+                rest: p.to_array(),
+                translate: offset.to_array(),
+                rotate: (rng.unit() - 0.5) * 0.6,
+                scale: 1.0,
+                depth: 0,
+            },
+        ))?;
     }
     Ok(doc)
 }

@@ -412,7 +412,15 @@ impl Document {
                 if index >= project.handles.len() {
                     bail!("there is no handle {index}");
                 }
+                // An overlaid handle takes its layer along and nothing else; a handle
+                // of the partition re-partitions the shape (the paper's removal), and
+                // the overlaid handles join it, so the remaining handles hold the
+                // whole picture again.
+                let partition = !project.overlaid.contains(&index);
                 project.remove_handle(index);
+                if partition {
+                    project.overlaid.clear();
+                }
             }
             Edit::Pose(index, handle) => match project.handles.get_mut(index) {
                 Some(slot) if same_rest(slot, &handle) => *slot = handle,
@@ -434,7 +442,11 @@ impl Document {
                 // At rest, nothing is held away from it; without keys, every handle
                 // joins the paper's weights again.
                 project.holds.clear();
-                if project.animation.as_ref().is_none_or(|a| a.keys.is_empty() && a.spatial_keys.is_empty()) {
+                if project
+                    .animation
+                    .as_ref()
+                    .is_none_or(|a| a.keys.is_empty() && a.spatial_keys.is_empty())
+                {
                     project.overlaid.clear();
                 }
             }

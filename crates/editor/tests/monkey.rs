@@ -359,7 +359,7 @@ impl Monkey {
                 "wait for the job".to_owned()
             }
             97 => self.perform(),
-            98 => self.pin_under_arap(),
+            98 => self.pin_in_pose(),
             _ => {
                 let size = *self.rng.pick(&[
                     Vec2::new(1200.0, 800.0),
@@ -384,29 +384,31 @@ impl Monkey {
         self.frames(1);
     }
 
-    /// A pin clicked onto the picture under ARAP, in whatever pose it is in (the walk
-    /// checks that it moves nothing): ARAP chosen if a handle method is in use, the
-    /// Puppet tool, a click on a vertex of the picture where it is shown.
-    fn pin_under_arap(&mut self) -> String {
+    /// A pin clicked onto the picture under ARAP or the C² weights, in whatever pose
+    /// it is in (the walk checks that it moves nothing): one of them chosen if a
+    /// handle method is in use, the Puppet tool, a click on a vertex of the picture
+    /// where it is shown.
+    fn pin_in_pose(&mut self) -> String {
         let app = self.h.state();
         let usable = !app.is_busy()
             && app
                 .document()
                 .is_some_and(|d| d.method().controls() == project::Controls::Handles);
         if !usable {
-            return "pin under ARAP (not now)".to_owned();
+            return "pin in a pose (not now)".to_owned();
         }
-        let arap = app
+        let holding = app
             .document()
-            .is_some_and(|d| d.method() == project::Method::Arap);
-        if !arap {
-            if let Some(node) = self.h.query_all_by_label("ARAP").next() {
+            .is_some_and(|d| matches!(d.method(), project::Method::Arap | project::Method::C2));
+        if !holding {
+            let method = *self.rng.pick(&[project::Method::Arap, project::Method::C2]);
+            if let Some(node) = self.h.query_all_by_label(method.label()).next() {
                 node.click();
             }
             // A large picture sets ARAP up on the worker.
             self.frames(1);
             self.wait_for_job();
-            return "ARAP chosen".to_owned();
+            return format!("{} chosen", method.label());
         }
         if self.h.state().tool != editor::Tool::Puppet {
             self.h.key_press(Key::W);
@@ -414,11 +416,11 @@ impl Monkey {
             return "the Puppet tool".to_owned();
         }
         let Some(doc) = self.h.state_mut().document_mut() else {
-            return "pin under ARAP (no picture)".to_owned();
+            return "pin in a pose (no picture)".to_owned();
         };
         let shown = doc.deformed().to_vec();
         if shown.is_empty() {
-            return "pin under ARAP (no mesh)".to_owned();
+            return "pin in a pose (no mesh)".to_owned();
         }
         let at = shown[self.rng.below(shown.len())];
         let pos = self.h.state().viewport.to_screen(at);
@@ -428,7 +430,7 @@ impl Monkey {
         self.frames(1);
         self.button(pos, egui::PointerButton::Primary, false, Modifiers::NONE);
         self.frames(2);
-        format!("pin under ARAP at {at}")
+        format!("pin in a pose at {at}")
     }
 
     /// The perform tool: a pose marker placed (with the button or Ctrl + click), or the
@@ -711,17 +713,17 @@ fn walk(seed: u64, actions: usize) {
     let mut reopened = 0usize;
     // Actions taken with two keys or more, the most keys seen, actions with markers.
     let (mut keyed, mut most_keys, mut marked) = (0usize, 0usize, 0usize);
-    // Pins placed under ARAP, each checked to have moved nothing.
+    // Pins placed under ARAP or C², each checked to have moved nothing.
     let mut held = 0usize;
     for step in 0..actions {
         let result = std::panic::catch_unwind(AssertUnwindSafe(|| {
-            // What the picture was, to check that a pin placed under ARAP (in any
-            // pose) moves nothing.
+            // What the picture was, to check that a pin placed under ARAP or C² (in
+            // any pose) moves nothing.
             let before = monkey
                 .h
                 .state_mut()
                 .document_mut()
-                .filter(|d| d.method() == project::Method::Arap)
+                .filter(|d| matches!(d.method(), project::Method::Arap | project::Method::C2))
                 .map(|d| {
                     let handles = d.project().handles.clone();
                     (handles, d.mesh_version(), d.deformed().to_vec())
@@ -750,7 +752,8 @@ fn walk(seed: u64, actions: usize) {
             {
                 let now = &doc.project().handles;
                 let placed = now.len() == handles.len() + 1 && now[..handles.len()] == handles[..];
-                if placed && doc.mesh_version() == mesh && doc.method() == project::Method::Arap {
+                let holding = matches!(doc.method(), project::Method::Arap | project::Method::C2);
+                if placed && doc.mesh_version() == mesh && holding {
                     held += 1;
                     let moved = shown
                         .iter()
@@ -759,7 +762,8 @@ fn walk(seed: u64, actions: usize) {
                         .fold(0.0, f64::max);
                     anyhow::ensure!(
                         moved <= 0.1,
-                        "a pin placed under ARAP moved the picture by {moved} px"
+                        "a pin placed under {} moved the picture by {moved} px",
+                        doc.method().label()
                     );
                 }
             }
@@ -824,7 +828,7 @@ fn walk(seed: u64, actions: usize) {
     );
     println!(
         "  with two keys or more: {keyed} actions (at most {most_keys} keys); with pose \
-         markers: {marked}; pins placed under ARAP, none moving the picture: {held}"
+         markers: {marked}; pins placed in a pose under ARAP or C², none moving the picture: {held}"
     );
     slowest.sort_by(|a, b| b.0.total_cmp(&a.0));
     for (s, what) in slowest.iter().take(3) {

@@ -444,8 +444,8 @@ pub fn rig_on_mesh(
                     *rest,
                     weights_core::bar_spacing_overlaid(&handles, &project.overlaid, i),
                 )
-                    .into_iter()
-                    .map(|(_, p)| p),
+                .into_iter()
+                .map(|(_, p)| p),
             ),
         }
     }

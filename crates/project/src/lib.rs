@@ -723,20 +723,23 @@ impl Project {
                     .map(|k| &k.pose)
                     .chain(a.spatial_keys.iter().map(|k| &k.pose))
                     .any(|p| {
-                        p.handles.iter().zip(&self.handles).any(|(k, h)| match (k, h) {
-                            (
-                                HandlePose::Point {
-                                    translate,
-                                    rotate,
-                                    scale,
-                                },
-                                _,
-                            ) => *translate != [0.0; 2] || *rotate != 0.0 || *scale != 1.0,
-                            (HandlePose::Bar { pose }, HandleSpec::Bar { rest, .. }) => {
-                                pose != rest
-                            }
-                            (HandlePose::Bar { .. }, HandleSpec::Point { .. }) => false,
-                        })
+                        p.handles
+                            .iter()
+                            .zip(&self.handles)
+                            .any(|(k, h)| match (k, h) {
+                                (
+                                    HandlePose::Point {
+                                        translate,
+                                        rotate,
+                                        scale,
+                                    },
+                                    _,
+                                ) => *translate != [0.0; 2] || *rotate != 0.0 || *scale != 1.0,
+                                (HandlePose::Bar { pose }, HandleSpec::Bar { rest, .. }) => {
+                                    pose != rest
+                                }
+                                (HandlePose::Bar { .. }, HandleSpec::Point { .. }) => false,
+                            })
                     })
             })
     }
@@ -836,7 +839,8 @@ impl Project {
             }
         }
         if let Some(i) = (0..self.overlaid.len()).find(|&i| {
-            self.overlaid[i] >= self.handles.len() || (i > 0 && self.overlaid[i] <= self.overlaid[i - 1])
+            self.overlaid[i] >= self.handles.len()
+                || (i > 0 && self.overlaid[i] <= self.overlaid[i - 1])
         }) {
             return bad(format!(
                 "overlaid[{i}] names handle {}: the list must be ascending, each of the {} \

@@ -38,10 +38,10 @@ pub use basis::{Basis, MAX_DEGREE, MIN_DEGREE, MiddleControls};
 pub use domain::{Domain, Metric};
 pub use error::{DomainError, RigError};
 pub use geometry::Similarity;
+pub use overlay::similarity_fit;
 pub use rig::{
     BuildTimings, COINCIDENT, Handle, MAX_BAR_PIECES, MAX_HANDLES, MAX_POSE, MAX_SCALE, MIN_SCALE,
     Node, NodeKind, NodeRadii, Phase, Progress, Rig, RigOptions, RigStats, UpdateTimings,
     VirtualHandle, bar_samples, bar_spacing, bar_spacing_overlaid,
 };
-pub use overlay::similarity_fit;
 pub use virtual_handles::Placement;

@@ -162,9 +162,9 @@ impl Overlay {
             };
             for n in own {
                 let radius = match domain.metric() {
-                    Metric::Intrinsic => nearest_node_distance(domain, n.vertex, &|v| {
-                        is_node.contains(v) || mine(v)
-                    }),
+                    Metric::Intrinsic => {
+                        nearest_node_distance(domain, n.vertex, &|v| is_node.contains(v) || mine(v))
+                    }
                     Metric::Euclidean => {
                         let p = positions[n.vertex as usize];
                         points
@@ -197,8 +197,10 @@ impl Overlay {
                     }
                 }
             }
-            let mut share: Vec<(u32, f64)> =
-                share.into_iter().map(|(v, (keep, _))| (v, 1.0 - keep)).collect();
+            let mut share: Vec<(u32, f64)> = share
+                .into_iter()
+                .map(|(v, (keep, _))| (v, 1.0 - keep))
+                .collect();
             share.sort_unstable_by_key(|e| e.0);
             overlay.layers.push(Layer {
                 handle: handle.unwrap_or(usize::MAX),
@@ -266,7 +268,11 @@ impl Overlay {
                 continue;
             };
             let fitted = match &layer.anchor {
-                Anchor::Point { rest, at: place, fit } => at(picture, place).map(|p: DVec2| {
+                Anchor::Point {
+                    rest,
+                    at: place,
+                    fit,
+                } => at(picture, place).map(|p: DVec2| {
                     let (a, b) = similarity_terms(positions, picture, fit, *rest, p);
                     let linear = glam::DMat2::from_cols(DVec2::new(a, b), DVec2::new(-b, a));
                     DAffine2::from_mat2_translation(linear, p - linear * *rest)
@@ -318,7 +324,6 @@ fn handle_of(n: &Node) -> Option<usize> {
         NodeKind::Boundary | NodeKind::Virtual => None,
     }
 }
-
 
 /// The rest point a layer is anchored at.
 fn anchor_point(anchor: &Anchor) -> DVec2 {

@@ -678,7 +678,12 @@ impl Rig {
             &rig.nodes,
             overlaid_nodes,
         )?;
-        rig.all_nodes = rig.nodes.iter().chain(&rig.overlay.nodes).copied().collect();
+        rig.all_nodes = rig
+            .nodes
+            .iter()
+            .chain(&rig.overlay.nodes)
+            .copied()
+            .collect();
         (rig.harmonic, rig.solved) = harmonic_of(
             &rig.domain,
             &rig.partition,
@@ -787,8 +792,13 @@ impl Rig {
             return Ok(());
         }
         let clock = Instant::now();
-        let (target, overlaid_nodes) =
-            real_nodes(&self.domain, &handles, &flags, &self.options, self.resolution)?;
+        let (target, overlaid_nodes) = real_nodes(
+            &self.domain,
+            &handles,
+            &flags,
+            &self.options,
+            self.resolution,
+        )?;
         let kept = match_handles(&self.handles, &handles, &self.overlaid, &flags);
         self.update_timings = UpdateTimings::default();
         self.update_timings.plan_ms = ms(clock);
@@ -804,8 +814,13 @@ impl Rig {
             &self.nodes,
             overlaid_nodes,
         )
-            .unwrap_or_default();
-        self.all_nodes = self.nodes.iter().chain(&self.overlay.nodes).copied().collect();
+        .unwrap_or_default();
+        self.all_nodes = self
+            .nodes
+            .iter()
+            .chain(&self.overlay.nodes)
+            .copied()
+            .collect();
         self.update_timings.weights_ms += ms(clock);
         let clock = Instant::now();
         self.update_affines();
@@ -1240,7 +1255,9 @@ impl Rig {
             Some(row) => (None, Some(row.into_iter())),
             None => (Some(base), None),
         };
-        base.into_iter().flatten().chain(overlaid.into_iter().flatten())
+        base.into_iter()
+            .flatten()
+            .chain(overlaid.into_iter().flatten())
     }
 
     /// The normalised weights of every sample as compressed rows for a GPU to blend:
@@ -1286,6 +1303,10 @@ impl Rig {
     }
 
     /// The weighted nodes: the partition's, then the overlaid handles' samples.
+    #[expect(
+        clippy::misnamed_getters,
+        reason = "the field `nodes` is the partition's alone; every node is in `all_nodes`"
+    )]
     pub fn nodes(&self) -> &[Node] {
         &self.all_nodes
     }
@@ -1293,7 +1314,9 @@ impl Rig {
     /// The overlaid handles (ascending): placed in a posed state, laid over the
     /// others' weights (see [`Rig::set_handles_overlaid`]).
     pub fn overlaid(&self) -> Vec<usize> {
-        (0..self.overlaid.len()).filter(|&i| self.overlaid[i]).collect()
+        (0..self.overlaid.len())
+            .filter(|&i| self.overlaid[i])
+            .collect()
     }
 
     /// The user handles.
@@ -1383,8 +1406,7 @@ impl Rig {
 
     /// Sizes.
     pub fn stats(&self) -> RigStats {
-        let count =
-            |f: fn(&NodeKind) -> bool| self.all_nodes.iter().filter(|n| f(&n.kind)).count();
+        let count = |f: fn(&NodeKind) -> bool| self.all_nodes.iter().filter(|n| f(&n.kind)).count();
         RigStats {
             samples: self.domain.len(),
             real_handles: self.handles.len(),

@@ -64,7 +64,10 @@ fn placed_point(rig: &Rig, picture: &[DVec2], rest: DVec2) -> Handle {
 }
 
 fn largest_move(a: &[DVec2], b: &[DVec2]) -> f64 {
-    a.iter().zip(b).map(|(p, q)| p.distance(*q)).fold(0.0, f64::max)
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| p.distance(*q))
+        .fold(0.0, f64::max)
 }
 
 fn check_weights(rig: &Rig) {
@@ -85,10 +88,16 @@ fn check_weights(rig: &Rig) {
         let row: Vec<(usize, f64)> = rig.weights(node.vertex as usize).collect();
         let own: f64 = row
             .iter()
-            .filter(|e| rig.owner_handle(e.0) == Some(h) && rig.nodes()[e.0].kind != weights_core::NodeKind::Virtual)
+            .filter(|e| {
+                rig.owner_handle(e.0) == Some(h)
+                    && rig.nodes()[e.0].kind != weights_core::NodeKind::Virtual
+            })
             .map(|e| e.1)
             .sum();
-        assert!((own - 1.0).abs() < 1e-12, "handle {h}'s node {k} holds {own} of its sample");
+        assert!(
+            (own - 1.0).abs() < 1e-12,
+            "handle {h}'s node {k} holds {own} of its sample"
+        );
     }
 }
 
@@ -102,22 +111,31 @@ fn placing_a_handle_in_a_posed_state_moves_nothing() {
         handles.push(Handle::Bar {
             rest: [DVec2::new(120.0, 20.0), DVec2::new(150.0, 40.0)],
             pose: [
-                rig.deform_point(&before, DVec2::new(120.0, 20.0)).unwrap(),
-                rig.deform_point(&before, DVec2::new(150.0, 40.0)).unwrap(),
+                rig.deform_point(&before, DVec2::new(120.0, 20.0))
+                    .expect("on the shape"),
+                rig.deform_point(&before, DVec2::new(150.0, 40.0))
+                    .expect("on the shape"),
             ],
         });
-        rig.set_handles_overlaid(handles.clone(), &[4, 5]).expect("overlaid");
+        rig.set_handles_overlaid(handles.clone(), &[4, 5])
+            .expect("overlaid");
         assert_eq!(rig.overlaid(), vec![4, 5]);
         let after = rig.deform();
         let moved = largest_move(&before, &after);
-        assert!(moved < 1e-6, "{shape:?}: placing two handles moved the picture {moved} px");
+        assert!(
+            moved < 1e-6,
+            "{shape:?}: placing two handles moved the picture {moved} px"
+        );
         check_weights(&rig);
 
         // The same handles not overlaid: the paper's re-partition moves it.
         let mut plain = posed_rig(shape);
         plain.set_handles(handles.clone()).expect("inserted");
         let jump = largest_move(&before, &plain.deform());
-        assert!(jump > 0.5, "{shape:?}: the paper's insertion moved only {jump} px");
+        assert!(
+            jump > 0.5,
+            "{shape:?}: the paper's insertion moved only {jump} px"
+        );
 
         // A rebuild with the same handles, overlaid, is the same rig.
         let rebuilt = Rig::with_overlaid(
@@ -141,7 +159,8 @@ fn an_overlaid_handle_moves_the_picture_under_it_and_holds_its_point() {
     let rest = DVec2::new(105.0, 42.0);
     let mut handles = rig.handles().to_vec();
     handles.push(placed_point(&rig, &picture, rest));
-    rig.set_handles_overlaid(handles.clone(), &[4]).expect("overlaid");
+    rig.set_handles_overlaid(handles.clone(), &[4])
+        .expect("overlaid");
 
     // Dragged by (15, −8): its point follows exactly, far away nothing moves.
     let Handle::Point { transform, .. } = handles[4] else {
@@ -153,9 +172,12 @@ fn an_overlaid_handle_moves_the_picture_under_it_and_holds_its_point() {
     };
     rig.set_point_transform(4, dragged).expect("posed");
     let moved = rig.deform();
-    let at = rig.deform_point(&moved, rest).unwrap();
+    let at = rig.deform_point(&moved, rest).expect("on the shape");
     let expected = rest + dragged.translation;
-    assert!(at.distance(expected) < 0.5, "its point is at {at}, the handle at {expected}");
+    assert!(
+        at.distance(expected) < 0.5,
+        "its point is at {at}, the handle at {expected}"
+    );
     let positions = rig.domain().positions();
     let last = rig.nodes().len() - 1;
     let (r, centre) = (
@@ -164,7 +186,10 @@ fn an_overlaid_handle_moves_the_picture_under_it_and_holds_its_point() {
     );
     for v in 0..positions.len() {
         if positions[v].distance(centre) > r {
-            assert!(moved[v].distance(picture[v]) < 1e-9, "sample {v} beyond the bump moved");
+            assert!(
+                moved[v].distance(picture[v]) < 1e-9,
+                "sample {v} beyond the bump moved"
+            );
         }
     }
 
@@ -175,8 +200,11 @@ fn an_overlaid_handle_moves_the_picture_under_it_and_holds_its_point() {
     }
     rig.set_handles_overlaid(handles, &[4]).expect("posed");
     let moved = rig.deform();
-    let at = rig.deform_point(&moved, rest).unwrap();
-    assert!(at.distance(expected) < 0.5, "its point went to {at}, the handle is at {expected}");
+    let at = rig.deform_point(&moved, rest).expect("on the shape");
+    assert!(
+        at.distance(expected) < 0.5,
+        "its point went to {at}, the handle is at {expected}"
+    );
     check_weights(&rig);
 }
 
@@ -186,7 +214,8 @@ fn removing_an_overlaid_handle_restores_the_picture_and_bad_indices_are_refused(
     let picture = rig.deform();
     let mut handles = rig.handles().to_vec();
     handles.push(placed_point(&rig, &picture, DVec2::new(105.0, 42.0)));
-    rig.set_handles_overlaid(handles.clone(), &[4]).expect("overlaid");
+    rig.set_handles_overlaid(handles.clone(), &[4])
+        .expect("overlaid");
     assert!(rig.set_handles_overlaid(handles.clone(), &[5]).is_err());
     assert_eq!(rig.overlaid(), vec![4], "unchanged on error");
     rig.remove_handle(4).expect("removed");

@@ -533,3 +533,102 @@ fn handles_half_a_pixel_apart_are_placed_and_reopen_the_same() {
         "{error}"
     );
 }
+
+#[test]
+fn under_c2_a_pin_placed_in_a_posed_state_is_overlaid_and_moves_no_key() {
+    let mut doc = document();
+    doc.apply(Edit::Add(point(30.0, 24.0)))
+        .expect("a third pin");
+    // A key at rest, then a bent pose keyed at one second and shown.
+    let keyed = doc.keyed_at(0.0);
+    doc.apply(Edit::Animation(Some(Box::new(keyed))))
+        .expect("a key at rest");
+    doc.apply(Edit::Pose(
+        1,
+        HandleSpec::Point {
+            rest: [50.0, 30.0],
+            translate: [6.0, 9.0],
+            rotate: 0.5,
+            scale: 1.0,
+            depth: 0,
+        },
+    ))
+    .expect("pose");
+    let keyed = doc.keyed_at(1.0);
+    doc.apply(Edit::Animation(Some(Box::new(keyed))))
+        .expect("a bent key");
+    let poses = |doc: &Document| -> Vec<project::Pose> {
+        doc.keys().iter().map(|k| k.pose.clone()).collect()
+    };
+    let pictures = |doc: &mut Document| -> Vec<Vec<DVec2>> {
+        poses(doc)
+            .iter()
+            .map(|p| doc.posed_mesh(p).expect("a key's picture").deformed)
+            .collect()
+    };
+    for (i, (x, y)) in [(36.0, 6.0), (14.0, 40.0)].into_iter().enumerate() {
+        let before = doc.deformed().to_vec();
+        let keys_before = pictures(&mut doc);
+        let at = DVec2::new(x, y);
+        let (rest, _, _) = doc.unwarp(at).expect("on the picture");
+        let (rotate, scale) = doc.local_pose(rest, at);
+        doc.apply(Edit::Add(HandleSpec::Point {
+            rest: rest.to_array(),
+            translate: (at - rest).to_array(),
+            rotate,
+            scale,
+            depth: 0,
+        }))
+        .expect("insert");
+        assert_eq!(doc.project().overlaid.len(), i + 1, "laid over the weights");
+        let largest = |a: &[DVec2], b: &[DVec2]| {
+            a.iter()
+                .zip(b)
+                .map(|(p, q)| p.distance(*q))
+                .fold(0.0, f64::max)
+        };
+        let jump = largest(&before, doc.deformed());
+        assert!(jump < 1e-6, "insertion {i}: the picture moved by {jump} px");
+        for (k, (a, b)) in keys_before.iter().zip(pictures(&mut doc)).enumerate() {
+            let jump = largest(a, &b);
+            assert!(jump < 1e-6, "insertion {i}: key {k} moved by {jump} px");
+        }
+        doc.check_reopens().expect("reopens as shown");
+    }
+    // Dragged, the new pin moves what is under it.
+    let last = doc.project().handles.len() - 1;
+    let HandleSpec::Point {
+        rest,
+        translate,
+        rotate,
+        scale,
+        depth,
+    } = doc.project().handles[last].clone()
+    else {
+        unreachable!("a point")
+    };
+    let before = doc.deformed().to_vec();
+    doc.apply(Edit::Pose(
+        last,
+        HandleSpec::Point {
+            rest,
+            translate: [translate[0] + 4.0, translate[1]],
+            rotate,
+            scale,
+            depth,
+        },
+    ))
+    .expect("pose");
+    let shift = before
+        .iter()
+        .zip(doc.deformed())
+        .map(|(a, b)| a.distance(*b))
+        .fold(0.0, f64::max);
+    assert!(
+        shift > 3.0,
+        "the overlaid pin moves what is under it ({shift})"
+    );
+    // Removing a pin of the partition lets the overlaid ones join it.
+    doc.apply(Edit::Remove(0)).expect("remove");
+    assert!(doc.project().overlaid.is_empty());
+}
