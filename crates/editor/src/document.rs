@@ -412,13 +412,22 @@ impl Document {
                 if index >= project.handles.len() {
                     bail!("there is no handle {index}");
                 }
-                // An overlaid handle takes its layer along and nothing else; a handle
-                // of the partition re-partitions the shape (the paper's removal), and
-                // the overlaid handles join it, so the remaining handles hold the
-                // whole picture again.
-                let partition = !project.overlaid.contains(&index);
+                // An overlaid handle takes its layer along and nothing else.
+                let overlaid = project.overlaid.contains(&index);
+                let partition_left = (0..project.handles.len())
+                    .any(|i| i != index && !project.overlaid.contains(&i));
+                let posed = project.is_posed();
                 project.remove_handle(index);
-                if partition {
+                if !overlaid && posed && partition_left {
+                    // In a posed state a handle of the partition leaves its nodes
+                    // behind as virtual handles: the cells and weights stay as they
+                    // are, and what it held follows the remaining handles
+                    // harmonically, as the paper's virtual handles do.
+                    return self.remove_keeping_nodes(project, index);
+                }
+                if !overlaid && !partition_left {
+                    // The last handle of the partition: the overlaid ones join it (left
+                    // over an empty partition they would hold their bumps alone).
                     project.overlaid.clear();
                 }
             }
@@ -521,6 +530,42 @@ impl Document {
             }
         }
         self.restore(project)
+    }
+
+    /// Makes `project` (the document's, with handle `removed` of the partition taken
+    /// out) the document's rig file, with that handle's nodes kept as virtual handles.
+    fn remove_keeping_nodes(&mut self, mut project: Project, removed: usize) -> Result<()> {
+        let snapshot = self.snapshot();
+        let rig = &self.rig;
+        let positions = rig.domain().positions();
+        let left: Vec<[f64; 2]> = (0..rig.nodes().len())
+            .filter(|&k| {
+                rig.owner_handle(k) == Some(removed)
+                    && matches!(
+                        rig.nodes()[k].kind,
+                        weights_core::NodeKind::Point { .. }
+                            | weights_core::NodeKind::BarSample { .. }
+                    )
+            })
+            .map(|k| positions[rig.nodes()[k].vertex as usize].to_array())
+            .collect();
+        let renumber = |h: Option<usize>| match h {
+            Some(h) if h > removed => Some(h - 1),
+            Some(h) if h == removed => None,
+            other => other,
+        };
+        project.virtual_placed_for = snapshot
+            .virtual_placed_for
+            .iter()
+            .map(|&h| renumber(h))
+            .chain(std::iter::repeat_n(None, left.len()))
+            .collect();
+        project.virtual_handles = snapshot.virtual_handles;
+        project.virtual_handles.extend(left);
+        if project.virtual_placed_for.iter().all(Option::is_none) {
+            project.virtual_placed_for.clear();
+        }
+        self.restore_with(project, true)
     }
 
     /// Refuses a cage off the picture, with too few or too many vertices, or with

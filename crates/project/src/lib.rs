@@ -1064,6 +1064,28 @@ mod tests {
     use super::*;
 
     #[test]
+    fn overlaid_handles_are_checked_and_follow_their_handles() {
+        let text = r#"{"version":1,"handles":[
+            {"type":"point","rest":[10,10]},{"type":"point","rest":[30,10],"translate":[2,0]},
+            {"type":"point","rest":[50,10]}],"overlaid":[0,2]}"#;
+        let mut project = Project::from_json(text).expect("a rig with overlaid handles");
+        assert!(project.is_posed());
+        assert_eq!(
+            Project::from_json(&project.to_json()).expect("round trip"),
+            project
+        );
+        project.remove_handle(0);
+        assert_eq!(project.overlaid, [1], "renumbered, the removed one gone");
+        for bad in ["[0,0]", "[2,0]", "[3]"] {
+            let text = text.replace("[0,2]", bad);
+            let error = Project::from_json(&text).expect_err(bad).to_string();
+            assert!(error.contains("overlaid"), "{bad}: {error}");
+        }
+        let at_rest = text.replace(r#","translate":[2,0]"#, "");
+        assert!(!Project::from_json(&at_rest).expect("at rest").is_posed());
+    }
+
+    #[test]
     fn holds_are_checked_and_follow_their_handles() {
         let text = r#"{"version":1,"handles":[
             {"type":"point","rest":[10,10]},{"type":"point","rest":[30,10]},

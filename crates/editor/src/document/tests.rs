@@ -628,7 +628,18 @@ fn under_c2_a_pin_placed_in_a_posed_state_is_overlaid_and_moves_no_key() {
         shift > 3.0,
         "the overlaid pin moves what is under it ({shift})"
     );
-    // Removing a pin of the partition lets the overlaid ones join it.
+    // Removing a pin of the partition in a posed state leaves its node behind as a
+    // virtual handle: the same nodes, the overlaid pins renumbered.
+    let nodes = doc.rig().nodes().len();
+    let virtuals = doc.rig().stats().virtual_nodes;
+    doc.apply(Edit::Remove(0)).expect("remove");
+    assert_eq!(doc.project().overlaid, [2, 3]);
+    assert_eq!(doc.rig().nodes().len(), nodes);
+    assert_eq!(doc.rig().stats().virtual_nodes, virtuals + 1);
+    doc.check_reopens().expect("reopens as shown");
+    // Removing the last pin of the partition lets the overlaid ones join it.
+    doc.apply(Edit::Remove(0)).expect("remove");
+    assert_eq!(doc.project().overlaid, [1, 2]);
     doc.apply(Edit::Remove(0)).expect("remove");
     assert!(doc.project().overlaid.is_empty());
 }
