@@ -67,6 +67,8 @@ pub(crate) struct PassTriangle {
     pub fit: [DVec2; 2],
     /// Rest edges `v0 → v1` and `v1 → v2` times the rigidity weight.
     pub edges: [DVec2; 2],
+    /// The rigidity weight.
+    pub weight: f64,
 }
 
 /// One block of `B` (eq. 8) and `D` (eq. 16): how free unknown `free` depends on the
@@ -360,6 +362,7 @@ impl Registration {
                     vertices: tri,
                     fit: mesh.fit[t as usize],
                     edges: [w * (r[1] - r[0]), w * (r[2] - r[1])],
+                    weight: w,
                 }
             })
             .collect();

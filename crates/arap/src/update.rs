@@ -164,16 +164,107 @@ impl Compiled {
         }
 
         // Step two: fit each rest triangle to its step-one triangle (eqs. 9–11),
-        // keep the rotation (the fit scaled back to rest size), and add the fitted
-        // edges to the linear term f of the final solve (eqs. 12–16) at each corner:
-        // corner c ends edge c−1 → c and starts edge c → c+1.
+        // keep the rotation (the fit scaled back to rest size), and solve for the
+        // positions whose edges are nearest the rotated rest edges (eqs. 12–16).
+        out.positions.clone_from(&out.step_one);
+        for (&v, &t) in self.constrained.iter().zip(targets) {
+            out.positions[v as usize] = t;
+        }
+        self.fit_and_solve(two, &out.step_one, targets, &mut out.positions, scratch);
+        Ok(())
+    }
+
+    /// Refines `out.positions` (a pose of these constraints at `targets`) towards
+    /// the minimum of the ARAP energy [`Compiled::energy`] with local/global
+    /// iterations (Sorkine and Alexa 2007): each fits every triangle's rotation to its
+    /// current shape (the local step, the paper's step-two fit) and solves step two's
+    /// system with those rotations (the global step, one back-substitution). Neither
+    /// step raises the energy. Stops after `iterations`, or once no vertex moves
+    /// farther than `tolerance`; returns the iterations run.
+    ///
+    /// # Errors
+    /// As [`Compiled::update`]; `out` is left unchanged on error.
+    pub fn refine_into(
+        &self,
+        targets: &[DVec2],
+        out: &mut Deformation,
+        iterations: usize,
+        tolerance: f64,
+    ) -> Result<usize, ArapError> {
+        if targets.len() != self.constrained.len() {
+            return Err(ArapError::TargetCount {
+                got: targets.len(),
+                expected: self.constrained.len(),
+            });
+        }
+        if let Some(constraint) = targets.iter().position(|t| !t.is_finite()) {
+            return Err(ArapError::NonFiniteTarget { constraint });
+        }
+        let Some(two) = &self.step_two else {
+            return Ok(0);
+        };
+        if out.positions.len() != self.mesh.rest.len() {
+            return Ok(0);
+        }
+        let mut previous = Vec::new();
+        for done in 0..iterations {
+            previous.clone_from(&out.positions);
+            let shape = std::mem::take(&mut out.positions);
+            let mut next = shape.clone();
+            self.fit_and_solve(two, &shape, targets, &mut next, &mut out.scratch);
+            out.positions = next;
+            let moved = previous
+                .iter()
+                .zip(&out.positions)
+                .map(|(a, b)| a.distance_squared(*b))
+                .fold(0.0, f64::max)
+                .sqrt();
+            if moved <= tolerance || moved.is_nan() {
+                return Ok(done + 1);
+            }
+        }
+        Ok(iterations)
+    }
+
+    /// The ARAP energy of `positions` over the triangles with a constraint in their
+    /// piece: Σ w·Σ‖d − R·e‖² over each triangle's three edges, e at rest, d posed, R
+    /// the rotation fitted to the triangle (the paper's fit), w its rigidity weight.
+    pub fn energy(&self, positions: &[DVec2]) -> f64 {
+        self.triangles
+            .iter()
+            .map(|t| {
+                let [i, j, k] = t.vertices.map(|v| v as usize);
+                let p = [positions[i], positions[j], positions[k]];
+                let rotation = fitted_rotation(&t.fit, p);
+                let rest = [t.edges[0], t.edges[1], -(t.edges[0] + t.edges[1])];
+                let posed = [p[1] - p[0], p[2] - p[1], p[0] - p[2]];
+                rest.iter()
+                    .zip(posed)
+                    .map(|(e, d)| (d - rotate(rotation, *e / t.weight)).length_squared())
+                    .sum::<f64>()
+                    * t.weight
+            })
+            .sum()
+    }
+
+    /// Step two's fit and solve: rotations fitted to the triangles of `shape`, the
+    /// rotated rest edges added to the linear term f at each corner (corner c ends
+    /// edge c−1 → c and starts edge c → c+1), and H'u = f_u − Dq solved (eq. 16, x and
+    /// y together) into the free vertices of `out`.
+    fn fit_and_solve(
+        &self,
+        two: &crate::solver::Cholesky<f64>,
+        shape: &[DVec2],
+        targets: &[DVec2],
+        out: &mut [DVec2],
+        scratch: &mut Scratch,
+    ) {
         let b = &mut scratch.linear;
         b.clear();
-        b.resize(mesh.rest.len(), DVec2::ZERO);
-        let step_one = &out.step_one;
+        b.resize(self.mesh.rest.len(), DVec2::ZERO);
         for t in &self.triangles {
             let [i, j, k] = t.vertices.map(|v| v as usize);
-            let rotation = fitted_rotation(&t.fit, [step_one[i], step_one[j], step_one[k]]);
+            let rotation = fitted_rotation(&t.fit, [shape[i], shape[j], shape[k]]);
             let e01 = rotate(rotation, t.edges[0]);
             let e12 = rotate(rotation, t.edges[1]);
             let e20 = -(e01 + e12);
@@ -181,7 +272,6 @@ impl Compiled {
             b[j] += e01 - e12;
             b[k] += e12 - e20;
         }
-        // Final solve (eq. 16): H'u = f_u − Dq, x and y together.
         let r2 = &mut scratch.step_two;
         r2.clear();
         r2.extend(self.free.iter().map(|&v| b[v as usize]));
@@ -189,14 +279,8 @@ impl Compiled {
             r2[c.free as usize] -= c.h * targets[c.constraint as usize];
         }
         two.solve_in_place(r2, &mut scratch.work);
-
-        out.positions.clone_from(&out.step_one);
-        for (&v, &t) in self.constrained.iter().zip(targets) {
-            out.positions[v as usize] = t;
-        }
         for (&v, &p) in self.free.iter().zip(r2.iter()) {
-            out.positions[v as usize] = p;
+            out[v as usize] = p;
         }
-        Ok(())
     }
 }

@@ -43,6 +43,12 @@ pub use geometry::polyline_distance_squared;
 /// ARAP's own mesh when the rig file names no `arap.density`.
 pub const DEFAULT_ARAP_DENSITY: usize = 3000;
 
+/// The most local/global iterations a pose runs (`"solver": "local-global"`).
+pub const LOCAL_GLOBAL_ITERATIONS: usize = 200;
+
+/// Local/global iterations stop once no vertex moves farther than this, pixels.
+pub const LOCAL_GLOBAL_TOLERANCE: f64 = 0.01;
+
 /// What a handle holds when the rig file names no `arap.pin_radius`: this share of the
 /// picture's diagonal.
 pub const DEFAULT_PIN_RADIUS: f64 = 0.02;
@@ -54,6 +60,8 @@ pub struct ArapOptions {
     pub pin_radius: f64,
     /// Target vertex count of ARAP's own mesh.
     pub density: usize,
+    /// How a pose is solved.
+    pub solver: project::ArapSolver,
 }
 
 impl ArapOptions {
@@ -68,6 +76,7 @@ impl ArapOptions {
                 .pin_radius
                 .unwrap_or_else(|| diagonal.map_or(0.0, |d| DEFAULT_PIN_RADIUS * d)),
             density: settings.density.unwrap_or(DEFAULT_ARAP_DENSITY),
+            solver: settings.solver.unwrap_or_default(),
         }
     }
 
@@ -559,6 +568,16 @@ impl ArapRig {
         }
         self.compiled
             .update_split_into(&one, &targets, &mut self.pose)?;
+        if self.options.solver == project::ArapSolver::LocalGlobal {
+            // On to the energy's minimum: until no vertex moves a hundredth of a
+            // pixel, or the iterations run out.
+            self.compiled.refine_into(
+                &targets,
+                &mut self.pose,
+                LOCAL_GLOBAL_ITERATIONS,
+                LOCAL_GLOBAL_TOLERANCE,
+            )?;
+        }
         match &self.control {
             Some(control) => control.follow(&self.pose.positions, &mut self.positions),
             None => self.positions.clone_from(&self.pose.positions),
@@ -961,6 +980,7 @@ mod tests {
     const PAPER: ArapOptions = ArapOptions {
         pin_radius: 0.0,
         density: DEFAULT_ARAP_DENSITY,
+        solver: project::ArapSolver::TwoStep,
     };
 
     /// A `w × h` grid of unit squares, each cut into two triangles.
@@ -1013,6 +1033,42 @@ mod tests {
         for (p, r) in arap.positions().iter().zip(domain.positions()) {
             assert!((*p - motion(*r)).length() < 1e-9, "{r} went to {p}");
         }
+    }
+
+    #[test]
+    fn the_local_global_solver_lowers_the_energy_and_keeps_the_pins() {
+        let domain = grid(16, 4);
+        // One end held, the other lifted and turned: a bend.
+        let handles = [
+            point(DVec2::new(0.0, 2.0), DVec2::ZERO, 0.0, 1.0),
+            point(DVec2::new(16.0, 2.0), DVec2::new(-5.0, 6.0), 1.3, 1.0),
+        ];
+        let two = ArapRig::new(domain.clone(), &handles, &[], PAPER).expect("two steps");
+        let options = ArapOptions {
+            solver: project::ArapSolver::LocalGlobal,
+            ..PAPER
+        };
+        let refined = ArapRig::new(domain.clone(), &handles, &[], options).expect("refined");
+        let energy = |arap: &ArapRig| arap.compiled.energy(&arap.pose.positions);
+        assert!(
+            energy(&refined) < 0.9 * energy(&two),
+            "local/global {} against the two steps' {}",
+            energy(&refined),
+            energy(&two)
+        );
+        let rest = refined.arap_mesh().positions();
+        for &(v, h) in &refined.pins {
+            let target = handle_map(&handles[h], rest[v as usize]);
+            assert!(refined.pose.positions[v as usize].distance(target) < 1e-9);
+        }
+        // Parsed from the rig file.
+        let project =
+            Project::from_json(r#"{"version":1,"handles":[],"arap":{"solver":"local-global"}}"#)
+                .expect("a rig file");
+        assert_eq!(
+            ArapOptions::of(&project, None).solver,
+            project::ArapSolver::LocalGlobal
+        );
     }
 
     #[test]
