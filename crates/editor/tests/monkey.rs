@@ -411,9 +411,9 @@ impl Monkey {
             return format!("{} chosen", method.label());
         }
         if self.h.state().tool != editor::Tool::Puppet {
+            // (A tool changes nothing on the picture: on to the click.)
             self.h.key_press(Key::W);
             self.frames(1);
-            return "the Puppet tool".to_owned();
         }
         let Some(doc) = self.h.state_mut().document_mut() else {
             return "pin in a pose (no picture)".to_owned();
