@@ -117,11 +117,12 @@ fn undo_across_a_density_change_re_meshes_on_the_worker() {
         |h: &Harness<'_, EditorApp>| h.state().document().map_or(0, |d| d.rig().stats().samples);
     let before = vertices(&h);
     let mut settings = h.state().document().expect("a document").settings();
-    settings.density = 4000;
+    // (Fine enough that a re-mesh takes the worker more than one frame.)
+    settings.density = 12_000;
     assert!(h.state_mut().edit(Edit::Settings(settings)));
     settle(&mut h);
     let coarse = vertices(&h);
-    assert!(coarse < 5000, "{coarse}");
+    assert!(coarse < 15_000, "{coarse}");
     h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
     h.step();
     assert!(h.state().is_busy(), "the undo re-meshes in the background");
