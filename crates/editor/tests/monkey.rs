@@ -905,10 +905,29 @@ fn env_list(name: &str, default: &[u64]) -> Vec<u64> {
     )
 }
 
+/// Walks the seeds `MONKEY_SEEDS` names, or `default` (one test per default seed, so
+/// that the walks run side by side on a machine's cores).
+fn walk_seeds(default: u64) {
+    let actions = env_list("MONKEY_ACTIONS", &[250])[0] as usize;
+    match std::env::var("MONKEY_SEEDS") {
+        // Named seeds are walked once, by the first test.
+        Ok(_) if default != 1 => {}
+        Ok(_) => env_list("MONKEY_SEEDS", &[]).into_iter().for_each(|s| walk(s, actions)),
+        Err(_) => walk(default, actions),
+    }
+}
+
 #[test]
 fn the_monkey_finds_nothing() {
-    let actions = env_list("MONKEY_ACTIONS", &[250])[0] as usize;
-    for seed in env_list("MONKEY_SEEDS", &[1, 2, 4]) {
-        walk(seed, actions);
-    }
+    walk_seeds(1);
+}
+
+#[test]
+fn the_monkey_finds_nothing_drawing_cages() {
+    walk_seeds(2);
+}
+
+#[test]
+fn the_monkey_finds_nothing_on_the_gpu() {
+    walk_seeds(4);
 }

@@ -130,7 +130,10 @@ impl HandleTool {
                 if on_picture(host, at) {
                     self.add_point(host, at);
                 } else {
+                    // Off the picture a click deselects; say so, as a pin was
+                    // probably meant.
                     host.select(None);
+                    host.info("no picture under the pointer: nothing pinned");
                 }
             }
             (Tool::Select, None) => host.select(None),
