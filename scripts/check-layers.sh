@@ -10,7 +10,7 @@ for crate in geometry weights-core arap lbc mls animation; do
     status=1
   fi
 done
-for crate in mesh render project; do
+for crate in mesh render layers project; do
   tree=$(cargo tree -p "$crate" -e normal --prefix none)
   if echo "$tree" | grep -Eq '^(egui|eframe|rfd|winit|weights-core) '; then
     echo "layering: $crate depends on: $(echo "$tree" | grep -Eo '^(egui|eframe|rfd|winit|weights-core) ' | sort -u | tr '\n' ' ')"

@@ -84,6 +84,52 @@ fn a_cut_out_at_rest_keeps_its_pixels() {
     assert_eq!(share, 0.0, "largest difference {worst}");
 }
 
+/// The picture with its colours multiplied by its alpha (what shows).
+fn premultiplied(image: &image::RgbaImage) -> image::RgbaImage {
+    let mut out = image.clone();
+    for p in out.pixels_mut() {
+        for c in 0..3 {
+            p[c] = ((u32::from(p[c]) * u32::from(p[3]) + 127) / 255) as u8;
+        }
+    }
+    out
+}
+
+/// A layered file written by another program.
+fn layered(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../layers/tests/data")
+        .join(name)
+}
+
+#[test]
+fn a_layered_file_at_rest_renders_as_its_layers_flattened() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    // Each file, its composite by the program that wrote it, two pins on its layers.
+    for (file, flat, [a, b]) in [
+        ("krita-like.ora", "krita-like.png", [[34, 8], [30, 25]]),
+        (
+            "psd-tools-8bit.psd",
+            "psd-tools-8bit.png",
+            [[5, 35], [60, 40]],
+        ),
+    ] {
+        let rig = dir.path().join("rest.json");
+        let pin = |p: [i32; 2]| format!(r#"{{"type":"point","rest":[{},{}]}}"#, p[0], p[1]);
+        let text = format!(r#"{{"version":1,"handles":[{},{}]}}"#, pin(a), pin(b));
+        fs::write(&rig, text).expect("write rig");
+        let out = dir.path().join(format!("{file}.png"));
+        ok(&render_args(&layered(file), &rig, &out, &[]));
+        let layers = layers::load(&layered(file), &render::ImageLimits::default()).expect(file);
+        let got = premultiplied(&load(&out));
+        let (worst, share) = difference(&got, &premultiplied(&layers.flatten().into_rgba8()), 1);
+        assert_eq!(share, 0.0, "{file}: largest difference {worst}");
+        // And the other program's own composite, within rounding.
+        let (worst, _) = difference(&got, &premultiplied(&load(&layered(flat))), 255);
+        assert!(worst <= 3, "{file}: {worst} levels from its reference");
+    }
+}
+
 #[test]
 fn weights_from_a_mesh_are_a_partition_of_unity_that_interpolates() {
     let dir = tempfile::tempdir().expect("temp dir");

@@ -6,7 +6,7 @@ use std::sync::atomic::AtomicBool;
 
 use anyhow::{Context, Result};
 use pipeline::animate::{Animator, Span, plan};
-use pipeline::{load_picture, load_project};
+use pipeline::load_project;
 use render::AnimationFormat;
 
 /// What `c2warp animate` was asked.
@@ -36,7 +36,7 @@ pub fn run(request: &Request) -> Result<()> {
         None => crate::named_picture(request.project, project.image.as_deref())?,
     };
     render::refuse_input_as_output(request.output, &[request.project, &image])?;
-    let picture = load_picture(&image)?;
+    let picture = crate::load_flattened(&image)?;
     let progress = crate::progress::Steps::new(2);
     progress.step("meshing and weighting");
     let animator = Animator::new(&picture, &project, &frames, request.gpu, &progress)?;

@@ -14,7 +14,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand};
-use pipeline::{DEFAULT_IMAGE, DEFAULT_RIG, Deformer, Method, load_picture, load_project};
+use pipeline::{DEFAULT_IMAGE, DEFAULT_RIG, Deformer, Method, load_project};
 use project::Project;
 use render::Picture;
 use weights_core::Rig;
@@ -487,9 +487,19 @@ fn render(
     if let Some(canvas) = canvas {
         project.canvas = canvas;
     }
-    let picture = load_picture(&image)?;
+    let picture = load_flattened(&image)?;
     warp_and_save(&picture, &project, density, output, gpu)?;
     Ok(())
+}
+
+/// Reads a picture as [`pipeline::load_picture`] does, saying on standard error what of a
+/// layered file is drawn otherwise than it asks.
+pub(crate) fn load_flattened(path: &Path) -> Result<render::Picture> {
+    let artwork = pipeline::load_artwork(path)?;
+    for note in &artwork.notes {
+        eprintln!("note: {}: {note}", path.display());
+    }
+    Ok(artwork.flatten())
 }
 
 /// Meshes, weights, warps and writes `picture` by `project` (with its method), with a

@@ -53,8 +53,11 @@ impl FileAction {
     }
 }
 
-/// The file name extensions of the pictures the editor opens.
-pub const IMAGES: &[&str] = &["png", "jpg", "jpeg", "webp", "tif", "tiff", "bmp", "gif"];
+/// The file name extensions of the pictures the editor opens (layered PSD and
+/// OpenRaster files among them).
+pub const IMAGES: &[&str] = &[
+    "png", "jpg", "jpeg", "webp", "tif", "tiff", "bmp", "gif", "psd", "ora",
+];
 
 /// A dialog's answer.
 #[derive(Clone, Debug, PartialEq, Eq)]

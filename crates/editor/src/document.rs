@@ -136,6 +136,9 @@ pub struct Document {
     pub image_path: Option<PathBuf>,
     /// Where the project was last saved or loaded from.
     pub project_path: Option<PathBuf>,
+    /// What the picture file holds that is drawn otherwise than it asks (layers whose
+    /// blend mode is drawn as normal), one line each; said when it is opened.
+    pub picture_notes: Vec<String>,
     rig: Rig,
     /// Bumped whenever the nodes or weights change (the GPU mesh must be re-uploaded).
     pub weights_version: u64,
@@ -196,6 +199,7 @@ impl Document {
             deep: None,
             image_path,
             project_path: None,
+            picture_notes: Vec::new(),
             rig: prepared.rig,
             weights_version: 1,
             pose_version: 1,
@@ -283,12 +287,15 @@ impl Document {
     /// An unreadable, corrupt, unsupported or oversized picture, or one that cannot be
     /// meshed (no opaque pixel).
     pub fn open_image(path: &Path) -> Result<Self> {
-        let picture = pipeline::load_picture(path)?;
+        let artwork = pipeline::load_artwork(path)?;
         let project = Project {
             image: Some(path.to_path_buf()),
             ..Project::default()
         };
-        Self::from_picture(picture, Some(path.to_path_buf()), project)
+        let mut document =
+            Self::from_picture(artwork.flatten(), Some(path.to_path_buf()), project)?;
+        document.picture_notes = artwork.notes;
+        Ok(document)
     }
 
     /// As [`Document::new`] for a decoded picture of either depth (a 16-bit one is
@@ -322,11 +329,12 @@ impl Document {
             bail!("{} names no image", path.display());
         };
         let image_path = path.parent().unwrap_or(Path::new("")).join(image);
-        let picture = pipeline::load_picture(&image_path)
+        let artwork = pipeline::load_artwork(&image_path)
             .with_context(|| format!("the image of project {}", path.display()))?;
-        let mut document = Self::from_picture(picture, Some(image_path), project)
+        let mut document = Self::from_picture(artwork.flatten(), Some(image_path), project)
             .with_context(|| format!("project {}", path.display()))?;
         document.project_path = Some(path.to_path_buf());
+        document.picture_notes = artwork.notes;
         Ok(document)
     }
 

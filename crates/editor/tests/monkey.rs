@@ -912,7 +912,9 @@ fn walk_seeds(default: u64) {
     match std::env::var("MONKEY_SEEDS") {
         // Named seeds are walked once, by the first test.
         Ok(_) if default != 1 => {}
-        Ok(_) => env_list("MONKEY_SEEDS", &[]).into_iter().for_each(|s| walk(s, actions)),
+        Ok(_) => env_list("MONKEY_SEEDS", &[])
+            .into_iter()
+            .for_each(|s| walk(s, actions)),
         Err(_) => walk(default, actions),
     }
 }

@@ -97,6 +97,34 @@ pub fn obj_mesh(data: &[u8]) {
     assert_eq!(back.triangles, mesh.triangles, "triangles round-trip");
 }
 
+/// The layered readers (PSD, OpenRaster): any bytes either read into layers that lie
+/// on the canvas, each with a visible pixel, an opacity in 0..=1 and at most
+/// `MAX_LAYERS` of them, that flatten to the canvas's size; or are refused.
+pub fn layered(data: &[u8]) {
+    let limits = render::ImageLimits {
+        max_width: 512,
+        max_height: 512,
+        max_alloc_bytes: 64 << 20,
+    };
+    let Ok(artwork) = layers::decode(data, &limits) else {
+        return;
+    };
+    assert!(artwork.width <= 512 && artwork.height <= 512);
+    assert!(artwork.layers.len() <= layers::MAX_LAYERS);
+    for layer in &artwork.layers {
+        let (w, h) = layer.dimensions();
+        assert!(w > 0 && h > 0, "an empty layer is dropped");
+        assert!(layer.x >= 0 && layer.y >= 0, "clipped to the canvas");
+        assert!(layer.x as u64 + u64::from(w) <= u64::from(artwork.width));
+        assert!(layer.y as u64 + u64::from(h) <= u64::from(artwork.height));
+        assert!((0.0..=1.0).contains(&layer.opacity));
+    }
+    assert_eq!(
+        artwork.flatten().dimensions(),
+        (artwork.width, artwork.height)
+    );
+}
+
 /// Image decoding and meshing: any bytes either decode (under small limits) into a
 /// picture that meshes into a valid mesh covering every visible pixel, or are refused.
 /// The first byte picks the mesh density; after it, bytes that start with `M` are a

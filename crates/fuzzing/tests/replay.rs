@@ -45,3 +45,8 @@ fn image_mesh() {
 fn rig_handles() {
     replay("rig_handles", fuzzing::rig_handles);
 }
+
+#[test]
+fn layered() {
+    replay("layered", fuzzing::layered);
+}

@@ -87,13 +87,45 @@ pub fn load_image(path: &Path) -> Result<RgbaImage> {
     Ok(load_picture(path)?.into_rgba8())
 }
 
-/// Decodes an image file (PNG, JPEG, WebP, TIFF, BMP, GIF) under the default size
-/// limits, keeping 16 bits per channel where the file has them.
+/// Decodes a picture file under the default size limits, keeping 16 bits per channel
+/// where the file has them: an image (PNG, JPEG, WebP, TIFF, BMP, GIF), or layered
+/// artwork (PSD, OpenRaster) flattened ([`load_artwork`]).
 ///
 /// # Errors
 /// As [`load_image`].
 pub fn load_picture(path: &Path) -> Result<Picture> {
-    render::load_picture(path, &render::ImageLimits::default()).map_err(|e| read_error(e, "image"))
+    Ok(load_artwork(path)?.flatten())
+}
+
+/// Reads a picture file as layers: a PSD or OpenRaster file's layers (the format found
+/// from the content, see [`layers::sniff`]), or any other picture as one layer named
+/// after the file. Its `notes` say what is drawn otherwise than the file asks.
+///
+/// # Errors
+/// A missing, non-regular, corrupt, truncated, unsupported or oversized file, as one
+/// sentence naming it.
+pub fn load_artwork(path: &Path) -> Result<layers::Artwork> {
+    let limits = render::ImageLimits::default();
+    let bytes = render::read_regular_file(path, "image", limits.max_alloc_bytes).map_err(|e| {
+        let e = match e {
+            render::RenderError::FileTooLarge { .. } => render::RenderError::MemoryLimit {
+                path: path.to_owned(),
+                limit: limits.max_alloc_bytes,
+            },
+            other => other,
+        };
+        read_error(e, "image")
+    })?;
+    if layers::sniff(&bytes).is_some() {
+        return layers::decode(&bytes, &limits).with_context(|| path.display().to_string());
+    }
+    let picture =
+        render::decode_picture_named(&bytes, &limits, path).map_err(|e| read_error(e, "image"))?;
+    let name = path.file_stem().map_or_else(
+        || "picture".to_owned(),
+        |s| s.to_string_lossy().into_owned(),
+    );
+    Ok(layers::Artwork::from_picture(&name, picture))
 }
 
 /// Reads a 2-D mesh from a Wavefront OBJ file (see [`mesh::Mesh::read_obj`]).

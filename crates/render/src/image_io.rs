@@ -120,6 +120,19 @@ pub fn decode_picture(bytes: &[u8], limits: &ImageLimits) -> Result<Picture, Ren
     decode(bytes, limits, Path::new(IN_MEMORY))
 }
 
+/// Decodes an image held in memory as [`decode_picture`] does, its errors naming
+/// `path` (where the bytes were read from).
+///
+/// # Errors
+/// Those of [`decode_picture`].
+pub fn decode_picture_named(
+    bytes: &[u8],
+    limits: &ImageLimits,
+    path: &Path,
+) -> Result<Picture, RenderError> {
+    decode(bytes, limits, path)
+}
+
 /// The dimensions an image header claims, read without decoding pixels.
 fn claimed_dimensions(bytes: &[u8], format: ImageFormat) -> Option<(u32, u32)> {
     match format {

@@ -50,7 +50,9 @@ pub use composite::{over, over16};
 pub use error::RenderError;
 pub use files::{open_regular_file, read_regular_file, refuse_input_as_output, same_file};
 pub use gpu::{Affine, GpuContext, SkinnedMesh};
-pub use image_io::{ImageLimits, decode_image, decode_picture, load_image, load_picture};
+pub use image_io::{
+    ImageLimits, decode_image, decode_picture, decode_picture_named, load_image, load_picture,
+};
 pub use mesh::WarpMesh;
 pub use picture::{Picture, Rgba16Image};
 pub use view::{MeshView, Overlay, ViewParams};

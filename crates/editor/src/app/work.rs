@@ -196,8 +196,14 @@ impl EditorApp {
                 }
                 self.needs_fit = true;
                 self.settings_draft = None;
+                let notes = self
+                    .doc
+                    .as_ref()
+                    .map(|d| d.picture_notes.join("; "))
+                    .filter(|n| !n.is_empty())
+                    .map_or_else(String::new, |n| format!("; {n}"));
                 self.info(format!(
-                    "opened {what} {} ({} mesh vertices)",
+                    "opened {what} {} ({} mesh vertices){notes}",
                     path.display(),
                     stats.samples
                 ));

@@ -643,3 +643,17 @@ fn under_c2_a_pin_placed_in_a_posed_state_is_overlaid_and_moves_no_key() {
     doc.apply(Edit::Remove(0)).expect("remove");
     assert!(doc.project().overlaid.is_empty());
 }
+
+#[test]
+fn layered_files_open_flattened_and_say_what_is_drawn_as_normal() {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../layers/tests/data");
+    let doc = Document::open_image(&data.join("psd-tools-8bit.psd")).expect("a PSD opens");
+    assert_eq!(doc.image.dimensions(), (64, 48));
+    assert_eq!(doc.picture_notes.len(), 1, "{:?}", doc.picture_notes);
+    assert!(doc.picture_notes[0].contains("shade"));
+    // The hidden layer (green, over the top-left corner) is not drawn.
+    assert_eq!(doc.image.get_pixel(2, 2).0, [0, 0, 0, 0]);
+    let doc = Document::open_image(&data.join("krita-like.ora")).expect("an ORA opens");
+    assert_eq!(doc.image.dimensions(), (64, 40));
+    assert!(doc.picture_notes.is_empty());
+}
