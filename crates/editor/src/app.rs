@@ -105,6 +105,8 @@ pub struct EditorApp {
     pub(crate) file_dialog: Option<BuiltinDialog>,
     /// The rigidity brush: its radius and weight, the stroke under way.
     pub brush: Brush,
+    /// The cut tool: the stroke under way.
+    pub cut: crate::cut::CutTool,
     /// The cage tool: its settings (the vertices of a cage from the outline, the mesh
     /// vertices inside a new cage), the polygon being drawn, the selection.
     pub cage: CageTool,
@@ -214,6 +216,7 @@ impl EditorApp {
             builtin_dialogs: false,
             file_dialog: None,
             brush: Brush::default(),
+            cut: crate::cut::CutTool::default(),
             cage: CageTool::default(),
             default_folder: None,
             gpu: FrameBuilder::default(),
@@ -375,6 +378,8 @@ impl EditorApp {
         // mesh: on the worker too.
         let heavy = match &edit {
             Edit::Method(method) => method.sets_up_on_the_mesh(),
+            // A cut re-meshes the picture.
+            Edit::Cuts(_) => true,
             Edit::Rigidity(_) => self
                 .doc
                 .as_ref()

@@ -109,6 +109,8 @@ impl EditorApp {
             let brushing = self.tool == Tool::Rigidity;
             let hover = pointer.filter(|p| rect.contains(*p));
             self.with_brush(|brush, host| brush.paint(host, &painter, hover, brushing));
+            let cutting = self.tool == Tool::Cut;
+            self.with_cut(|cut, host| cut.paint(host, &painter, hover, cutting));
             let active = matches!(
                 self.tool,
                 Tool::Puppet | Tool::Select | Tool::AddPoint | Tool::AddBar
@@ -220,6 +222,9 @@ impl EditorApp {
         }
         if self.tool == Tool::Rigidity {
             self.with_brush(|brush, host| brush.input(host, ui, response));
+        }
+        if self.tool == Tool::Cut {
+            self.with_cut(|cut, host| cut.input(host, ui, response));
         }
         if self.tool == Tool::Cage {
             self.with_cage(|cage, host| cage.input(host, ui, response));

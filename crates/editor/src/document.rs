@@ -96,6 +96,8 @@ pub enum Edit {
     Method(Method),
     /// New painted rigidity (ARAP).
     Rigidity(Vec<RigidityStroke>),
+    /// New cuts: the picture is re-meshed, split along them.
+    Cuts(Vec<project::Cut>),
     /// A new cage at rest, in image pixels: LBC becomes the method, and a rig file
     /// without a count of mesh vertices inside the cage (`lbc.density`) takes
     /// `vertices`. Its coordinates are solved separately ([`Document::solve_cage`], or
@@ -478,6 +480,7 @@ impl Document {
             }
             Edit::Method(method) => project.method = method,
             Edit::Rigidity(strokes) => project.rigidity = strokes,
+            Edit::Cuts(cuts) => project.cuts = cuts,
             Edit::Cage { rest, vertices } => {
                 if project.lbc.and_then(|l| l.density).is_none() {
                     project.lbc = Some(LbcSettings {
@@ -653,7 +656,9 @@ impl Document {
         // frame, leaves it as it is.)
         let refinement_changed = (!same_rest || new.density != old.density)
             && refined(&project) != refined(&self.project);
-        if new.density != old.density || refinement_changed {
+        // A cut splits the mesh along it.
+        let cuts_changed = project.cuts != self.project.cuts;
+        if new.density != old.density || refinement_changed || cuts_changed {
             let mut with_virtuals = project.clone();
             if exact {
                 with_virtuals.virtual_handles = virtuals;

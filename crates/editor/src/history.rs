@@ -156,6 +156,14 @@ pub fn describe_change(from: &Project, to: &Project) -> String {
     if from.rigidity != to.rigidity {
         parts.push("the painted rigidity".to_owned());
     }
+    if from.cuts != to.cuts {
+        let (a, b) = (from.cuts.len(), to.cuts.len());
+        parts.push(match b.cmp(&a) {
+            std::cmp::Ordering::Greater => "a cut".to_owned(),
+            std::cmp::Ordering::Less => "a cut removed".to_owned(),
+            std::cmp::Ordering::Equal => "the cuts".to_owned(),
+        });
+    }
     match (&from.cage, &to.cage) {
         (None, Some(_)) => parts.push("a cage".to_owned()),
         (Some(_), None) => parts.push("the cage removed".to_owned()),

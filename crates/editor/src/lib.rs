@@ -13,6 +13,7 @@ mod brush;
 mod cage;
 mod cage_commands;
 mod canvas;
+mod cut;
 mod dialogs;
 mod document;
 mod gpu_frame;

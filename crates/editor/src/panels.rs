@@ -26,6 +26,10 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
         "Rigidity brush (ARAP): drag to paint stiffness, Alt + drag to erase",
     ),
     (
+        "X",
+        "Cut tool: drag across where parts touch to separate them, Alt + click removes a cut",
+    ),
+    (
         "K",
         "Cage tool (LBC): click a polygon around the subject, adjust it, solve, pose it",
     ),
@@ -279,6 +283,9 @@ impl EditorApp {
         }
         if pressed(none, Key::R) {
             self.set_tool(Tool::Rigidity);
+        }
+        if pressed(none, Key::X) {
+            self.set_tool(Tool::Cut);
         }
         if pressed(none, Key::K) {
             self.set_tool(Tool::Cage);
@@ -542,6 +549,12 @@ impl EditorApp {
                      erases. One undo step per stroke",
                 ),
                 (
+                    Tool::Cut,
+                    "Cut",
+                    "Cut (X): drag across where parts touch to separate them (C², ARAP); \
+                     Alt-click a cut to remove it",
+                ),
+                (
                     Tool::Cage,
                     "Cage",
                     "LBC's cage (K): click a polygon around the subject, adjust it, \
@@ -578,6 +591,9 @@ impl EditorApp {
         });
         if self.tool == Tool::Rigidity {
             self.with_brush(|brush, host| brush.panel(host, ui));
+        }
+        if self.tool == Tool::Cut {
+            self.with_cut(|cut, host| cut.panel(host, ui));
         }
         if self.tool == Tool::Perform {
             ui.separator();

@@ -27,6 +27,8 @@ pub enum Tool {
     AddBar,
     /// Paint rigidity (ARAP); Alt-drag erases.
     Rigidity,
+    /// Draw cuts that separate the shape (`CutTool`); Alt-click removes one.
+    Cut,
     /// Draw, adjust, solve and pose an LBC cage (the cage tool, `CageTool`).
     Cage,
     /// Spatial keyframing: place key poses at markers, drag the control cursor to

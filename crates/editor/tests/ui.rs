@@ -616,3 +616,55 @@ fn a_density_the_shape_cannot_hold_says_why() {
         "{message:?}"
     );
 }
+
+#[test]
+fn the_cut_tool_splits_the_mesh_along_a_stroke_in_one_undo_step() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    let vertices =
+        |h: &Harness<'_, EditorApp>| h.state().document().map_or(0, |d| d.rig().stats().samples);
+    // Vertices that share their place with another: a cut's two sides.
+    let doubled = |h: &Harness<'_, EditorApp>| {
+        let doc = h.state().document().expect("a document");
+        let mut places: Vec<(u64, u64)> = doc
+            .rig()
+            .domain()
+            .positions()
+            .iter()
+            .map(|p| (p.x.to_bits(), p.y.to_bits()))
+            .collect();
+        let n = places.len();
+        places.sort_unstable();
+        places.dedup();
+        n - places.len()
+    };
+    let before = vertices(&h);
+    assert_eq!(doubled(&h), 0);
+    click_label(&mut h, "Cut");
+    assert_eq!(h.state().tool, Tool::Cut);
+    // Across the lizard's body, starting and ending off it.
+    let (from, to) = (at(&h, 300.0, 150.0), at(&h, 300.0, 450.0));
+    drag(&mut h, from, to, Modifiers::NONE);
+    settle(&mut h);
+    let doc = h.state().document().expect("a document");
+    assert_eq!(doc.project().cuts.len(), 1, "{:?}", h.state().message);
+    assert!(doc.project().cuts[0].stroke.len() >= 2);
+    // The vertices along the cut are doubled (a body about 100 px across, a vertex
+    // every few pixels).
+    assert!(doubled(&h) > 10, "{} vertices doubled", doubled(&h));
+    h.state()
+        .document()
+        .expect("doc")
+        .check_reopens()
+        .expect("reopens as shown");
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.step();
+    settle(&mut h);
+    let doc = h.state().document().expect("a document");
+    assert!(doc.project().cuts.is_empty(), "undone");
+    assert_eq!(vertices(&h), before, "undo brings the old mesh back");
+    assert_eq!(
+        h.state().message.as_ref().map(|m| m.text.as_str()),
+        Some("undone: a cut")
+    );
+}

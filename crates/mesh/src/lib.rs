@@ -47,6 +47,7 @@
 //! ```
 
 mod cover;
+mod cut;
 mod domain;
 mod enclose;
 mod error;
@@ -57,6 +58,7 @@ mod simplify;
 mod trace;
 mod triangulate;
 
+pub use cut::{clip_to_domain, split_along};
 pub use domain::{Domain, DomainOptions, Polygon, domain_for_density, domain_from_image};
 pub use enclose::{Coverage, Enclosure, enclosing_ring, enclosing_ring_of};
 pub use error::MeshError;

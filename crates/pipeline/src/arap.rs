@@ -110,34 +110,43 @@ struct Control {
 impl Control {
     /// ARAP's mesh of `image` at `density` vertices, and the places of `picture`'s
     /// vertices in it.
-    fn new(image: &image::RgbaImage, picture: &Domain, density: usize) -> Result<Self> {
+    fn new(
+        image: &image::RgbaImage,
+        cuts: &[project::Cut],
+        picture: &Domain,
+        density: usize,
+    ) -> Result<Self> {
         let options = mesh::MeshOptions {
             target_vertices: density,
             ..mesh::MeshOptions::default()
         };
-        let meshed = mesh::mesh_image(
-            image,
-            &mesh::DomainOptions::default(),
-            &options,
-            &mesh::Constraints::default(),
-        )
-        .context("cannot mesh the picture for ARAP")?;
-        let domain = Domain::new(
-            meshed.mesh.vertices,
-            meshed.mesh.triangles,
-            Metric::Euclidean,
-        )
-        .context("cannot set up ARAP's mesh")?;
+        let (meshed, _) = crate::mesh_picture(image, &options, cuts)
+            .context("cannot mesh the picture for ARAP")?;
+        let domain = Domain::new(meshed.vertices, meshed.triangles, Metric::Euclidean)
+            .context("cannot set up ARAP's mesh")?;
         let mut around: Vec<Vec<u32>> = vec![Vec::new(); domain.len()];
         for (t, tri) in domain.triangles().iter().enumerate() {
             for &v in tri {
                 around[v as usize].push(t as u32);
             }
         }
+        // A vertex on a cut is looked up from just inside one of its own triangles, so
+        // that each side's copy follows ARAP's triangle on its side.
+        let mut inward = vec![None; picture.len()];
+        if !cuts.is_empty() {
+            let positions = picture.positions();
+            for tri in picture.triangles() {
+                let centroid = tri.iter().map(|&v| positions[v as usize]).sum::<DVec2>() / 3.0;
+                for &v in tri {
+                    inward[v as usize].get_or_insert(centroid);
+                }
+            }
+        }
         let places = picture
             .positions()
             .iter()
-            .map(|&p| place(&domain, &around, p))
+            .zip(&inward)
+            .map(|(&p, toward)| place(&domain, &around, p, *toward))
             .collect::<Option<Vec<_>>>()
             .context("ARAP's mesh has no triangle near the picture's")?;
         Ok(Self { domain, places })
@@ -155,9 +164,25 @@ impl Control {
 }
 
 /// The triangle of `domain` holding `p` and `p`'s barycentric coordinates in it, or,
-/// outside, the triangle around `p`'s nearest vertex where `p` is least outside.
-fn place(domain: &Domain, around: &[Vec<u32>], p: DVec2) -> Option<([u32; 3], [f64; 3])> {
+/// outside, the triangle around `p`'s nearest vertex where `p` is least outside. With
+/// `toward`, the triangle is the one holding a point a hair from `p` toward it (the side
+/// of a cut `p` belongs to).
+fn place(
+    domain: &Domain,
+    around: &[Vec<u32>],
+    p: DVec2,
+    toward: Option<DVec2>,
+) -> Option<([u32; 3], [f64; 3])> {
     let triangles = domain.triangles();
+    if let Some(toward) = toward
+        && let Some((t, _)) = domain.locate(p.lerp(toward, 1e-6))
+    {
+        let tri = triangles[t];
+        let corners = tri.map(|k| domain.positions()[k as usize]);
+        if let Some(bary) = barycentric(corners, p) {
+            return Some((tri, bary));
+        }
+    }
     if let Some((t, bary)) = domain.locate(p) {
         return Some((triangles[t], bary));
     }
@@ -269,8 +294,24 @@ impl ArapRig {
         rigidity_strokes: &[RigidityStroke],
         options: ArapOptions,
     ) -> Result<Self> {
+        Self::with_own_mesh_cut(image, &[], picture, handles, rigidity_strokes, options)
+    }
+
+    /// [`ArapRig::with_own_mesh`] with ARAP's mesh split along `cuts` as the picture's
+    /// is ([`crate::mesh_picture`]).
+    ///
+    /// # Errors
+    /// As [`ArapRig::with_own_mesh`].
+    pub fn with_own_mesh_cut(
+        image: &image::RgbaImage,
+        cuts: &[project::Cut],
+        picture: Domain,
+        handles: &[Handle],
+        rigidity_strokes: &[RigidityStroke],
+        options: ArapOptions,
+    ) -> Result<Self> {
         let clock = Instant::now();
-        let control = Control::new(image, &picture, options.density)?;
+        let control = Control::new(image, cuts, &picture, options.density)?;
         Self::set_up(
             picture,
             Some(Arc::new(control)),
@@ -353,7 +394,8 @@ impl ArapRig {
         let mut arap = match picture {
             Some(picture) => {
                 let options = ArapOptions::for_picture(project, picture);
-                Self::with_own_mesh(picture, domain, &handles, strokes, options)?
+                let cuts = &project.cuts;
+                Self::with_own_mesh_cut(picture, cuts, domain, &handles, strokes, options)?
             }
             None => Self::new(domain, &handles, strokes, ArapOptions::of(project, None))?,
         };

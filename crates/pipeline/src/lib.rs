@@ -128,6 +128,46 @@ pub fn load_artwork(path: &Path) -> Result<layers::Artwork> {
     Ok(layers::Artwork::from_picture(&name, picture))
 }
 
+/// Meshes a picture at `options` (its outline traced from the alpha channel, or its
+/// rectangle), split along the rig file's `cuts` (each stroke's parts inside the shape
+/// meshed as edges, then the vertices along them doubled, [`mesh::split_along`]).
+/// Returns the mesh and whether the shape is convex (never with a cut).
+///
+/// # Errors
+/// A picture with nothing visible, or a failure of the triangulator.
+pub fn mesh_picture(
+    image: &RgbaImage,
+    options: &MeshOptions,
+    cuts: &[project::Cut],
+) -> Result<(Mesh, bool), mesh::MeshError> {
+    if cuts.is_empty() {
+        let meshed = mesh::mesh_image(
+            image,
+            &DomainOptions::default(),
+            options,
+            &Constraints::default(),
+        )?;
+        return Ok((meshed.mesh, meshed.is_convex));
+    }
+    let domain =
+        mesh::domain_for_density(image, &DomainOptions::default(), options.target_vertices)?;
+    let pieces: Vec<Vec<DVec2>> = cuts
+        .iter()
+        .flat_map(|cut| {
+            let stroke: Vec<DVec2> = cut.stroke.iter().map(|&p| DVec2::from(p)).collect();
+            mesh::clip_to_domain(&domain, &stroke)
+        })
+        .collect();
+    let constraints = Constraints {
+        points: &[],
+        polylines: &pieces,
+    };
+    let mut meshed = mesh::triangulate(&domain, &constraints, options)?;
+    mesh::split_along(&mut meshed.mesh, &meshed.polyline_paths);
+    let convex = meshed.is_convex && pieces.is_empty();
+    Ok((meshed.mesh, convex))
+}
+
 /// Reads a 2-D mesh from a Wavefront OBJ file (see [`mesh::Mesh::read_obj`]).
 ///
 /// Only a regular file of at most [`MAX_OBJ_BYTES`] is read.
@@ -392,17 +432,12 @@ pub fn prepare_with_progress(
         refine,
         ..MeshOptions::default()
     };
-    let mesh = mesh::mesh_image(
-        image,
-        &DomainOptions::default(),
-        &options,
-        &Constraints::default(),
-    )
-    .context("cannot mesh the image")?;
+    let (mesh, convex) =
+        mesh_picture(image, &options, &project.cuts).context("cannot mesh the image")?;
     let domain = Domain::new(
-        mesh.mesh.vertices,
-        mesh.mesh.triangles,
-        metric(project.metric, mesh.is_convex),
+        mesh.vertices,
+        mesh.triangles,
+        metric(project.metric, convex),
     )?;
     // A saved virtual handle sits on a vertex of this mesh; one off the shape was not
     // saved from it, and is refused as a handle off the shape is.

@@ -582,6 +582,25 @@ pub struct Project {
     /// the shape, so that placing one moves nothing away from it.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub overlaid: Vec<usize>,
+    /// Strokes that separate the shape along them (`"cuts": [{"stroke": [[x, y], …]}]`),
+    /// so that parts of a flat picture that touch move apart: the mesh is split along
+    /// each stroke's parts inside the shape, so no distance crosses it.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub cuts: Vec<Cut>,
+}
+
+/// The most points one cut's stroke may have.
+pub const MAX_CUT_POINTS: usize = 10_000;
+
+/// The most cuts a rig file may hold.
+pub const MAX_CUTS: usize = 1_000;
+
+/// A cut: a stroke (image pixels) along which the shape is separated.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Cut {
+    /// The stroke's points, in order (at least two, not all at one place).
+    pub stroke: Vec<[f64; 2]>,
 }
 
 /// What a handle placed in a posed state holds (ARAP): the points of ARAP's mesh it
@@ -635,6 +654,7 @@ impl Default for Project {
             animation: None,
             holds: Vec::new(),
             overlaid: Vec::new(),
+            cuts: Vec::new(),
         }
     }
 }
@@ -864,6 +884,37 @@ impl Project {
                 self.overlaid[i],
                 self.handles.len()
             ));
+        }
+        if self.cuts.len() > MAX_CUTS {
+            return bad(format!(
+                "{} cuts; at most {MAX_CUTS} are accepted",
+                self.cuts.len()
+            ));
+        }
+        for (i, cut) in self.cuts.iter().enumerate() {
+            let n = cut.stroke.len();
+            if !(2..=MAX_CUT_POINTS).contains(&n) {
+                return bad(format!(
+                    "cuts[{i}].stroke has {n} points; a stroke has 2 to {MAX_CUT_POINTS}"
+                ));
+            }
+            if let Some(j) = cut.stroke.iter().position(|p| {
+                !p[0].is_finite() || !p[1].is_finite() || p[0].abs() > 1e9 || p[1].abs() > 1e9
+            }) {
+                return bad(format!(
+                    "cuts[{i}].stroke[{j}] is not a finite point within ±1e9"
+                ));
+            }
+            let first = cut.stroke[0];
+            if cut
+                .stroke
+                .iter()
+                .all(|p| (p[0] - first[0]).hypot(p[1] - first[1]) < 1e-6)
+            {
+                return bad(format!(
+                    "cuts[{i}].stroke has no length: its points coincide"
+                ));
+            }
         }
         let mut held = std::collections::BTreeSet::new();
         for (i, hold) in self.holds.iter().enumerate() {

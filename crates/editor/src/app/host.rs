@@ -116,6 +116,17 @@ impl EditorApp {
         out
     }
 
+    /// Runs `f` on the cut tool with the app as its host (lent out for the call).
+    pub(crate) fn with_cut<R>(
+        &mut self,
+        f: impl FnOnce(&mut crate::cut::CutTool, &mut dyn Host) -> R,
+    ) -> R {
+        let mut cut = std::mem::take(&mut self.cut);
+        let out = f(&mut cut, self);
+        self.cut = cut;
+        out
+    }
+
     /// Runs `f` on the handle tools with the app as their host (the tool is lent out
     /// for the call, so it and the host can both be changed).
     pub(crate) fn with_handles<R>(

@@ -118,7 +118,7 @@ impl HandleTool {
     fn click(&mut self, host: &mut dyn Host, pos: Pos2, alt: bool) {
         let hit = self.hit(host, pos).map(|(i, _)| i);
         match (host.tool(), hit) {
-            (Tool::AddBar | Tool::Rigidity | Tool::Cage | Tool::Perform, _) => {}
+            (Tool::AddBar | Tool::Rigidity | Tool::Cut | Tool::Cage | Tool::Perform, _) => {}
             (_, Some(i)) if alt => {
                 // The Puppet Warp convention: Alt-click deletes a handle.
                 host.select(Some(i));
