@@ -173,7 +173,7 @@ fn visible_window(
             }
         }
     }
-    (left < right).then_some([left, top, right - left, bottom - top])
+    (left < right).then(|| [left, top, right - left, bottom - top])
 }
 
 /// The layer made of `pixels` at (`x`, `y`), clipped to the canvas and to its visible

@@ -297,3 +297,39 @@ fn an_entry_inflating_past_the_memory_limit_is_refused_before_inflating() {
     let error = layers::decode(&bytes, &limits).expect_err("refused");
     assert!(matches!(error, LayerError::MemoryLimit { .. }), "{error}");
 }
+
+#[test]
+fn empty_layers_are_skipped_and_layers_past_the_canvas_clipped() {
+    let layer = |name: &str, x: i32, alpha: u8| layers::Layer {
+        name: name.to_owned(),
+        x,
+        y: 0,
+        opacity: 1.0,
+        visible: true,
+        pixels: Picture::Rgba8(image::RgbaImage::from_pixel(
+            4,
+            4,
+            image::Rgba([9, 9, 9, alpha]),
+        )),
+    };
+    let artwork = Artwork {
+        width: 6,
+        height: 4,
+        layers: vec![
+            layer("empty", 0, 0),
+            layer("half off", 4, 255),
+            layer("off", 9, 255),
+        ],
+        notes: Vec::new(),
+    };
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("clip.ora");
+    layers::write_ora(&path, &artwork).expect("write");
+    let back = layers::load(&path, &ImageLimits::default()).expect("read");
+    let kept: Vec<(&str, i32, (u32, u32))> = back
+        .layers
+        .iter()
+        .map(|l| (l.name.as_str(), l.x, l.dimensions()))
+        .collect();
+    assert_eq!(kept, [("half off", 4, (2, 4))]);
+}
