@@ -123,6 +123,8 @@ const LABELS: &[&str] = &[
     "Add point",
     "Add bar",
     "Rigidity",
+    "Cut",
+    "Clear cuts",
     "C² weights",
     "ARAP",
     "MLS",
@@ -193,6 +195,7 @@ const KEYS: &[(Modifiers, Key)] = &[
     (Modifiers::NONE, Key::P),
     (Modifiers::NONE, Key::B),
     (Modifiers::NONE, Key::R),
+    (Modifiers::NONE, Key::X),
     (Modifiers::NONE, Key::K),
     (Modifiers::NONE, Key::K),
     (Modifiers::NONE, Key::Enter),
@@ -713,6 +716,8 @@ fn walk(seed: u64, actions: usize) {
     let mut reopened = 0usize;
     // Actions taken with two keys or more, the most keys seen, actions with markers.
     let (mut keyed, mut most_keys, mut marked) = (0usize, 0usize, 0usize);
+    // Actions taken with cuts in the project.
+    let mut with_cuts = 0usize;
     // Pins placed under ARAP or C², each checked to have moved nothing.
     let mut held = 0usize;
     // Handles removed in a posed state under C², each checked to have moved nothing
@@ -756,6 +761,7 @@ fn walk(seed: u64, actions: usize) {
                     .as_ref()
                     .is_some_and(|a| !a.spatial_keys.is_empty())
             }));
+            with_cuts += usize::from(app.document().is_some_and(|d| !d.project().cuts.is_empty()));
             app.sanity_check()?;
             if let (Some((handles, mesh, shown, posed)), Some(doc)) =
                 (before, monkey.h.state_mut().document_mut())
@@ -890,7 +896,7 @@ fn walk(seed: u64, actions: usize) {
     println!(
         "  with two keys or more: {keyed} actions (at most {most_keys} keys); with pose \
          markers: {marked}; pins placed in a pose under ARAP or C², none moving the picture: {held}; handles removed in a pose under C², checked: \
-         {removed_checked}"
+         {removed_checked}; with cuts: {with_cuts}"
     );
     slowest.sort_by(|a, b| b.0.total_cmp(&a.0));
     for (s, what) in slowest.iter().take(3) {
@@ -908,7 +914,7 @@ fn env_list(name: &str, default: &[u64]) -> Vec<u64> {
 /// Walks the seeds `MONKEY_SEEDS` names, or `default` (one test per default seed, so
 /// that the walks run side by side on a machine's cores).
 fn walk_seeds(default: u64) {
-    let actions = env_list("MONKEY_ACTIONS", &[250])[0] as usize;
+    let actions = env_list("MONKEY_ACTIONS", &[200])[0] as usize;
     match std::env::var("MONKEY_SEEDS") {
         // Named seeds are walked once, by the first test.
         Ok(_) if default != 1 => {}
