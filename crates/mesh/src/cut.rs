@@ -32,7 +32,7 @@ pub fn clip_to_domain(domain: &Domain, stroke: &[DVec2]) -> Vec<Vec<DVec2>> {
         let (a, b) = (pair[0], pair[1]);
         // Where the segment crosses the rings: fractions along it, and the crossing
         // taken on the ring's own edge (so that it lies on the boundary exactly).
-        let mut cuts = vec![(0.0, a), (1.0, b)];
+        let mut cuts = Vec::new();
         for ring in &rings {
             for (i, &p) in ring.iter().enumerate() {
                 let q = ring[(i + 1) % ring.len()];
@@ -48,6 +48,9 @@ pub fn clip_to_domain(domain: &Domain, stroke: &[DVec2]) -> Vec<Vec<DVec2>> {
                 }
             }
         }
+        // The segment's own ends last, so that where one lies on a ring the crossing
+        // (exactly on the ring) is what the stable sort and the dedup keep.
+        cuts.extend([(0.0, a), (1.0, b)]);
         cuts.sort_by(|x, y| x.0.total_cmp(&y.0));
         cuts.dedup_by(|x, y| (x.0 - y.0).abs() < 1e-12);
         for span in cuts.windows(2) {
@@ -207,6 +210,43 @@ mod tests {
         assert_eq!(copies.len(), along);
         t.mesh.sanity_check().expect("a valid mesh");
         assert_eq!(components(&t.mesh), 2);
+    }
+
+    #[test]
+    fn strokes_that_double_back_or_start_on_the_outline_mesh_and_split() {
+        let domain = square();
+        let strokes = [
+            // Starts exactly on the outline, doubles back over itself.
+            vec![
+                DVec2::new(10.0, 0.0),
+                DVec2::new(10.0, 12.0),
+                DVec2::new(10.0, 6.0),
+                DVec2::new(10.0, 20.0),
+            ],
+            // A zigzag crossing the first.
+            vec![
+                DVec2::new(0.0, 3.0),
+                DVec2::new(15.0, 9.0),
+                DVec2::new(5.0, 14.0),
+                DVec2::new(30.0, 17.0),
+            ],
+        ];
+        let pieces: Vec<Vec<DVec2>> = strokes
+            .iter()
+            .flat_map(|s| clip_to_domain(&domain, s))
+            .collect();
+        let options = MeshOptions {
+            target_vertices: 400,
+            ..MeshOptions::default()
+        };
+        let constraints = Constraints {
+            points: &[],
+            polylines: &pieces,
+        };
+        let mut t = triangulate(&domain, &constraints, &options).expect("meshed");
+        let copies = split_along(&mut t.mesh, &t.polyline_paths);
+        t.mesh.sanity_check().expect("a valid mesh");
+        assert!(!copies.is_empty());
     }
 
     #[test]
