@@ -32,7 +32,7 @@ use project::{Project, RigidityStroke};
 use serde::Serialize;
 use weights_core::{Domain, Handle, Metric, Rig, Similarity};
 
-use crate::method::{
+use crate::deformer::{
     Deformer, Follow, Method, Output, Sequence, WeightsListing, json, median, quantile,
 };
 

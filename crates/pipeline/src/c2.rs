@@ -11,7 +11,7 @@ use project::Project;
 use serde::Serialize;
 use weights_core::{Handle, Metric, NodeKind, Rig};
 
-use crate::method::{
+use crate::deformer::{
     Deformer, Follow, Method, Output, SkinTable, Skinning, WeightsListing, json, median, quantile,
 };
 
@@ -112,7 +112,7 @@ impl Deformer for Rig {
             deform.push(ms(t));
         }
         let n = self.domain().len() as u64;
-        let mut sequence = crate::method::Sequence::new();
+        let mut sequence = crate::deformer::Sequence::new();
         let (mut insert, mut remove) = (Vec::new(), Vec::new());
         let mut tries = 0;
         while insert.len() < poses && tries < poses * 10 {

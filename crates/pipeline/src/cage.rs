@@ -19,7 +19,7 @@ use glam::DVec2;
 use project::{MAX_CAGE_VERTICES, Method, Project, Tau};
 use serde::Serialize;
 
-use crate::method::{
+use crate::deformer::{
     Backdrop, Deformer, Follow, Listener, Output, SkinTable, Skinning, Source, WeightsListing,
     json, median,
 };

@@ -6,6 +6,7 @@ pub mod arap;
 mod c2;
 pub mod cage;
 pub mod crowding;
+pub mod deformer;
 pub mod method;
 pub mod mls;
 pub mod order;

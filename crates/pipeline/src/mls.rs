@@ -22,7 +22,7 @@ use project::{MlsVariant, Project};
 use serde::Serialize;
 use weights_core::{Handle, Rig};
 
-use crate::method::{
+use crate::deformer::{
     Deformer, Follow, Method, Output, Sequence, WeightsListing, json, median, quantile,
 };
 
