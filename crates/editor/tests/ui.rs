@@ -657,6 +657,26 @@ fn the_cut_tool_splits_the_mesh_along_a_stroke_in_one_undo_step() {
         .expect("doc")
         .check_reopens()
         .expect("reopens as shown");
+    // Pull the front foot (right of the cut) down: the other side stays.
+    click_label(&mut h, "Puppet");
+    let viewport = h.state().viewport;
+    let near = viewport.to_image(egui::pos2(856.0, 209.0));
+    let foot = h
+        .state()
+        .document()
+        .expect("a document")
+        .project()
+        .handles
+        .iter()
+        .flat_map(editor::posed)
+        .min_by(|a, b| a.distance(near).total_cmp(&b.distance(near)))
+        .expect("handles");
+    let foot = viewport.to_screen(foot);
+    drag(&mut h, foot, foot + egui::vec2(0.0, 90.0), Modifiers::NONE);
+    h.run();
+    h.snapshot("editor_cut");
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
     h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
     h.step();
     settle(&mut h);
