@@ -220,6 +220,18 @@ fn clipped(
     })
 }
 
+/// The note that names the layers (`"name" (mode)` each) drawn with normal blending
+/// instead of the mode their file asks for; none when there are none.
+fn blend_notes(blended: &[String]) -> Vec<String> {
+    if blended.is_empty() {
+        return Vec::new();
+    }
+    vec![format!(
+        "drawn with normal blending: {}",
+        blended.join(", ")
+    )]
+}
+
 /// Checks a canvas or layer size against `limits` before anything is allocated.
 fn check_size(what: &str, width: u64, height: u64, limits: &ImageLimits) -> Result<(), LayerError> {
     if width > u64::from(limits.max_width) || height > u64::from(limits.max_height) {

@@ -50,6 +50,16 @@ struct Frame {
     visible: bool,
 }
 
+impl Frame {
+    /// What the outermost stack's parent passes down: nothing.
+    const ROOT: Self = Self {
+        x: 0,
+        y: 0,
+        opacity: 1.0,
+        visible: true,
+    };
+}
+
 /// Reads an OpenRaster file (see the module's documentation).
 pub(crate) fn decode(bytes: &[u8], limits: &ImageLimits) -> Result<Artwork, LayerError> {
     let mut archive =
@@ -188,24 +198,14 @@ fn parse_stack(xml: &str) -> Result<(u64, u64, Vec<Entry>), LayerError> {
                 size = Some((w.min(u64::MAX as f64) as u64, h.min(u64::MAX as f64) as u64));
             }
             b"stack" => {
-                let parent = frames.last().copied().unwrap_or(Frame {
-                    x: 0,
-                    y: 0,
-                    opacity: 1.0,
-                    visible: true,
-                });
+                let parent = frames.last().copied().unwrap_or(Frame::ROOT);
                 let frame = attrs.frame(parent)?;
                 if opens {
                     frames.push(frame);
                 }
             }
             b"layer" => {
-                let parent = frames.last().copied().unwrap_or(Frame {
-                    x: 0,
-                    y: 0,
-                    opacity: 1.0,
-                    visible: true,
-                });
+                let parent = frames.last().copied().unwrap_or(Frame::ROOT);
                 let frame = attrs.frame(parent)?;
                 let src = attrs
                     .get("src")

@@ -198,18 +198,11 @@ pub(crate) fn decode(bytes: &[u8], limits: &ImageLimits) -> Result<Artwork, Laye
             canvas,
         ));
     }
-    let mut notes = Vec::new();
-    if !blended.is_empty() {
-        notes.push(format!(
-            "drawn with normal blending: {}",
-            blended.join(", ")
-        ));
-    }
     Ok(Artwork {
         width,
         height,
         layers,
-        notes,
+        notes: crate::blend_notes(&blended),
     })
 }
 

@@ -124,13 +124,6 @@ pub fn split_along(mesh: &mut Mesh, paths: &[Vec<u32>]) -> Vec<u32> {
         let fan = &around[&v];
         // Union-find over the fan: two triangles sharing an edge v–w that is not cut.
         let mut parent: Vec<usize> = (0..fan.len()).collect();
-        fn root(parent: &mut [usize], mut i: usize) -> usize {
-            while parent[i] != i {
-                parent[i] = parent[parent[i]];
-                i = parent[i];
-            }
-            i
-        }
         let others = |t: usize| mesh.triangles[t].into_iter().filter(move |&w| w != v);
         for i in 0..fan.len() {
             for j in i + 1..fan.len() {
@@ -169,6 +162,15 @@ pub fn split_along(mesh: &mut Mesh, paths: &[Vec<u32>]) -> Vec<u32> {
     copies
 }
 
+/// The root of `i`'s set in the union-find forest `parent` (paths halved on the way).
+fn root(parent: &mut [usize], mut i: usize) -> usize {
+    while parent[i] != i {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    i
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -176,6 +178,23 @@ mod tests {
 
     fn square() -> Domain {
         Domain::full_rectangle(40, 20)
+    }
+
+    /// `domain` meshed at about `vertices` vertices with `pieces` as edges.
+    fn mesh_along(
+        domain: &Domain,
+        pieces: &[Vec<DVec2>],
+        vertices: usize,
+    ) -> crate::TriangulatedImage {
+        let options = MeshOptions {
+            target_vertices: vertices,
+            ..MeshOptions::default()
+        };
+        let constraints = Constraints {
+            points: &[],
+            polylines: pieces,
+        };
+        triangulate(domain, &constraints, &options).expect("meshed")
     }
 
     #[test]
@@ -195,15 +214,7 @@ mod tests {
     fn a_cut_across_the_shape_splits_it_in_two() {
         let domain = square();
         let pieces = clip_to_domain(&domain, &[DVec2::new(20.0, -5.0), DVec2::new(20.0, 25.0)]);
-        let options = MeshOptions {
-            target_vertices: 300,
-            ..MeshOptions::default()
-        };
-        let constraints = Constraints {
-            points: &[],
-            polylines: &pieces,
-        };
-        let mut t = triangulate(&domain, &constraints, &options).expect("mesh");
+        let mut t = mesh_along(&domain, &pieces, 300);
         let along = t.polyline_paths[0].len();
         let copies = split_along(&mut t.mesh, &t.polyline_paths);
         // Every vertex along the cut, its ends on the boundary included, is doubled.
@@ -235,15 +246,7 @@ mod tests {
             .iter()
             .flat_map(|s| clip_to_domain(&domain, s))
             .collect();
-        let options = MeshOptions {
-            target_vertices: 400,
-            ..MeshOptions::default()
-        };
-        let constraints = Constraints {
-            points: &[],
-            polylines: &pieces,
-        };
-        let mut t = triangulate(&domain, &constraints, &options).expect("meshed");
+        let mut t = mesh_along(&domain, &pieces, 400);
         let copies = split_along(&mut t.mesh, &t.polyline_paths);
         t.mesh.sanity_check().expect("a valid mesh");
         assert!(!copies.is_empty());
@@ -253,15 +256,7 @@ mod tests {
     fn a_cut_inside_the_shape_leaves_it_joined_past_its_ends() {
         let domain = square();
         let pieces = vec![vec![DVec2::new(20.0, 5.0), DVec2::new(20.0, 15.0)]];
-        let options = MeshOptions {
-            target_vertices: 300,
-            ..MeshOptions::default()
-        };
-        let constraints = Constraints {
-            points: &[],
-            polylines: &pieces,
-        };
-        let mut t = triangulate(&domain, &constraints, &options).expect("mesh");
+        let mut t = mesh_along(&domain, &pieces, 300);
         let along = t.polyline_paths[0].len();
         let copies = split_along(&mut t.mesh, &t.polyline_paths);
         assert_eq!(copies.len(), along - 2, "the inner vertices only");
@@ -273,13 +268,6 @@ mod tests {
     fn components(mesh: &Mesh) -> usize {
         let n = mesh.vertices.len();
         let mut parent: Vec<usize> = (0..n).collect();
-        fn root(parent: &mut [usize], mut i: usize) -> usize {
-            while parent[i] != i {
-                parent[i] = parent[parent[i]];
-                i = parent[i];
-            }
-            i
-        }
         for tri in &mesh.triangles {
             for k in 0..3 {
                 let (a, b) = (
