@@ -392,6 +392,7 @@ impl EditorApp {
         {
             let label = match edit {
                 Edit::Method(method) => format!("Setting up {}", method.label()),
+                Edit::Cuts(_) => "Cutting the mesh".to_owned(),
                 _ => "Repainting rigidity".to_owned(),
             };
             let copy = doc.clone();
