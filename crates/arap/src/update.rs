@@ -105,6 +105,21 @@ impl Compiled {
     /// over fewer free vertices is the one it had).
     ///
     /// # Errors
+    /// Refuses a list of constrained positions of the wrong length or with a
+    /// non-finite entry.
+    fn check_targets(&self, targets: &[DVec2]) -> Result<(), ArapError> {
+        if targets.len() != self.constrained.len() {
+            return Err(ArapError::TargetCount {
+                got: targets.len(),
+                expected: self.constrained.len(),
+            });
+        }
+        if let Some(constraint) = targets.iter().position(|t| !t.is_finite()) {
+            return Err(ArapError::NonFiniteTarget { constraint });
+        }
+        Ok(())
+    }
+
     /// As [`Compiled::update`], for either list; `out` is left unchanged on error.
     pub fn update_split_into(
         &self,
@@ -112,17 +127,8 @@ impl Compiled {
         targets: &[DVec2],
         out: &mut Deformation,
     ) -> Result<(), ArapError> {
-        for list in [step_one, targets] {
-            if list.len() != self.constrained.len() {
-                return Err(ArapError::TargetCount {
-                    got: list.len(),
-                    expected: self.constrained.len(),
-                });
-            }
-            if let Some(constraint) = list.iter().position(|t| !t.is_finite()) {
-                return Err(ArapError::NonFiniteTarget { constraint });
-            }
-        }
+        self.check_targets(step_one)?;
+        self.check_targets(targets)?;
         let mesh = &*self.mesh;
         out.step_one.clear();
         out.step_one.extend_from_slice(&mesh.rest);
@@ -191,15 +197,7 @@ impl Compiled {
         iterations: usize,
         tolerance: f64,
     ) -> Result<usize, ArapError> {
-        if targets.len() != self.constrained.len() {
-            return Err(ArapError::TargetCount {
-                got: targets.len(),
-                expected: self.constrained.len(),
-            });
-        }
-        if let Some(constraint) = targets.iter().position(|t| !t.is_finite()) {
-            return Err(ArapError::NonFiniteTarget { constraint });
-        }
+        self.check_targets(targets)?;
         let Some(two) = &self.step_two else {
             return Ok(0);
         };

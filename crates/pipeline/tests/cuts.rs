@@ -36,13 +36,21 @@ fn left_moves(method: Method, cuts: Vec<Cut>) -> f64 {
         cuts,
         ..Project::default()
     };
-    let warper = pipeline::prepare_warper(&touching(), &project, None, &())
+    largest_move(&project, |x| x < 59.0)
+}
+
+/// The largest move of a vertex of `touching()` whose rest x is `where_`, warped by
+/// `project`'s method (every position finite).
+fn largest_move(project: &Project, where_: impl Fn(f64) -> bool) -> f64 {
+    let method = project.method;
+    let warper = pipeline::prepare_warper(&touching(), project, None, &())
         .unwrap_or_else(|e| panic!("{}: {}", method.name(), pipeline::error_line(&e)));
     let rest = warper.deformer.rest().to_vec();
     let deformed = warper.deformer.deformed();
+    assert!(deformed.iter().all(|p| p.is_finite()), "{}", method.name());
     rest.iter()
         .zip(&deformed)
-        .filter(|(r, _)| r.x < 59.0)
+        .filter(|(r, _)| where_(r.x))
         .map(|(r, d)| r.distance(*d))
         .fold(0.0, f64::max)
 }
@@ -104,17 +112,7 @@ fn a_piece_cut_free_of_every_handle_stays_where_it_is_except_under_mls() {
             cuts: across(),
             ..Project::default()
         };
-        let warper = pipeline::prepare_warper(&touching(), &project, None, &())
-            .unwrap_or_else(|e| panic!("{}: {}", method.name(), pipeline::error_line(&e)));
-        let rest = warper.deformer.rest().to_vec();
-        let deformed = warper.deformer.deformed();
-        let right = rest
-            .iter()
-            .zip(&deformed)
-            .filter(|(r, _)| r.x > 61.0)
-            .map(|(r, d)| r.distance(*d))
-            .fold(0.0, f64::max);
-        assert!(deformed.iter().all(|p| p.is_finite()), "{}", method.name());
+        let right = largest_move(&project, |x| x > 61.0);
         if method == Method::Mls {
             // MLS measures straight-line distance: a cut changes nothing for it.
             assert!(right > 1.0, "mls: {right}");
