@@ -69,6 +69,9 @@ pub(crate) struct PassTriangle {
     pub edges: [DVec2; 2],
     /// The rigidity weight.
     pub weight: f64,
+    /// One over the rigidity weight (the energy's terms are the weighted edges'
+    /// differences, squared, divided by the weight).
+    pub inverse_weight: f64,
 }
 
 /// One block of `B` (eq. 8) and `D` (eq. 16): how free unknown `free` depends on the
@@ -363,6 +366,7 @@ impl Registration {
                     fit: mesh.fit[t as usize],
                     edges: [w * (r[1] - r[0]), w * (r[2] - r[1])],
                     weight: w,
+                    inverse_weight: 1.0 / w,
                 }
             })
             .collect();

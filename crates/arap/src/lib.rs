@@ -82,6 +82,7 @@
 
 mod compile;
 mod error;
+mod minimise;
 mod registration;
 mod ring;
 mod solver;
@@ -92,6 +93,7 @@ mod update;
 pub use compile::Compiled;
 pub use error::ArapError;
 pub use geometry::Similarity;
+pub use minimise::{Convergence, Minimise};
 pub use registration::Registration;
 pub use ring::{ring_constraints, similarity_constraints};
 pub use update::Deformation;

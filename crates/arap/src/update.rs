@@ -3,7 +3,7 @@
 
 use glam::DVec2;
 
-use crate::compile::{Compiled, StepOne};
+use crate::compile::{Compiled, PassTriangle, StepOne};
 use crate::error::ArapError;
 use crate::solver::Entry;
 use crate::triangle::{fitted_rotation, rotate};
@@ -19,7 +19,7 @@ pub struct Deformation {
     pub step_one: Vec<DVec2>,
     /// The final result (§4.2): step two's scale-adjusted positions.
     pub positions: Vec<DVec2>,
-    scratch: Scratch,
+    pub(crate) scratch: Scratch,
 }
 
 impl Clone for Deformation {
@@ -43,11 +43,11 @@ impl std::fmt::Debug for Deformation {
 
 /// Buffers reused between updates.
 #[derive(Default)]
-struct Scratch {
+pub(crate) struct Scratch {
     step_one: Vec<DVec2>,
-    step_two: Vec<DVec2>,
-    linear: Vec<DVec2>,
-    work: Vec<DVec2>,
+    pub(crate) step_two: Vec<DVec2>,
+    pub(crate) linear: Vec<DVec2>,
+    pub(crate) work: Vec<DVec2>,
 }
 
 impl Compiled {
@@ -107,7 +107,7 @@ impl Compiled {
     /// # Errors
     /// Refuses a list of constrained positions of the wrong length or with a
     /// non-finite entry.
-    fn check_targets(&self, targets: &[DVec2]) -> Result<(), ArapError> {
+    pub(crate) fn check_targets(&self, targets: &[DVec2]) -> Result<(), ArapError> {
         if targets.len() != self.constrained.len() {
             return Err(ArapError::TargetCount {
                 got: targets.len(),
@@ -180,99 +180,43 @@ impl Compiled {
         Ok(())
     }
 
-    /// Refines `out.positions` (a pose of these constraints at `targets`) towards
-    /// the minimum of the ARAP energy [`Compiled::energy`] with local/global
-    /// iterations (Sorkine and Alexa 2007): each fits every triangle's rotation to its
-    /// current shape (the local step, the paper's step-two fit) and solves step two's
-    /// system with those rotations (the global step, one back-substitution). Neither
-    /// step raises the energy. Stops after `iterations`, or once no vertex moves
-    /// farther than `tolerance`; returns the iterations run.
-    ///
-    /// # Errors
-    /// As [`Compiled::update`]; `out` is left unchanged on error.
-    pub fn refine_into(
-        &self,
-        targets: &[DVec2],
-        out: &mut Deformation,
-        iterations: usize,
-        tolerance: f64,
-    ) -> Result<usize, ArapError> {
-        self.check_targets(targets)?;
-        let Some(two) = &self.step_two else {
-            return Ok(0);
-        };
-        if out.positions.len() != self.mesh.rest.len() {
-            return Ok(0);
-        }
-        let mut previous = Vec::new();
-        for done in 0..iterations {
-            previous.clone_from(&out.positions);
-            let shape = std::mem::take(&mut out.positions);
-            let mut next = shape.clone();
-            self.fit_and_solve(two, &shape, targets, &mut next, &mut out.scratch);
-            out.positions = next;
-            let moved = previous
-                .iter()
-                .zip(&out.positions)
-                .map(|(a, b)| a.distance_squared(*b))
-                .fold(0.0, f64::max)
-                .sqrt();
-            if moved <= tolerance || moved.is_nan() {
-                return Ok(done + 1);
-            }
-        }
-        Ok(iterations)
-    }
-
     /// The ARAP energy of `positions` over the triangles with a constraint in their
     /// piece: Σ w·Σ‖d − R·e‖² over each triangle's three edges, e at rest, d posed, R
     /// the rotation fitted to the triangle (the paper's fit), w its rigidity weight.
     pub fn energy(&self, positions: &[DVec2]) -> f64 {
-        self.triangles
-            .iter()
-            .map(|t| {
-                let [i, j, k] = t.vertices.map(|v| v as usize);
-                let p = [positions[i], positions[j], positions[k]];
-                let rotation = fitted_rotation(&t.fit, p);
-                let rest = [t.edges[0], t.edges[1], -(t.edges[0] + t.edges[1])];
-                let posed = [p[1] - p[0], p[2] - p[1], p[0] - p[2]];
-                rest.iter()
-                    .zip(posed)
-                    .map(|(e, d)| (d - rotate(rotation, *e / t.weight)).length_squared())
-                    .sum::<f64>()
-                    * t.weight
-            })
-            .sum()
+        self.fit(positions, &mut Vec::new())
     }
 
     /// Step two's fit and solve: rotations fitted to the triangles of `shape`, the
     /// rotated rest edges added to the linear term f at each corner (corner c ends
     /// edge c−1 → c and starts edge c → c+1), and H'u = f_u − Dq solved (eq. 16, x and
-    /// y together) into the free vertices of `out`.
-    fn fit_and_solve(
+    /// y together) into the free vertices of `out`. Returns the energy of `shape`
+    /// ([`Compiled::energy`]), which the fit computes on the way.
+    pub(crate) fn fit_and_solve(
         &self,
         two: &crate::solver::Cholesky<f64>,
         shape: &[DVec2],
         targets: &[DVec2],
         out: &mut [DVec2],
         scratch: &mut Scratch,
+    ) -> f64 {
+        let energy = self.fit(shape, &mut scratch.linear);
+        self.solve_fitted(two, targets, out, scratch);
+        energy
+    }
+
+    /// The global step after [`Compiled::fit`] has filled `scratch.linear`: H'u =
+    /// f_u − Dq solved into the free vertices of `out`.
+    pub(crate) fn solve_fitted(
+        &self,
+        two: &crate::solver::Cholesky<f64>,
+        targets: &[DVec2],
+        out: &mut [DVec2],
+        scratch: &mut Scratch,
     ) {
-        let b = &mut scratch.linear;
-        b.clear();
-        b.resize(self.mesh.rest.len(), DVec2::ZERO);
-        for t in &self.triangles {
-            let [i, j, k] = t.vertices.map(|v| v as usize);
-            let rotation = fitted_rotation(&t.fit, [shape[i], shape[j], shape[k]]);
-            let e01 = rotate(rotation, t.edges[0]);
-            let e12 = rotate(rotation, t.edges[1]);
-            let e20 = -(e01 + e12);
-            b[i] += e20 - e01;
-            b[j] += e01 - e12;
-            b[k] += e12 - e20;
-        }
         let r2 = &mut scratch.step_two;
         r2.clear();
-        r2.extend(self.free.iter().map(|&v| b[v as usize]));
+        r2.extend(self.free.iter().map(|&v| scratch.linear[v as usize]));
         for c in &self.couplings {
             r2[c.free as usize] -= c.h * targets[c.constraint as usize];
         }
@@ -281,4 +225,42 @@ impl Compiled {
             out[v as usize] = p;
         }
     }
+
+    /// The local step: fits every triangle's rotation to `shape` and writes the
+    /// rotated rest edges' contributions to the global step's linear term into `b`
+    /// (one per vertex). Returns the energy of `shape` with those rotations, which
+    /// is [`Compiled::energy`] of it.
+    pub(crate) fn fit(&self, shape: &[DVec2], b: &mut Vec<DVec2>) -> f64 {
+        let n = self.mesh.rest.len();
+        b.clear();
+        b.resize(n, DVec2::ZERO);
+        fit_triangles(&self.triangles, shape, b)
+    }
+}
+
+/// [`Compiled::fit`] over some of its triangles, adding into `b`.
+fn fit_triangles(triangles: &[PassTriangle], shape: &[DVec2], b: &mut [DVec2]) -> f64 {
+    let mut energy = 0.0;
+    for t in triangles {
+        let [i, j, k] = t.vertices.map(|v| v as usize);
+        let rotation = fitted_rotation(&t.fit, [shape[i], shape[j], shape[k]]);
+        let e01 = rotate(rotation, t.edges[0]);
+        let e12 = rotate(rotation, t.edges[1]);
+        let e20 = -(e01 + e12);
+        b[i] += e20 - e01;
+        b[j] += e01 - e12;
+        b[k] += e12 - e20;
+        // The edges carry the weight w: w·‖d − R·e‖² = ‖w·d − R·(w·e)‖² / w.
+        let w = t.weight;
+        let d = [
+            shape[j] - shape[i],
+            shape[k] - shape[j],
+            shape[i] - shape[k],
+        ];
+        energy += ((d[0] * w - e01).length_squared()
+            + (d[1] * w - e12).length_squared()
+            + (d[2] * w - e20).length_squared())
+            * t.inverse_weight;
+    }
+    energy
 }

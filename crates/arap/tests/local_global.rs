@@ -1,11 +1,11 @@
-//! Local/global refinement (Sorkine and Alexa 2007) of the two-step result: it never
-//! raises the ARAP energy, and it reaches the minimum a plain reference finds — local
-//! and global steps written from their definitions, the global one by the dense
-//! solver of `support::dense`.
+//! Local/global minimisation (Sorkine and Alexa 2007) from the two-step result, plain
+//! and accelerated: it never raises the ARAP energy, and it reaches the minimum a
+//! plain reference finds — local and global steps written from their definitions,
+//! the global one by the dense solver of `support::dense`.
 
 mod support;
 
-use arap::Registration;
+use arap::{Minimise, Registration};
 use glam::DVec2;
 use support::dense::{fitted_rotation, minimise, step_two_energy};
 use support::{Diagonals, MeshData, grid};
@@ -75,11 +75,16 @@ fn local_global_lowers_the_energy_to_the_reference_minimum() {
         (ours - two_step).abs() <= 1e-9 * two_step.max(1.0),
         "energy {ours}, the reference's {two_step}"
     );
-    // One iteration at a time: never up.
+    // Plain local/global, one iteration at a time: never up.
+    let plain = Minimise {
+        iterations: 1,
+        tolerance: 0.0,
+        history: 0,
+    };
     let mut last = two_step;
     for i in 0..300 {
         compiled
-            .refine_into(&targets, &mut pose, 1, 0.0)
+            .minimise_into(&targets, &mut pose, &plain)
             .expect("an iteration");
         let e = energy(&mesh, &pose.positions);
         assert!(
@@ -101,15 +106,61 @@ fn local_global_lowers_the_energy_to_the_reference_minimum() {
         last <= 1.001 * expected && expected <= 1.001 * last,
         "local/global reached {last}, the reference {expected} (two steps: {two_step})"
     );
-    // Run to a tolerance, it stops early and lands on the same minimum.
+    // Accelerated, run to a tolerance: it stops early, in far fewer iterations than
+    // plain iteration needs, on the same minimum.
+    let settings = Minimise {
+        iterations: 1000,
+        tolerance: 1e-9,
+        history: 5,
+    };
     let mut pose = compiled.update(&targets).expect("two steps");
-    let ran = compiled
-        .refine_into(&targets, &mut pose, 1000, 1e-9)
-        .expect("refined");
-    assert!(ran < 1000, "converged in {ran}");
-    let converged = energy(&mesh, &pose.positions);
+    let accelerated = compiled
+        .minimise_into(&targets, &mut pose, &settings)
+        .expect("minimised");
+    let mut plain_pose = compiled.update(&targets).expect("two steps");
+    let plainly = compiled
+        .minimise_into(
+            &targets,
+            &mut plain_pose,
+            &Minimise {
+                history: 0,
+                ..settings
+            },
+        )
+        .expect("minimised");
     assert!(
-        (converged - last).abs() <= 1e-6 * last,
-        "{converged} against {last}"
+        accelerated.iterations < 1000 && 2 * accelerated.iterations < plainly.iterations,
+        "accelerated {} iterations, plain {}",
+        accelerated.iterations,
+        plainly.iterations
     );
+    for e in [energy(&mesh, &pose.positions), accelerated.energy] {
+        assert!((e - last).abs() <= 1e-6 * last, "{e} against {last}");
+    }
+    for (a, b) in pose.positions.iter().zip(&plain_pose.positions) {
+        assert!(a.distance(*b) < 1e-6, "{a} against {b}");
+    }
+    // The energies it accepts never rise: a run of k + 1 iterations ends no higher
+    // than one of k.
+    let mut last = f64::INFINITY;
+    for k in 1..40 {
+        let mut pose = compiled.update(&targets).expect("two steps");
+        let run = compiled
+            .minimise_into(
+                &targets,
+                &mut pose,
+                &Minimise {
+                    iterations: k,
+                    ..settings
+                },
+            )
+            .expect("minimised");
+        assert!(
+            run.energy <= last * (1.0 + 1e-12),
+            "{k} iterations: {last} → {}",
+            run.energy
+        );
+        assert!(energy(&mesh, &pose.positions) <= run.energy * (1.0 + 1e-12) + 1e-12);
+        last = run.energy;
+    }
 }

@@ -185,7 +185,23 @@ fn method_switch(c: &mut Criterion) {
                 scale: 1.0,
                 depth: 0,
             };
-            doc.apply(Edit::Pose(2, handle)).expect("pose");
+            // As a drag frame poses it: live, on from the previous frame.
+            let mut project = doc.project().clone();
+            project.handles[2] = handle;
+            doc.preview(project).expect("pose");
+            black_box(doc.deformer().deformed().len())
+        })
+    });
+    // The drag's end: the pose solved in full from the two steps.
+    c.bench_function("editor/arap_settle/lizard_20k", |b| {
+        b.iter(|| {
+            dx = if dx > 20.0 { 0.0 } else { dx + 1.0 };
+            let mut project = doc.project().clone();
+            if let HandleSpec::Point { translate, .. } = &mut project.handles[2] {
+                *translate = [-20.0 + dx, -60.0];
+            }
+            doc.preview(project).expect("pose");
+            doc.settle().expect("settled");
             black_box(doc.deformer().deformed().len())
         })
     });

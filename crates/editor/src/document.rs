@@ -596,7 +596,34 @@ impl Document {
     /// # Errors
     /// As [`Document::apply`]; on error nothing changes.
     pub fn restore(&mut self, project: Project) -> Result<()> {
+        self.set_live(false)?;
         self.restore_with(project, false)
+    }
+
+    /// [`Document::restore`] for a frame of a live drag: an iterative method starts
+    /// from the previous frame's answer and stops early ([`Deformer::set_live`]);
+    /// [`Document::settle`] finishes the pose when the drag ends.
+    ///
+    /// # Errors
+    /// As [`Document::restore`].
+    pub fn preview(&mut self, project: Project) -> Result<()> {
+        self.set_live(true)?;
+        self.restore_with(project, false)
+    }
+
+    /// Ends a live drag: the pose shown is solved in full, as a file of it renders.
+    ///
+    /// # Errors
+    /// What the method refuses in the pose (as [`Document::restore`]).
+    pub fn settle(&mut self) -> Result<()> {
+        self.set_live(false)
+    }
+
+    fn set_live(&mut self, live: bool) -> Result<()> {
+        if let Some((_, deformer)) = &mut self.method {
+            deformer.set_live(live)?;
+        }
+        Ok(())
     }
 
     /// The rig file with the rig's virtual handles: a state that [`Document::undo_to`]

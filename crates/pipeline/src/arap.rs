@@ -43,11 +43,22 @@ pub use geometry::polyline_distance_squared;
 /// ARAP's own mesh when the rig file names no `arap.density`.
 pub const DEFAULT_ARAP_DENSITY: usize = 3000;
 
-/// The most local/global iterations a pose runs (`"solver": "local-global"`).
-pub const LOCAL_GLOBAL_ITERATIONS: usize = 200;
+/// How the local/global solver (`"solver": "local-global"`) settles a pose: from the
+/// two steps' answer, until an iteration moves no vertex farther than a hundredth of
+/// a pixel (at most 500 iterations), five earlier iterates accelerating it.
+pub const SETTLED: arap::Minimise = arap::Minimise {
+    iterations: 500,
+    tolerance: 0.01,
+    history: 5,
+};
 
-/// Local/global iterations stop once no vertex moves farther than this, pixels.
-pub const LOCAL_GLOBAL_TOLERANCE: f64 = 0.01;
+/// How it follows a live drag: from the previous frame's answer, at most this many
+/// iterations a frame (the drag's end settles the pose in full, [`SETTLED`]).
+pub const LIVE: arap::Minimise = arap::Minimise {
+    iterations: 8,
+    tolerance: 0.01,
+    history: 5,
+};
 
 /// What a handle holds when the rig file names no `arap.pin_radius`: this share of the
 /// picture's diagonal.
@@ -76,7 +87,13 @@ impl ArapOptions {
                 .pin_radius
                 .unwrap_or_else(|| diagonal.map_or(0.0, |d| DEFAULT_PIN_RADIUS * d)),
             density: settings.density.unwrap_or(DEFAULT_ARAP_DENSITY),
-            solver: settings.solver.unwrap_or_default(),
+            // The energy's minimum on a picture; the paper's algorithm exactly on a
+            // mesh given as ARAP's own.
+            solver: settings.solver.unwrap_or(if diagonal.is_some() {
+                project::ArapSolver::LocalGlobal
+            } else {
+                project::ArapSolver::TwoStep
+            }),
         }
     }
 
@@ -251,6 +268,14 @@ pub struct ArapRig {
     /// mesh, a copy of the pose's positions).
     positions: Vec<DVec2>,
     times: ArapTimes,
+    /// When the local/global solver stops when it settles a pose and in a live drag,
+    /// and how its last pose went.
+    minimise: (arap::Minimise, arap::Minimise),
+    convergence: Option<arap::Convergence>,
+    /// In a live drag; `warm`: the current pose came from the previous one rather
+    /// than settled from the two steps.
+    live: bool,
+    warm: bool,
     /// The diagonal of the picture ARAP meshed, pixels (`None` on a given mesh): what
     /// the rig file's default pin radius resolves against.
     diagonal: Option<f64>,
@@ -371,6 +396,10 @@ impl ArapRig {
                 compile_ms,
                 update_ms: 0.0,
             },
+            minimise: (SETTLED, LIVE),
+            convergence: None,
+            live: false,
+            warm: false,
             diagonal: None,
         };
         rig.update()?;
@@ -421,6 +450,22 @@ impl ArapRig {
     /// The settings in use.
     pub fn options(&self) -> ArapOptions {
         self.options
+    }
+
+    /// When the local/global solver stops (`"solver": "local-global"`): settling a
+    /// pose ([`SETTLED`] unless set here) and in a live drag ([`LIVE`]); poses again
+    /// with the new settings. For measurements: the rig file does not set these.
+    ///
+    /// # Errors
+    /// As a pose can fail.
+    pub fn set_minimise(&mut self, settled: arap::Minimise, live: arap::Minimise) -> Result<()> {
+        self.minimise = (settled, live);
+        self.update()
+    }
+
+    /// How the local/global solver's last pose converged; `None` under the two steps.
+    pub fn convergence(&self) -> Option<arap::Convergence> {
+        self.convergence
     }
 
     /// The times of the last registration, compilation and update.
@@ -608,17 +653,27 @@ impl ArapRig {
             targets.push(handle_map(handle, at));
             one.push(handle_map(handle, at_one));
         }
-        self.compiled
-            .update_split_into(&one, &targets, &mut self.pose)?;
-        if self.options.solver == project::ArapSolver::LocalGlobal {
-            // On to the energy's minimum: until no vertex moves a hundredth of a
-            // pixel, or the iterations run out.
-            self.compiled.refine_into(
+        let local_global = self.options.solver == project::ArapSolver::LocalGlobal;
+        self.warm = local_global && self.live && self.pose.positions.len() == positions.len();
+        if self.warm {
+            // A drag frame: on from the previous frame's answer.
+            self.convergence = Some(self.compiled.minimise_into(
                 &targets,
                 &mut self.pose,
-                LOCAL_GLOBAL_ITERATIONS,
-                LOCAL_GLOBAL_TOLERANCE,
-            )?;
+                &self.minimise.1,
+            )?);
+        } else {
+            self.compiled
+                .update_split_into(&one, &targets, &mut self.pose)?;
+            // On to the energy's minimum.
+            self.convergence = if local_global {
+                Some(
+                    self.compiled
+                        .minimise_into(&targets, &mut self.pose, &self.minimise.0)?,
+                )
+            } else {
+                None
+            };
         }
         match &self.control {
             Some(control) => control.follow(&self.pose.positions, &mut self.positions),
@@ -654,6 +709,14 @@ impl Deformer for ArapRig {
             return Err(e);
         }
         Ok(Follow::Followed)
+    }
+
+    fn set_live(&mut self, live: bool) -> Result<()> {
+        self.live = live;
+        if !live && self.warm {
+            self.update()?;
+        }
+        Ok(())
     }
 
     fn deformed(&self) -> Vec<DVec2> {
@@ -693,11 +756,22 @@ impl Deformer for ArapRig {
         let pinned_vertices = self.pinned();
         let scale = self.picture.mean_edge_length() * 10.0;
         let mut sequence = Sequence::new();
+        let poses: Vec<Vec<Handle>> = (0..poses.max(1))
+            .map(|_| sequence.jiggle(&handles, scale))
+            .collect();
+        // Drag frames, live.
+        self.live = true;
         let mut update = Vec::new();
-        for _ in 0..poses.max(1) {
-            let posed = sequence.jiggle(&handles, scale);
-            self.set_handles(&posed)?;
+        for posed in &poses {
+            self.set_handles(posed)?;
             update.push(self.times.update_ms);
+        }
+        self.live = false;
+        let (mut settle, mut iterations) = (Vec::new(), Vec::new());
+        for posed in &poses {
+            self.set_handles(posed)?;
+            settle.push(self.times.update_ms);
+            iterations.push(self.convergence.map_or(0.0, |c| c.iterations as f64));
         }
         self.set_handles(&handles)?;
         json(&ArapReport {
@@ -710,8 +784,12 @@ impl Deformer for ArapRig {
             pinned_vertices,
             registration_ms,
             compile_ms_median: median(compile),
+            solver: self.options.solver,
             update_ms_p90: quantile(update.clone(), 0.9),
             update_ms_median: median(update.clone()),
+            settle_ms_p90: quantile(settle.clone(), 0.9),
+            settle_ms_median: median(settle),
+            settle_iterations_median: median(iterations),
             poses: update.len(),
         })
     }
@@ -743,10 +821,20 @@ struct ArapReport {
     registration_ms: f64,
     /// Median compilation (factorising both steps' systems), ms.
     compile_ms_median: f64,
-    /// Median update (a new pose: step one, the fit, step two), ms.
+    /// How a pose is solved: `"local-global"` or `"two-step"`.
+    solver: project::ArapSolver,
+    /// Median update of a drag frame (live: on from the previous pose, at most
+    /// [`LIVE`]'s iterations; under the two steps, the two steps), the picture's
+    /// vertices following included, ms.
     update_ms_median: f64,
-    /// 90th percentile of the updates, ms.
+    /// 90th percentile of the drag frames, ms.
     update_ms_p90: f64,
+    /// Median and 90th percentile of a pose settled in full (from the two steps to
+    /// the energy's minimum; under the two steps, the two steps), ms.
+    settle_ms_median: f64,
+    settle_ms_p90: f64,
+    /// Median local/global iterations a settled pose took.
+    settle_iterations_median: f64,
     /// Poses timed.
     poses: usize,
 }

@@ -99,6 +99,18 @@ pub trait Deformer: Send {
     /// Controls the method refuses (off the shape, coincident, non-finite).
     fn follow(&mut self, project: &Project) -> Result<Follow>;
 
+    /// Whether the poses to follow come from a live drag: an iterative method may then
+    /// start each from its previous answer and stop early. Leaving live mode solves
+    /// the current pose in full, as [`Deformer::follow`] does outside it, so what
+    /// shows after a drag is what a file of that pose renders.
+    ///
+    /// # Errors
+    /// As [`Deformer::follow`].
+    fn set_live(&mut self, live: bool) -> Result<()> {
+        let _ = live;
+        Ok(())
+    }
+
     /// Where every vertex of [`Deformer::rest`] goes in the current pose.
     fn deformed(&self) -> Vec<DVec2>;
 

@@ -248,18 +248,18 @@ pub struct ArapSettings {
     /// mesh has too little hold). Default: 3,000.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub density: Option<usize>,
-    /// How a pose is solved: the paper's two steps (the default), or those refined by
-    /// local/global iterations to the ARAP energy's minimum.
+    /// How a pose is solved: the paper's two steps refined by local/global iterations
+    /// to the ARAP energy's minimum (the default on a picture), or the paper's two
+    /// steps alone (the default on a mesh given as ARAP's own, `c2warp deform --mesh`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub solver: Option<ArapSolver>,
 }
 
 /// How ARAP solves a pose.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ArapSolver {
     /// Igarashi et al.'s two closed-form steps (scale-free fit, then scale adjustment).
-    #[default]
     TwoStep,
     /// The two steps, then local/global iterations (Sorkine and Alexa 2007) to the
     /// minimum of the ARAP energy the pins define.

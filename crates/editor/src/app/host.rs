@@ -40,7 +40,7 @@ impl Host for EditorApp {
         // it), and samples every pose it shows.
         self.start_take();
         let Some(doc) = &mut self.doc else { return };
-        if let Err(e) = doc.restore(project) {
+        if let Err(e) = doc.preview(project) {
             self.error(&e);
         }
         self.sample_take();
@@ -55,6 +55,12 @@ impl Host for EditorApp {
     }
 
     fn record(&mut self, before: Project) {
+        // The drag is over: what it shows is solved in full.
+        if let Some(doc) = &mut self.doc
+            && let Err(e) = doc.settle()
+        {
+            self.error(&e);
+        }
         if self.end_take() {
             return;
         }

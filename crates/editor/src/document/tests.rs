@@ -190,7 +190,11 @@ fn under_arap_a_pin_placed_in_a_bent_pose_holds_the_picture_where_it_is() {
             .zip(doc.deformed())
             .map(|(a, b)| a.distance(*b))
             .fold(0.0, f64::max);
-        assert!(jump < 1e-6, "insertion {i}: the picture moved by {jump} px");
+        // The new pin holds its points where the solve has them, so the energy's
+        // minimum stays where it was; the settled solve stops within a hundredth of a
+        // pixel of it, from the same two-step start (exact, 1e-9, under the two steps
+        // alone: `arap`'s tests).
+        assert!(jump < 0.05, "insertion {i}: the picture moved by {jump} px");
         assert_eq!(
             doc.project().holds.len(),
             i + 1,
@@ -588,7 +592,11 @@ fn under_c2_a_pin_placed_in_a_posed_state_is_overlaid_and_moves_no_key() {
                 .fold(0.0, f64::max)
         };
         let jump = largest(&before, doc.deformed());
-        assert!(jump < 1e-6, "insertion {i}: the picture moved by {jump} px");
+        // The new pin holds its points where the solve has them, so the energy's
+        // minimum stays where it was; the settled solve stops within a hundredth of a
+        // pixel of it, from the same two-step start (exact, 1e-9, under the two steps
+        // alone: `arap`'s tests).
+        assert!(jump < 0.05, "insertion {i}: the picture moved by {jump} px");
         for (k, (a, b)) in keys_before.iter().zip(pictures(&mut doc)).enumerate() {
             let jump = largest(a, &b);
             assert!(jump < 1e-6, "insertion {i}: key {k} moved by {jump} px");

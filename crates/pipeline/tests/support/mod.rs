@@ -1,3 +1,4 @@
 //! Helpers shared by the pipeline's integration tests.
 
+pub mod energy;
 pub mod pins;
