@@ -118,14 +118,7 @@ fn main() {
                     history: 8,
                 },
             ),
-            (
-                "AA5 0.001px",
-                arap::Minimise {
-                    iterations: 2000,
-                    tolerance: 0.001,
-                    history: 5,
-                },
-            ),
+            ("default", pipeline::arap::SETTLED),
         ] {
             let mut rig = rig.clone();
             let clock = Instant::now();
