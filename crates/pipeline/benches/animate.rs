@@ -8,8 +8,9 @@
 //!   ([`Animator::render`]), each split into bands of rows by the warp alone: what
 //!   drawing whole frames side by side gains over that;
 //! * `animate/encode/FORMAT`: 24 frames already drawn, written by
-//!   [`render::AnimationWriter`] to a temporary folder (one thread, as the animator's
-//!   writer thread does): what each encoder costs a frame.
+//!   [`render::AnimationWriter`] to a temporary folder four at a time (each four
+//!   compressed side by side, as the animator's writer thread hands them over): what
+//!   each encoder costs a frame.
 //!
 //! ```sh
 //! cargo bench -p pipeline --bench animate
@@ -57,8 +58,8 @@ fn animate(c: &mut Criterion) {
                 pool.install(|| {
                     animator.for_each_frame(
                         &frames.times,
-                        &mut |_, picture| {
-                            drop(std::hint::black_box(picture));
+                        &mut |_, pictures| {
+                            drop(std::hint::black_box(pictures));
                             Ok(())
                         },
                         &none,
@@ -82,8 +83,8 @@ fn animate(c: &mut Criterion) {
     animator
         .for_each_frame(
             &frames.times,
-            &mut |_, picture| {
-                drawn.push(picture);
+            &mut |_, pictures| {
+                drawn.extend(pictures);
                 Ok(())
             },
             &none,
@@ -104,8 +105,8 @@ fn animate(c: &mut Criterion) {
                 let mut writer =
                     AnimationWriter::create(&path, format, width, height, FRAMES, frames.fps)
                         .expect("created");
-                for picture in &drawn {
-                    writer.push(picture).expect("pushed");
+                for pictures in drawn.chunks(4) {
+                    writer.push_all(pictures).expect("pushed");
                 }
                 writer.finish().expect("written");
             });

@@ -285,10 +285,18 @@ impl<'a> Animator<'a> {
         let (width, height) = self.size();
         let mut writer = AnimationWriter::create(output, format, width, height, total, frames.fps)?;
         progress(0, total);
+        // A chunk's frames are compressed side by side, on threads of their own: the
+        // operating system lets them fill the gaps the drawing leaves (a chunk's last
+        // frame, the writer waiting on the disk), which the drawing's pool cannot.
+        let encoding = rayon::ThreadPoolBuilder::new()
+            .num_threads(rayon::current_num_threads())
+            .thread_name(|i| format!("encode-{i}"))
+            .build()
+            .context("starting the animation's encoding threads")?;
         self.for_each_frame(
             &frames.times,
-            &mut |_, picture| {
-                writer.push(&picture)?;
+            &mut |_, pictures| {
+                encoding.install(|| writer.push_all(&pictures))?;
                 progress(writer.pushed(), total);
                 Ok(())
             },
@@ -298,22 +306,22 @@ impl<'a> Animator<'a> {
         Ok(())
     }
 
-    /// Draws the frames at `times` in parallel and hands each, in order, to `each`
-    /// (with its index), on a thread of its own while the next frames are drawn: what
-    /// [`Animator::write`] does with a writer. Chunks of two frames a thread are drawn
-    /// at once, each thread with its own copy of the method; `each` runs on the chunk
-    /// before. Called from inside a rayon pool, it draws a chunk and then hands it
-    /// over, in turn (a thread of the pool waiting on `each` could hold up work that
-    /// `each` waits for).
+    /// Draws the frames at `times` in parallel and hands them, a chunk at a time in
+    /// order, to `each` (with the index of the chunk's first frame), on a thread of its
+    /// own while the next chunk is drawn: what [`Animator::write`] does with a writer.
+    /// Chunks of two frames a thread are drawn at once, each thread with its own copy
+    /// of the method; `each` runs on the chunk before. Called from inside a rayon
+    /// pool, it draws a chunk and then hands it over, in turn (a thread of the pool
+    /// waiting on `each` could hold up work that `each` waits for).
     ///
     /// # Errors
     /// What drawing a frame refuses, or `each`'s first error (no frame is drawn or
     /// handed over after either); [`Cancelled`] when `cancel` is set (checked before
-    /// each chunk and each frame handed over).
+    /// each chunk is drawn and handed over).
     pub fn for_each_frame(
         &self,
         times: &[f64],
-        each: &mut (dyn FnMut(usize, Picture) -> Result<()> + Send),
+        each: &mut (dyn FnMut(usize, Vec<Picture>) -> Result<()> + Send),
         cancel: &AtomicBool,
     ) -> Result<()> {
         let scene = &self.scene;
@@ -341,13 +349,12 @@ impl<'a> Animator<'a> {
         let cancelled = || cancel.load(Ordering::Relaxed);
         let mut next = 0;
         let mut hand_over = |pictures: Vec<Picture>| -> Result<()> {
-            for picture in pictures {
-                if cancelled() {
-                    return Err(Cancelled.into());
-                }
-                each(next, picture)?;
-                next += 1;
+            if cancelled() {
+                return Err(Cancelled.into());
             }
+            let count = pictures.len();
+            each(next, pictures)?;
+            next += count;
             Ok(())
         };
         if rayon::current_thread_index().is_some() {

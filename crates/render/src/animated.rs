@@ -111,8 +111,9 @@ impl AnimationFormat {
 }
 
 /// Writes an animation frame by frame, streaming: each [`push`](Self::push)
-/// encodes one frame and writes it out, so no more than one frame is held in
-/// memory. The animation loops forever.
+/// encodes one frame and writes it out, and [`push_all`](Self::push_all) encodes a
+/// run of frames side by side (on rayon's threads) and writes them out in order,
+/// so no more than those frames are held in memory. The animation loops forever.
 ///
 /// The file appears at its path only when [`finish`](Self::finish) succeeds: the
 /// frames go to a temporary file in the same directory, which is synced and
@@ -167,7 +168,7 @@ pub struct AnimationWriter {
     frames: usize,
     pushed: usize,
     /// The format's encoder; `None` once a frame failed (the animation is abandoned).
-    sink: Option<Box<dyn FrameSink + Send>>,
+    sink: Option<Box<dyn FrameSink + Send + Sync>>,
 }
 
 impl AnimationWriter {
@@ -239,7 +240,7 @@ impl AnimationWriter {
                 ),
             ));
         }
-        let sink: Box<dyn FrameSink + Send> = match format {
+        let sink: Box<dyn FrameSink + Send + Sync> = match format {
             AnimationFormat::Apng => Box::new(ApngSink::create(path, width, height, frames, fps)?),
             AnimationFormat::WebP => Box::new(WebpSink::create(path, width, height, fps)?),
             AnimationFormat::Gif => Box::new(GifSink::create(path, width, height, fps)?),
@@ -268,40 +269,83 @@ impl AnimationWriter {
     /// encoder fails; [`RenderError::Io`] if writing fails. After an encoding or
     /// writing error the animation is abandoned (its temporary files removed).
     pub fn push(&mut self, frame: &Picture) -> Result<(), RenderError> {
-        let index = self.pushed;
-        if index == self.frames {
+        self.push_all(std::slice::from_ref(frame))
+    }
+
+    /// Appends the next `frames.len()` frames, as [`push`](Self::push) each, but
+    /// encodes them side by side on rayon's threads (compression is most of an
+    /// animated PNG's or a GIF's cost) before writing them out in order. The file
+    /// is byte for byte what pushing them one by one writes.
+    ///
+    /// # Errors
+    /// As [`push`](Self::push); frames are checked before any is encoded, and after
+    /// an error none of them is written.
+    pub fn push_all(&mut self, frames: &[Picture]) -> Result<(), RenderError> {
+        let first = self.pushed;
+        if first + frames.len() > self.frames {
             return Err(animation_error(
                 &self.path,
                 format!(
                     "frame {} is one too many: the animation was started for {} frames",
-                    index + 1,
+                    self.frames + 1,
                     self.frames
                 ),
             ));
         }
-        let (width, height) = frame.dimensions();
-        if (width, height) != (self.width, self.height) {
-            return Err(animation_error(
-                &self.path,
-                format!(
-                    "frame {} of {} is {width}x{height} pixels, not {}x{}",
-                    index + 1,
-                    self.frames,
-                    self.width,
-                    self.height
-                ),
-            ));
+        for (offset, frame) in frames.iter().enumerate() {
+            let (width, height) = frame.dimensions();
+            if (width, height) != (self.width, self.height) {
+                return Err(animation_error(
+                    &self.path,
+                    format!(
+                        "frame {} of {} is {width}x{height} pixels, not {}x{}",
+                        first + offset + 1,
+                        self.frames,
+                        self.width,
+                        self.height
+                    ),
+                ));
+            }
         }
         let Some(sink) = self.sink.as_mut() else {
             return Err(self.abandoned());
         };
-        let result = sink.push(index, frame);
+        let result = Self::encode_and_write(sink.as_mut(), first, frames);
         if result.is_err() {
             self.sink = None;
         } else {
-            self.pushed += 1;
+            self.pushed += frames.len();
         }
         result
+    }
+
+    /// Encodes `frames` (from frame `first`) side by side, then writes them in order.
+    fn encode_and_write(
+        sink: &mut (dyn FrameSink + Send + Sync),
+        first: usize,
+        frames: &[Picture],
+    ) -> Result<(), RenderError> {
+        if first == 0
+            && let Some(frame) = frames.first()
+        {
+            sink.begin(frame)?;
+        }
+        let encoded: Vec<Encoded> = {
+            let sink = &*sink;
+            if frames.len() == 1 {
+                vec![sink.encode(first, &frames[0])?]
+            } else {
+                frames
+                    .par_iter()
+                    .enumerate()
+                    .map(|(offset, frame)| sink.encode(first + offset, frame))
+                    .collect::<Result<_, _>>()?
+            }
+        };
+        for (offset, frame) in encoded.into_iter().enumerate() {
+            sink.write(first + offset, frame)?;
+        }
+        Ok(())
     }
 
     /// Ends the animation and puts it in place (see the type's documentation).
@@ -348,12 +392,43 @@ impl AnimationWriter {
 }
 
 /// One format's encoder behind [`AnimationWriter`], which has already checked
-/// each frame's size and the count.
+/// each frame's size and the count. Encoding takes the sink shared, so that frames
+/// are encoded side by side; writing takes it alone, in order.
 trait FrameSink {
-    /// Encodes frame `index` (from 0) and writes it out.
-    fn push(&mut self, index: usize, frame: &Picture) -> Result<(), RenderError>;
+    /// Sees the first frame before any frame is encoded (an animated PNG takes its
+    /// depth and writes its header).
+    fn begin(&mut self, _first: &Picture) -> Result<(), RenderError> {
+        Ok(())
+    }
+    /// Encodes frame `index` (from 0).
+    fn encode(&self, index: usize, frame: &Picture) -> Result<Encoded, RenderError>;
+    /// Writes out frame `index`, encoded; frames come in order.
+    fn write(&mut self, index: usize, frame: Encoded) -> Result<(), RenderError>;
     /// Ends the file and puts it in place.
     fn finish(self: Box<Self>) -> Result<(), RenderError>;
+}
+
+/// A frame as a [`FrameSink`] encoded it.
+enum Encoded {
+    /// The bytes the format wraps: a zlib stream (animated PNG), a `VP8L` chunk
+    /// (WebP) or a whole PNG file (sequence).
+    Bytes(Vec<u8>),
+    /// A GIF frame with its LZW data.
+    Gif(gif::Frame<'static>),
+}
+
+impl Encoded {
+    /// The bytes, for a sink that encodes to bytes (a sink only ever sees its own
+    /// kind, so `Gif` is an error that cannot happen).
+    fn into_bytes(self, path: &Path) -> Result<Vec<u8>, RenderError> {
+        match self {
+            Self::Bytes(bytes) => Ok(bytes),
+            Self::Gif(_) => Err(RenderError::Encode {
+                path: path.to_owned(),
+                detail: "a GIF frame was handed to another format's writer".to_owned(),
+            }),
+        }
+    }
 }
 
 /// A [`RenderError::Animation`] for `path`.
@@ -401,20 +476,35 @@ fn apng_delay(fps: f64) -> (u16, u16) {
 
 // ---------------------------------------------------------------- animated PNG
 
-/// Animated PNG through the `png` crate: every frame full size, blended by
-/// replacing (`BlendOp::Source`), not disposed.
+/// Animated PNG, muxed here: each frame is compressed by the `png` crate as a PNG of
+/// its own (fdeflate, adaptive filters: what [`save_png_atomic`](crate::save_png_atomic)
+/// uses), frames side by side, and its `IDAT` data is written as the first frame's
+/// `IDAT` or a later frame's `fdAT` chunks. Every frame is full size, blended by
+/// replacing (`blend_op` source), not disposed.
 struct ApngSink {
     path: PathBuf,
-    /// Configured but without a header until the first frame sets the depth.
-    encoder: Option<png::Encoder<'static, BufWriter<File>>>,
-    /// The encoder after the header, and whether it writes 16 bits per channel.
-    writer: Option<(png::Writer<BufWriter<File>>, bool)>,
-    /// The samples of the frame being written, when they need converting.
-    scratch: Vec<u8>,
-    /// The temporary file (the encoder writes to a clone of it).
-    file: File,
+    width: u32,
+    height: u32,
+    frames: u32,
+    /// The delay of every frame, `num / den` seconds.
+    delay: (u16, u16),
+    /// Whether frames have 16 bits per channel (the first frame's depth), once it
+    /// came.
+    sixteen: Option<bool>,
+    /// The next `fcTL` / `fdAT` sequence number.
+    sequence: u32,
+    out: BufWriter<File>,
+    /// Bytes written since the file was last synced.
+    unsynced: usize,
     replacement: Replacement,
 }
+
+/// The most data an `IDAT` or `fdAT` chunk holds (the `png` crate's choice too).
+const APNG_CHUNK_DATA: usize = 1 << 20;
+/// An animated PNG's file is synced each time this many bytes were written, while
+/// frames are still being drawn, so that the sync before it is put in place has
+/// little left to do (a 16-bit animation runs to hundreds of megabytes).
+const APNG_SYNC_BYTES: usize = 64 << 20;
 
 impl ApngSink {
     fn create(
@@ -428,80 +518,174 @@ impl ApngSink {
             animation_error(path, "an animated PNG holds at most 4294967295 frames")
         })?;
         let (replacement, file) = Replacement::begin(path)?;
-        let clone = file.try_clone().map_err(write_error(path))?;
-        let mut encoder = png::Encoder::new(BufWriter::new(clone), width, height);
-        encoder.set_color(png::ColorType::Rgba);
-        // What `save_png_atomic` uses (image's default): fdeflate, adaptive filters.
-        encoder.set_compression(png::Compression::Fast);
-        encoder.set_filter(png::Filter::Adaptive);
-        let (num, den) = apng_delay(fps);
-        let configure = |encoder: &mut png::Encoder<'static, BufWriter<File>>| {
-            encoder.set_animated(frames, 0)?;
-            encoder.set_frame_delay(num, den)?;
-            encoder.set_dispose_op(png::DisposeOp::None)?;
-            encoder.set_blend_op(png::BlendOp::Source)
-        };
-        configure(&mut encoder).map_err(|error| png_error(path, error))?;
         Ok(Self {
             path: path.to_owned(),
-            encoder: Some(encoder),
-            writer: None,
-            scratch: Vec::new(),
-            file,
+            width,
+            height,
+            frames,
+            delay: apng_delay(fps),
+            sixteen: None,
+            sequence: 0,
+            out: BufWriter::new(file),
+            unsynced: 0,
             replacement,
         })
+    }
+
+    /// Writes one chunk: length, type, data, CRC of type and data.
+    fn chunk(&mut self, kind: &[u8; 4], data: &[&[u8]]) -> Result<(), RenderError> {
+        let length: usize = data.iter().map(|part| part.len()).sum();
+        let mut crc = crc32fast::Hasher::new();
+        crc.update(kind);
+        for part in data {
+            crc.update(part);
+        }
+        let write = write_error(&self.path);
+        self.out
+            .write_all(&(length as u32).to_be_bytes())
+            .map_err(&write)?;
+        self.out.write_all(kind).map_err(&write)?;
+        for part in data {
+            self.out.write_all(part).map_err(&write)?;
+        }
+        self.out
+            .write_all(&crc.finalize().to_be_bytes())
+            .map_err(&write)?;
+        self.unsynced += 12 + length;
+        if self.unsynced >= APNG_SYNC_BYTES && !self.replacement.writes_through() {
+            self.unsynced = 0;
+            self.out.flush().map_err(&write)?;
+            self.out.get_ref().sync_data().map_err(&write)?;
+        }
+        Ok(())
     }
 }
 
 impl FrameSink for ApngSink {
-    fn push(&mut self, _index: usize, frame: &Picture) -> Result<(), RenderError> {
-        if let Some(mut encoder) = self.encoder.take() {
-            let sixteen = frame.bits_per_channel() == 16;
-            encoder.set_depth(if sixteen {
-                png::BitDepth::Sixteen
-            } else {
-                png::BitDepth::Eight
-            });
-            let writer = encoder
-                .write_header()
-                .map_err(|error| png_error(&self.path, error))?;
-            self.writer = Some((writer, sixteen));
-        }
-        let Some((writer, sixteen)) = self.writer.as_mut() else {
-            return Err(animation_error(&self.path, "the PNG encoder is gone"));
-        };
-        let scratch = &mut self.scratch;
-        let data: &[u8] = match (frame, *sixteen) {
+    fn begin(&mut self, first: &Picture) -> Result<(), RenderError> {
+        let sixteen = first.bits_per_channel() == 16;
+        self.sixteen = Some(sixteen);
+        self.out
+            .write_all(b"\x89PNG\r\n\x1a\n")
+            .map_err(write_error(&self.path))?;
+        let mut header = [0u8; 13];
+        header[..4].copy_from_slice(&self.width.to_be_bytes());
+        header[4..8].copy_from_slice(&self.height.to_be_bytes());
+        // Depth, colour type 6 (RGBA); deflate, adaptive filtering, no interlace.
+        header[8] = if sixteen { 16 } else { 8 };
+        header[9] = 6;
+        self.chunk(b"IHDR", &[&header])?;
+        let mut control = [0u8; 8];
+        control[..4].copy_from_slice(&self.frames.to_be_bytes());
+        // Plays: 0, forever.
+        self.chunk(b"acTL", &[&control])
+    }
+
+    fn encode(&self, _index: usize, frame: &Picture) -> Result<Encoded, RenderError> {
+        let sixteen = self.sixteen.unwrap_or(frame.bits_per_channel() == 16);
+        let converted: Vec<u8>;
+        let data: &[u8] = match (frame, sixteen) {
             (Picture::Rgba8(image), false) => image.as_raw(),
             (Picture::Rgba16(image), true) => {
-                scratch.clear();
-                scratch.extend(image.as_raw().iter().flat_map(|v| v.to_be_bytes()));
-                scratch
+                converted = big_endian(image.as_raw());
+                &converted
             }
             (Picture::Rgba8(image), true) => {
-                scratch.clear();
-                scratch.extend(image.as_raw().iter().flat_map(|&v| [v, v]));
-                scratch
+                let widened: Vec<u16> =
+                    image.as_raw().iter().map(|&v| u16::from(v) * 257).collect();
+                converted = big_endian(&widened);
+                &converted
             }
             (Picture::Rgba16(_), false) => {
-                scratch.clear();
-                scratch.extend_from_slice(frame.to_rgba8().as_raw());
-                scratch
+                converted = frame.to_rgba8().into_owned().into_raw();
+                &converted
             }
         };
-        writer
-            .write_image_data(data)
-            .map_err(|error| png_error(&self.path, error))
+        let error = |error| png_error(&self.path, error);
+        let mut png = Vec::with_capacity(data.len() / 2);
+        let mut encoder = png::Encoder::new(&mut png, self.width, self.height);
+        encoder.set_color(png::ColorType::Rgba);
+        encoder.set_depth(if sixteen {
+            png::BitDepth::Sixteen
+        } else {
+            png::BitDepth::Eight
+        });
+        encoder.set_compression(png::Compression::Fast);
+        encoder.set_filter(png::Filter::Adaptive);
+        let mut writer = encoder.write_header().map_err(error)?;
+        writer.write_image_data(data).map_err(error)?;
+        writer.finish().map_err(error)?;
+        idat_data(&png)
+            .map(Encoded::Bytes)
+            .ok_or_else(|| RenderError::Encode {
+                path: self.path.clone(),
+                detail: "the PNG encoder wrote no image data".to_owned(),
+            })
+    }
+
+    fn write(&mut self, index: usize, frame: Encoded) -> Result<(), RenderError> {
+        let data = frame.into_bytes(&self.path)?;
+        let mut control = [0u8; 26];
+        control[..4].copy_from_slice(&self.sequence.to_be_bytes());
+        control[4..8].copy_from_slice(&self.width.to_be_bytes());
+        control[8..12].copy_from_slice(&self.height.to_be_bytes());
+        // Bytes 12..20: offset (0, 0).
+        control[20..22].copy_from_slice(&self.delay.0.to_be_bytes());
+        control[22..24].copy_from_slice(&self.delay.1.to_be_bytes());
+        // Dispose op 0 (none), blend op 0 (source).
+        self.sequence += 1;
+        self.chunk(b"fcTL", &[&control])?;
+        for piece in data.chunks(APNG_CHUNK_DATA) {
+            if index == 0 {
+                self.chunk(b"IDAT", &[piece])?;
+            } else {
+                let sequence = self.sequence.to_be_bytes();
+                self.sequence += 1;
+                self.chunk(b"fdAT", &[&sequence, piece])?;
+            }
+        }
+        Ok(())
     }
 
     fn finish(mut self: Box<Self>) -> Result<(), RenderError> {
-        if let Some((writer, _)) = self.writer.take() {
-            writer
-                .finish()
-                .map_err(|error| png_error(&self.path, error))?;
-        }
-        self.replacement.commit(self.file)
+        self.chunk(b"IEND", &[])?;
+        let Self {
+            path,
+            out,
+            replacement,
+            ..
+        } = *self;
+        let file = out
+            .into_inner()
+            .map_err(|error| write_error(&path)(error.into_error()))?;
+        replacement.commit(file)
     }
+}
+
+/// 16-bit samples as PNG stores them, big-endian.
+fn big_endian(samples: &[u16]) -> Vec<u8> {
+    let mut bytes = vec![0; 2 * samples.len()];
+    for (pair, sample) in bytes.chunks_exact_mut(2).zip(samples) {
+        pair.copy_from_slice(&sample.to_be_bytes());
+    }
+    bytes
+}
+
+/// The image data of a PNG file: its `IDAT` chunks' data, joined (one zlib stream);
+/// `None` if it has none or its chunks do not add up.
+fn idat_data(png: &[u8]) -> Option<Vec<u8>> {
+    let mut rest = png.get(8..)?;
+    let mut data = Vec::new();
+    while rest.len() >= 12 {
+        let length = u32::from_be_bytes(rest[..4].try_into().ok()?) as usize;
+        let kind = &rest[4..8];
+        let body = rest.get(8..8 + length)?;
+        if kind == b"IDAT" {
+            data.extend_from_slice(body);
+        }
+        rest = rest.get(12 + length..)?;
+    }
+    (!data.is_empty()).then_some(data)
 }
 
 /// A `png` encoding error as a [`RenderError`] for `path`.
@@ -529,8 +713,6 @@ struct WebpSink {
     out: BufWriter<File>,
     /// Bytes after the RIFF header's size field so far (the RIFF size).
     riff_size: u64,
-    /// One frame's encoding.
-    scratch: Vec<u8>,
     replacement: Replacement,
 }
 
@@ -568,17 +750,16 @@ impl WebpSink {
             fps,
             out,
             riff_size: header.len() as u64 - 8,
-            scratch: Vec::new(),
             replacement,
         })
     }
 }
 
 impl FrameSink for WebpSink {
-    fn push(&mut self, index: usize, frame: &Picture) -> Result<(), RenderError> {
+    fn encode(&self, _index: usize, frame: &Picture) -> Result<Encoded, RenderError> {
         let rgba = frame.to_rgba8();
-        self.scratch.clear();
-        image_webp::WebPEncoder::new(&mut self.scratch)
+        let mut file = Vec::new();
+        image_webp::WebPEncoder::new(&mut file)
             .encode(
                 rgba.as_raw(),
                 self.width,
@@ -594,15 +775,19 @@ impl FrameSink for WebpSink {
             })?;
         // The encoder writes a simple file: RIFF, size, WEBP, then the VP8L chunk
         // (header, data, padding to an even length), which is what ANMF wraps.
-        let vp8l = match self.scratch.get(12..) {
-            Some(chunk) if self.scratch.starts_with(b"RIFF") && chunk.starts_with(b"VP8L") => chunk,
-            _ => {
-                return Err(RenderError::Encode {
-                    path: self.path.clone(),
-                    detail: "the WebP encoder wrote no VP8L chunk".to_owned(),
-                });
-            }
-        };
+        if file.starts_with(b"RIFF") && file.get(12..).is_some_and(|c| c.starts_with(b"VP8L")) {
+            file.drain(..12);
+            Ok(Encoded::Bytes(file))
+        } else {
+            Err(RenderError::Encode {
+                path: self.path.clone(),
+                detail: "the WebP encoder wrote no VP8L chunk".to_owned(),
+            })
+        }
+    }
+
+    fn write(&mut self, index: usize, frame: Encoded) -> Result<(), RenderError> {
+        let vp8l = frame.into_bytes(&self.path)?;
         let anmf_size = 16 + vp8l.len() as u64;
         self.riff_size += 8 + anmf_size;
         if self.riff_size > u64::from(u32::MAX) {
@@ -625,7 +810,7 @@ impl FrameSink for WebpSink {
         header[23] = ANMF_NO_BLEND;
         let write = write_error(&self.path);
         self.out.write_all(&header).map_err(&write)?;
-        self.out.write_all(vp8l).map_err(&write)
+        self.out.write_all(&vp8l).map_err(&write)
     }
 
     fn finish(self: Box<Self>) -> Result<(), RenderError> {
@@ -659,6 +844,13 @@ fn u24(value: u32) -> [u8; 3] {
 /// The NeuQuant sampling factor for frames of more than 255 colours (1 is best and
 /// slowest, 30 fastest; 10 is the gif crate's choice).
 const GIF_QUANTIZER_SPEED: i32 = 10;
+/// The most opaque pixels of a frame NeuQuant learns its palette from (evenly spaced;
+/// with [`GIF_QUANTIZER_SPEED`], it visits a tenth of them).
+const GIF_LEARNING_PIXELS: usize = 1 << 18;
+/// Bits a channel of the cells of the colour cube whose centres are matched to the
+/// palette (a pixel is at most 2 levels a channel from its cell's centre, well within
+/// a 255-colour palette's own error).
+const GIF_CELL_BITS: u32 = 6;
 
 /// GIF through the `gif` crate: a palette per frame, every frame full size and
 /// disposed to the background (transparent) so that transparent pixels show
@@ -695,11 +887,11 @@ impl GifSink {
 }
 
 impl FrameSink for GifSink {
-    fn push(&mut self, index: usize, frame: &Picture) -> Result<(), RenderError> {
+    fn encode(&self, index: usize, frame: &Picture) -> Result<Encoded, RenderError> {
         let rgba = frame.to_rgba8();
         let (palette, indices, transparent) = quantize(&rgba);
         let (width, height) = rgba.dimensions();
-        let gif_frame = gif::Frame {
+        let mut gif_frame = gif::Frame {
             delay: frame_ticks(index, self.fps, 100.0, u32::from(u16::MAX)) as u16,
             dispose: gif::DisposalMethod::Background,
             transparent: Some(transparent),
@@ -709,8 +901,19 @@ impl FrameSink for GifSink {
             buffer: Cow::Owned(indices),
             ..gif::Frame::default()
         };
+        gif_frame.make_lzw_pre_encoded();
+        Ok(Encoded::Gif(gif_frame))
+    }
+
+    fn write(&mut self, _index: usize, frame: Encoded) -> Result<(), RenderError> {
+        let Encoded::Gif(frame) = frame else {
+            return Err(RenderError::Encode {
+                path: self.path.clone(),
+                detail: "another format's frame was handed to the GIF writer".to_owned(),
+            });
+        };
         self.encoder
-            .write_frame(&gif_frame)
+            .write_lzw_pre_encoded_frame(&frame)
             .map_err(|error| gif_error(&self.path, error))
     }
 
@@ -745,7 +948,8 @@ fn gif_error(path: &Path, error: gif::EncodingError) -> RenderError {
 /// A GIF frame's palette (RGB triples), pixel indices and transparent index.
 /// Pixels with alpha below 128 are transparent (the last palette entry), the
 /// others opaque: up to 255 distinct opaque colours keep an exact palette, more
-/// are reduced to 255 by NeuQuant.
+/// are reduced to 255 by NeuQuant (learnt from at most [`GIF_LEARNING_PIXELS`]
+/// of them), each pixel taking the entry nearest its cell of the colour cube.
 fn quantize(image: &RgbaImage) -> (Vec<u8>, Vec<u8>, u8) {
     let pixels = image.as_raw();
     let opaque = |p: &[u8]| p[3] >= 128;
@@ -782,9 +986,13 @@ fn quantize(image: &RgbaImage) -> (Vec<u8>, Vec<u8>, u8) {
             .collect();
         return (palette, indices, transparent);
     }
+    // NeuQuant learns from at most `GIF_LEARNING_PIXELS` opaque pixels, evenly spaced.
+    let count = pixels.chunks_exact(4).filter(|p| opaque(p)).count();
+    let stride = count.div_ceil(GIF_LEARNING_PIXELS).max(1);
     let samples: Vec<u8> = pixels
         .chunks_exact(4)
         .filter(|p| opaque(p))
+        .step_by(stride)
         .flat_map(|p| [p[0], p[1], p[2], 255])
         .collect();
     let quantizer = color_quant::NeuQuant::new(GIF_QUANTIZER_SPEED, 255, &samples);
@@ -792,11 +1000,42 @@ fn quantize(image: &RgbaImage) -> (Vec<u8>, Vec<u8>, u8) {
     palette.truncate(255 * 3);
     let transparent = (palette.len() / 3) as u8;
     palette.extend_from_slice(&[0, 0, 0]);
+    // Each pixel takes the palette entry nearest the centre of its cell of the colour
+    // cube (`GIF_CELL_BITS` bits a channel), looked up once per cell in use.
+    let cell = |p: &[u8]| {
+        let shift = 8 - GIF_CELL_BITS;
+        (usize::from(p[0] >> shift) << (2 * GIF_CELL_BITS))
+            | (usize::from(p[1] >> shift) << GIF_CELL_BITS)
+            | usize::from(p[2] >> shift)
+    };
+    let mut used = vec![false; 1 << (3 * GIF_CELL_BITS)];
+    for p in pixels.chunks_exact(4).filter(|p| opaque(p)) {
+        used[cell(p)] = true;
+    }
+    let mask = (1 << GIF_CELL_BITS) - 1;
+    let centre = |c: usize| ((c & mask) << (8 - GIF_CELL_BITS) | (1 << (7 - GIF_CELL_BITS))) as u8;
+    let table: Vec<u8> = used
+        .par_iter()
+        .enumerate()
+        .map(|(c, &used)| {
+            if used {
+                let rgba = [
+                    centre(c >> (2 * GIF_CELL_BITS)),
+                    centre(c >> GIF_CELL_BITS),
+                    centre(c),
+                    255,
+                ];
+                quantizer.index_of(&rgba) as u8
+            } else {
+                transparent
+            }
+        })
+        .collect();
     let indices = pixels
         .par_chunks_exact(4)
         .map(|p| {
             if opaque(p) {
-                quantizer.index_of(&[p[0], p[1], p[2], 255]) as u8
+                table[cell(p)]
             } else {
                 transparent
             }
@@ -978,10 +1217,17 @@ fn create_dir(dir: &Path) -> Result<bool, RenderError> {
 }
 
 impl FrameSink for SequenceSink {
-    fn push(&mut self, index: usize, frame: &Picture) -> Result<(), RenderError> {
+    fn encode(&self, index: usize, frame: &Picture) -> Result<Encoded, RenderError> {
+        let mut png = Vec::new();
+        write_png(&mut png, frame, &self.dir.join(self.frame_name(index)))?;
+        Ok(Encoded::Bytes(png))
+    }
+
+    fn write(&mut self, index: usize, frame: Encoded) -> Result<(), RenderError> {
         let path = self.dir.join(self.frame_name(index));
+        let png = frame.into_bytes(&path)?;
         let (replacement, mut file) = Replacement::begin(&path)?;
-        write_png(&mut file, frame, &path)?;
+        file.write_all(&png).map_err(write_error(&path))?;
         replacement.seal(file)?;
         self.written.push(replacement);
         Ok(())

@@ -185,6 +185,111 @@ fn apng_16_bit_round_trip_is_exact() {
     }
 }
 
+/// Frames of 16-bit noise too big for one chunk of image data (the low bytes do
+/// not compress), so each frame spans several `fdAT` chunks.
+#[test]
+fn apng_16_bit_frames_of_many_chunks_round_trip_exactly() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("noise.png");
+    let (width, height) = (420, 360);
+    let frames: Vec<Picture> = (0..3u64)
+        .map(|seed| {
+            let mut random = support::Rng::new(seed + 5);
+            Picture::from(Rgba16Image::from_fn(width, height, |_, _| {
+                let v = random.next_u64();
+                Rgba([
+                    v as u16,
+                    (v >> 16) as u16,
+                    (v >> 32) as u16,
+                    (v >> 48) as u16 | 1,
+                ])
+            }))
+        })
+        .collect();
+    write(&path, AnimationFormat::Apng, &frames).expect("write");
+    assert!(fs::metadata(&path).expect("written").len() > 3 << 20);
+    let mut reader = png::Decoder::new(BufReader::new(File::open(&path).expect("open")))
+        .read_info()
+        .expect("png header");
+    let mut buffer = vec![0; reader.output_buffer_size().expect("size")];
+    for picture in &frames {
+        let output = reader.next_frame(&mut buffer).expect("frame");
+        let samples: Vec<u16> = buffer[..output.buffer_size()]
+            .chunks_exact(2)
+            .map(|b| u16::from_be_bytes([b[0], b[1]]))
+            .collect();
+        let Picture::Rgba16(expected) = picture else {
+            panic!("16-bit frames")
+        };
+        assert!(samples == *expected.as_raw());
+    }
+}
+
+/// Frames pushed a run at a time (encoded side by side) make the same file, byte for
+/// byte, as frames pushed one by one, in every format.
+#[test]
+fn pushing_runs_of_frames_writes_what_pushing_each_writes() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let mut eight = random_frames(12, 7);
+    eight.extend(random_frames(12, 7).into_iter().rev());
+    let mut sixteen = frames16(12, 7);
+    sixteen.extend(frames16(12, 7).into_iter().rev());
+    for (name, frames) in [
+        ("walk.png", &eight),
+        ("deep.png", &sixteen),
+        ("walk.webp", &eight),
+        ("walk.gif", &eight),
+        ("walk/", &sixteen),
+    ] {
+        let one = dir.path().join("one").join(name);
+        let runs = dir.path().join("runs").join(name);
+        for path in [&one, &runs] {
+            fs::create_dir_all(path.parent().expect("parent")).expect("folder");
+        }
+        write(
+            &one,
+            AnimationFormat::from_path(&one).expect("format"),
+            frames,
+        )
+        .expect("write");
+        let format = AnimationFormat::from_path(&runs).expect("format");
+        let mut writer =
+            AnimationWriter::create(&runs, format, 12, 7, frames.len(), FPS).expect("created");
+        writer.push_all(&frames[..4]).expect("four");
+        writer.push(&frames[4]).expect("one");
+        writer.push_all(&frames[5..]).expect("the rest");
+        writer.finish().expect("finished");
+        let bytes = |path: &Path| -> Vec<Vec<u8>> {
+            if path.is_dir() {
+                listing(path)
+                    .iter()
+                    .map(|name| fs::read(path.join(name)).expect("read"))
+                    .collect()
+            } else {
+                vec![fs::read(path).expect("read")]
+            }
+        };
+        assert!(bytes(&one) == bytes(&runs), "{name}");
+    }
+}
+
+/// A run that would take the animation past its frame count is refused whole, and
+/// the animation goes on.
+#[test]
+fn a_run_of_too_many_frames_is_refused() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("walk.png");
+    let frames = random_frames(8, 8);
+    let mut writer =
+        AnimationWriter::create(&path, AnimationFormat::Apng, 8, 8, 3, FPS).expect("created");
+    writer.push(&frames[0]).expect("one");
+    let error = writer.push_all(&frames).expect_err("four of three");
+    assert!(error.to_string().contains("one too many"), "{error}");
+    writer.push_all(&frames[1..]).expect("the rest");
+    writer.finish().expect("finished");
+    assert_eq!(decode_apng(&path).len(), 3);
+}
+
 #[test]
 fn apng_of_one_frame_is_a_png() {
     let dir = tempfile::tempdir().expect("tempdir");
@@ -297,6 +402,35 @@ fn gif_quantises_many_colours() {
         // NeuQuant without dithering, learning from few pixels.
         assert!(mean < 10.0, "mean error {mean}");
     }
+}
+
+/// A frame with more opaque pixels than NeuQuant learns from, in smooth gradients
+/// with noise (a photograph's colours): the palette still fits it closely.
+#[test]
+fn gif_of_a_large_photograph_stays_close() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("photo.gif");
+    let mut random = support::Rng::new(3);
+    let photo = RgbaImage::from_fn(640, 480, |x, y| {
+        let (x, y) = (x as f32, y as f32);
+        let noise = |random: &mut support::Rng| random.range(-4.0, 4.0);
+        Rgba([
+            (128.0 + 90.0 * (x / 97.0).sin() + noise(&mut random)) as u8,
+            (128.0 + 90.0 * ((x + y) / 151.0).sin() + noise(&mut random)) as u8,
+            (100.0 + 80.0 * (x / 31.0).cos() * (y / 47.0).sin() + noise(&mut random)) as u8,
+            255,
+        ])
+    });
+    let frame = Picture::from(photo.clone());
+    write(&path, AnimationFormat::Gif, std::slice::from_ref(&frame)).expect("write");
+    let decoded = decode_gif(&path);
+    let mut error = 0u64;
+    for (got, want) in decoded[0].buffer().pixels().zip(photo.pixels()) {
+        assert_eq!(got[3], 255);
+        error += (0..3).map(|c| got[c].abs_diff(want[c]) as u64).sum::<u64>();
+    }
+    let mean = error as f64 / (3 * photo.len() / 4) as f64;
+    assert!(mean < 6.0, "mean error {mean}");
 }
 
 #[test]
