@@ -130,6 +130,95 @@ fn a_layered_file_at_rest_renders_as_its_layers_flattened() {
     }
 }
 
+/// `render --layers OUT.ora` writes each layer warped on its own: the file another
+/// program wrote, posed, comes back with its layers' names, order, opacity and
+/// visibility, and those layers flattened are the picture `-o` writes.
+#[test]
+fn render_writes_the_warped_layers_as_openraster() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let rig = dir.path().join("pose.json");
+    fs::write(
+        &rig,
+        r#"{"version":1,"handles":[{"type":"point","rest":[34,8]},{"type":"point","rest":[30,25],"translate":[6,3]}]}"#,
+    )
+    .expect("write rig");
+    let (png, ora) = (dir.path().join("posed.png"), dir.path().join("posed.ora"));
+    let source = layered("krita-like.ora");
+    ok(&render_args(
+        &source,
+        &rig,
+        &png,
+        &["--layers", ora.to_str().expect("a path")],
+    ));
+    let limits = render::ImageLimits::default();
+    let before = layers::load(&source, &limits).expect("the source");
+    let after = layers::load(&ora, &limits).expect("the written layers");
+    assert_eq!((after.width, after.height), (before.width, before.height));
+    let describe = |artwork: &layers::Artwork| -> Vec<(String, bool, f32)> {
+        artwork
+            .layers
+            .iter()
+            .map(|l| (l.name.clone(), l.visible, l.opacity))
+            .collect()
+    };
+    assert_eq!(describe(&after), describe(&before));
+    // A hidden layer is not meshed: it is kept as it was, nothing of it lost.
+    for (kept, was) in after.layers.iter().zip(&before.layers) {
+        if !was.visible {
+            assert_eq!((kept.x, kept.y), (was.x, was.y));
+            assert!(kept.pixels == was.pixels, "{}", was.name);
+        }
+    }
+    let warped = load(&png);
+    let (worst, share) = difference(
+        &premultiplied(&after.flatten().into_rgba8()),
+        &premultiplied(&warped),
+        1,
+    );
+    assert_eq!(share, 0.0, "largest difference {worst}");
+    // Each layer moved: the pose is in every visible layer, not only the composite.
+    let (_, moved) = difference(&warped, &premultiplied(&before.flatten().into_rgba8()), 8);
+    assert!(moved > 0.01, "the pose moved almost nothing ({moved})");
+    // `--layers` alone; a flat picture is one layer.
+    let alone = dir.path().join("flat.ora");
+    ok(&[
+        os("render"),
+        data("dino.png").as_os_str(),
+        os("--rig"),
+        data("dino-rig.json").as_os_str(),
+        os("--layers"),
+        alone.as_os_str(),
+    ]);
+    let flat = layers::load(&alone, &limits).expect("one layer");
+    assert_eq!(flat.layers.len(), 1);
+    let golden = load(&data("dino-warped.png"));
+    let (_, share) = difference(&flat.flatten().into_rgba8(), &golden, 8);
+    assert!(share < 0.002, "{share}");
+}
+
+#[test]
+fn render_refuses_layers_it_cannot_write() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let (image, rig) = (data("dino.png"), data("dino-rig.json"));
+    let png = dir.path().join("out.png");
+    let line = fails(&render_args(
+        &image,
+        &rig,
+        &png,
+        &["--layers", png.to_str().expect("a path")],
+    ));
+    assert!(line.contains("OUT.ora"), "{line}");
+    let ora = dir.path().join("out.ora");
+    let line = fails(&render_args(
+        &image,
+        &rig,
+        &ora,
+        &["--layers", ora.to_str().expect("a path")],
+    ));
+    assert!(line.contains("different files"), "{line}");
+    assert!(!ora.exists() && !png.exists());
+}
+
 #[test]
 fn weights_from_a_mesh_are_a_partition_of_unity_that_interpolates() {
     let dir = tempfile::tempdir().expect("temp dir");

@@ -55,8 +55,14 @@ enum Command {
         /// Where to write the PNG (`-`: standard output). A file is replaced
         /// atomically (never one of the inputs); a device or FIFO is written to; a
         /// symbolic link's target is written.
-        #[arg(short, long)]
-        output: PathBuf,
+        #[arg(short, long, required_unless_present = "layers")]
+        output: Option<PathBuf>,
+        /// Also (or instead) write OUT.ora: an OpenRaster file with each layer of the
+        /// picture warped on a layer of its own, in its order, with its name, opacity
+        /// and visibility (a flat picture gives one layer), drawn on the CPU. Krita
+        /// and GIMP open it; replaced atomically like the PNG.
+        #[arg(long, value_name = "OUT.ora")]
+        layers: Option<PathBuf>,
         /// Target number of mesh vertices (overrides the rig's `density`).
         #[arg(long, allow_negative_numbers = true, value_parser = flags::density)]
         density: Option<usize>,
@@ -351,6 +357,7 @@ fn run(command: Command) -> Result<()> {
             input,
             rig,
             output,
+            layers,
             density,
             gpu,
             method,
@@ -358,7 +365,10 @@ fn run(command: Command) -> Result<()> {
         } => render(
             &input,
             rig.as_deref(),
-            &output,
+            Outputs {
+                png: output.as_deref(),
+                layers: layers.as_deref(),
+            },
             density,
             gpu,
             method,
@@ -470,36 +480,101 @@ fn project_and_picture(first: &Path, rig: Option<&Path>) -> Result<(PathBuf, Pro
     Ok((first.to_path_buf(), project, picture))
 }
 
+/// What `render` writes: the warped picture, its layers, or both.
+#[derive(Clone, Copy)]
+struct Outputs<'a> {
+    /// The PNG (`-`: standard output).
+    png: Option<&'a Path>,
+    /// The OpenRaster file of warped layers.
+    layers: Option<&'a Path>,
+}
+
 fn render(
     input: &Path,
     rig: Option<&Path>,
-    output: &Path,
+    outputs: Outputs,
     density: Option<usize>,
     gpu: bool,
     method: Option<Method>,
     canvas: Option<project::Canvas>,
 ) -> Result<()> {
     let (rig, mut project, image) = project_and_picture(input, rig)?;
-    render::refuse_input_as_output(output, &[&image, &rig])?;
+    for output in [outputs.png, outputs.layers].into_iter().flatten() {
+        render::refuse_input_as_output(output, &[&image, &rig])?;
+    }
+    if let Some(layers) = outputs.layers {
+        let is_ora = layers
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("ora"));
+        if !is_ora {
+            bail!(
+                "--layers writes OpenRaster: name the file OUT.ora, not {}",
+                layers.display()
+            );
+        }
+        if outputs.png.is_some_and(|png| same_file_name(png, layers)) {
+            bail!(
+                "-o and --layers both name {}: give them different files",
+                layers.display()
+            );
+        }
+    }
     if let Some(method) = method {
         project.method = method;
     }
     if let Some(canvas) = canvas {
         project.canvas = canvas;
     }
-    let picture = load_flattened(&image)?;
-    warp_and_save(&picture, &project, density, output, gpu)?;
+    let artwork = load_artwork_noting(&image)?;
+    let picture = artwork.flatten();
+    let steps = 1 + 2 * u64::from(outputs.png.is_some()) + u64::from(outputs.layers.is_some());
+    let progress = progress::Steps::new(steps);
+    progress.step("meshing and weighting");
+    let warper = {
+        let rgba8 = picture.to_rgba8();
+        pipeline::prepare_warper(&rgba8, &project, density, &progress)?
+    };
+    warn(&*warper.deformer);
+    if let Some(output) = outputs.png {
+        progress.step("rendering");
+        let warped = if gpu {
+            Picture::Rgba8(pipeline::warp_gpu(&picture.to_rgba8(), &warper)?)
+        } else {
+            pipeline::warp_picture(&picture, &warper)?
+        };
+        progress.step("writing");
+        write_png(output, &warped)?;
+    }
+    if let Some(output) = outputs.layers {
+        progress.step("rendering and writing the layers");
+        let warped = pipeline::warp_layers(&artwork, &warper)?;
+        pipeline::write_ora(output, &warped)?;
+    }
+    progress.finish();
     Ok(())
+}
+
+/// Whether `a` and `b` name the same file by their paths as given (the files may not
+/// exist yet; [`render::refuse_input_as_output`] covers files that do).
+fn same_file_name(a: &Path, b: &Path) -> bool {
+    let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+    absolute(a) == absolute(b)
+}
+
+/// Reads a picture as [`pipeline::load_artwork`] does, saying on standard error what of
+/// a layered file is drawn otherwise than it asks.
+fn load_artwork_noting(path: &Path) -> Result<pipeline::Artwork> {
+    let artwork = pipeline::load_artwork(path)?;
+    for note in &artwork.notes {
+        eprintln!("note: {}: {note}", path.display());
+    }
+    Ok(artwork)
 }
 
 /// Reads a picture as [`pipeline::load_picture`] does, saying on standard error what of a
 /// layered file is drawn otherwise than it asks.
 pub(crate) fn load_flattened(path: &Path) -> Result<render::Picture> {
-    let artwork = pipeline::load_artwork(path)?;
-    for note in &artwork.notes {
-        eprintln!("note: {}: {note}", path.display());
-    }
-    Ok(artwork.flatten())
+    Ok(load_artwork_noting(path)?.flatten())
 }
 
 /// Meshes, weights, warps and writes `picture` by `project` (with its method), with a

@@ -22,6 +22,7 @@ use project::{Canvas, HandleSpec, MetricChoice, Middle, Project};
 use render::Picture;
 
 pub use arap::{ArapOptions, ArapRig, ArapTimes};
+pub use layers::{Artwork, write_ora};
 pub use mesh::Mesh;
 pub use method::{
     Backdrop, Controls, Deformer, Follow, Listener, Method, Output, SkinTable, Skinning,
@@ -915,6 +916,66 @@ pub fn warp_picture(picture: &Picture, warper: &Warper) -> Result<Picture> {
     let mut out = warper.backdrop(picture, frame)?;
     render::warp_picture_over(picture, &mesh, &mut out)?;
     Ok(out)
+}
+
+/// Each visible layer of `artwork` warped by the current pose on its own layer, as
+/// [`warp_picture`] draws the flattened picture: the layer is put on the canvas at its
+/// offset and drawn through the same warped mesh, in its own depth, into the same
+/// frame. Hidden layers are kept as they are (they are not meshed, so nothing warps
+/// them), at their place on the canvas. The result keeps the layers' order, names,
+/// opacity and visibility. Flattening it gives the warped flattened picture (exactly
+/// where triangles of the warped mesh do not overlap; where they fold over, each layer
+/// is drawn in the mesh's order on its own).
+///
+/// `warper` must be set up on `artwork`'s flattened picture (its mesh covers every
+/// visible pixel of every visible layer).
+///
+/// # Errors
+/// As [`warp_picture`], for any layer.
+pub fn warp_layers(artwork: &layers::Artwork, warper: &Warper) -> Result<layers::Artwork> {
+    let canvas = Frame {
+        origin: [0, 0],
+        width: artwork.width,
+        height: artwork.height,
+    };
+    let frame = Frame::new(
+        artwork.width,
+        artwork.height,
+        &warper.deformed()?,
+        warper.canvas,
+    )?;
+    let shift = |at: i32, origin: i64| i32::try_from(i64::from(at) - origin);
+    let mut warped = Vec::with_capacity(artwork.layers.len());
+    for layer in &artwork.layers {
+        let (x, y, pixels) = if layer.visible {
+            let on_canvas = placed(
+                &layer.pixels,
+                canvas,
+                [i64::from(layer.x), i64::from(layer.y)],
+            )?;
+            let pixels = warp_picture(&on_canvas, warper)
+                .with_context(|| format!("layer \"{}\"", layer.name))?;
+            (0, 0, pixels)
+        } else {
+            let x = shift(layer.x, frame.origin[0]).context("a layer far off the canvas")?;
+            let y = shift(layer.y, frame.origin[1]).context("a layer far off the canvas")?;
+            (x, y, layer.pixels.clone())
+        };
+        warped.push(layers::Layer {
+            name: layer.name.clone(),
+            x,
+            y,
+            opacity: layer.opacity,
+            visible: layer.visible,
+            pixels,
+        });
+    }
+    Ok(layers::Artwork {
+        width: frame.width,
+        height: frame.height,
+        layers: warped,
+        notes: Vec::new(),
+    })
 }
 
 /// The image warped by the current pose, at the image's full resolution, 8 bits per
