@@ -17,6 +17,8 @@ pub enum FileAction {
     SaveProject,
     /// Where to export the warped PNG.
     ExportPng,
+    /// Where to export the warped layers (OpenRaster).
+    ExportLayers,
     /// Where to export the animation (an animated PNG, WebP or GIF; for a PNG
     /// sequence, the folder is named after the file).
     ExportAnimation,
@@ -30,6 +32,7 @@ impl FileAction {
             Self::OpenProject => "Open project",
             Self::SaveProject => "Save project",
             Self::ExportPng => "Export warped PNG",
+            Self::ExportLayers => "Export warped layers",
             Self::ExportAnimation => "Export animation",
         }
     }
@@ -38,7 +41,7 @@ impl FileAction {
     pub fn writes(self) -> bool {
         matches!(
             self,
-            Self::SaveProject | Self::ExportPng | Self::ExportAnimation
+            Self::SaveProject | Self::ExportPng | Self::ExportLayers | Self::ExportAnimation
         )
     }
 
@@ -48,6 +51,7 @@ impl FileAction {
             Self::OpenImage => IMAGES,
             Self::OpenProject | Self::SaveProject => &["json"],
             Self::ExportPng => &["png"],
+            Self::ExportLayers => &["ora"],
             Self::ExportAnimation => &["png", "webp", "gif"],
         }
     }
@@ -109,6 +113,7 @@ impl Dialogs for NativeDialogs {
                 dialog.add_filter("C2Warp project", &["json"])
             }
             FileAction::ExportPng => dialog.add_filter("PNG", &["png"]),
+            FileAction::ExportLayers => dialog.add_filter("OpenRaster", &["ora"]),
             FileAction::ExportAnimation => dialog.add_filter("Animation", &["png", "webp", "gif"]),
         };
         let chosen = if action.writes() {

@@ -134,6 +134,9 @@ pub struct Document {
     /// The picture as its file has it when that has 16 bits per channel: exports are
     /// drawn from it, so they keep the depth.
     pub deep: Option<Arc<render::Picture>>,
+    /// The picture's layers, as its file has them (one for a flat picture; `None`
+    /// for the built-in picture): *Export layers…* warps each on its own.
+    pub layers: Option<Arc<pipeline::Artwork>>,
     /// Where the picture came from (`None`: the built-in picture).
     pub image_path: Option<PathBuf>,
     /// Where the project was last saved or loaded from.
@@ -199,6 +202,7 @@ impl Document {
             project,
             image,
             deep: None,
+            layers: None,
             image_path,
             project_path: None,
             picture_notes: Vec::new(),
@@ -296,7 +300,7 @@ impl Document {
         };
         let mut document =
             Self::from_picture(artwork.flatten(), Some(path.to_path_buf()), project)?;
-        document.picture_notes = artwork.notes;
+        document.take_layers(artwork);
         Ok(document)
     }
 
@@ -336,8 +340,15 @@ impl Document {
         let mut document = Self::from_picture(artwork.flatten(), Some(image_path), project)
             .with_context(|| format!("project {}", path.display()))?;
         document.project_path = Some(path.to_path_buf());
-        document.picture_notes = artwork.notes;
+        document.take_layers(artwork);
         Ok(document)
+    }
+
+    /// Keeps `artwork`, the layers the document's picture was flattened from, and
+    /// what its reading noted.
+    fn take_layers(&mut self, mut artwork: pipeline::Artwork) {
+        self.picture_notes = std::mem::take(&mut artwork.notes);
+        self.layers = Some(Arc::new(artwork));
     }
 
     /// The rig file as it stands (without virtual handles).

@@ -372,6 +372,17 @@ impl EditorApp {
                     self.export();
                 }
                 if ui
+                    .button("Export layers…")
+                    .on_hover_text(
+                        "Each layer of the picture warped on a layer of its own, as an \
+                         OpenRaster file (Krita and GIMP open it)",
+                    )
+                    .clicked()
+                {
+                    ui.close();
+                    self.export_layers();
+                }
+                if ui
                     .button("Export animation…")
                     .on_hover_text(
                         "The keys played as an animated PNG, WebP or GIF, or a PNG sequence, \

@@ -480,6 +480,51 @@ fn a_sixteen_bit_picture_exports_with_sixteen_bits() {
     assert_eq!(exported.to_rgba16(), deep);
 }
 
+/// *Export layers…* of a layered file written by another program: at rest, every
+/// layer comes back as it was (names, order, opacity, visibility, offsets, pixels), and
+/// the built-in picture exports as one layer.
+#[test]
+fn export_layers_writes_each_layer_on_its_own() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let source = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../layers/tests/data/krita-like.ora");
+    let mut h = editor_with(Box::new(NoDesktop), false);
+    h.state_mut().open_in_background(source.clone());
+    settle(&mut h);
+    let out = dir.path().join("layers.ora");
+    h.state_mut().export_layers_to(&out);
+    let read = |path: &std::path::Path| pipeline::load_artwork(path).expect("layers");
+    let (before, after) = (read(&source), read(&out));
+    assert_eq!(after.layers.len(), 4, "{:?}", h.state().message);
+    // What shows of a pixel: a fully transparent one's colour is not kept.
+    let shown = |layer: &pipeline::Layer| {
+        let mut pixels = layer.pixels.to_rgba8().into_owned();
+        for p in pixels.pixels_mut().filter(|p| p[3] == 0) {
+            *p = image::Rgba([0, 0, 0, 0]);
+        }
+        (
+            layer.name.clone(),
+            layer.x,
+            layer.y,
+            layer.opacity,
+            layer.visible,
+            pixels,
+        )
+    };
+    let described =
+        |artwork: &pipeline::Artwork| artwork.layers.iter().map(shown).collect::<Vec<_>>();
+    assert!(described(&after) == described(&before));
+    // The built-in picture in its pose: one layer, what *Export PNG…* writes.
+    let mut h = editor_with(Box::new(NoDesktop), false);
+    h.state_mut().export_layers_to(&out);
+    let flat = read(&out);
+    assert_eq!(flat.layers.len(), 1);
+    let png = dir.path().join("warped.png");
+    h.state_mut().export_to(&png);
+    let exported = image::open(&png).expect("the PNG").to_rgba8();
+    assert!(flat.flatten().into_rgba8() == exported);
+}
+
 #[test]
 fn a_fifo_or_a_device_is_refused_at_once() {
     let dir = tempfile::tempdir().expect("temp dir");

@@ -85,6 +85,7 @@ impl Dialogs for MonkeyDialogs {
             FileAction::OpenProject => &["project.json", "broken.json", "missing.json"],
             FileAction::SaveProject => &["project.json", "project.json", "no-folder/p.json"],
             FileAction::ExportPng => &["warped.png", "no-folder/w.png"],
+            FileAction::ExportLayers => &["warped.ora", "no-folder/w.ora", "small.png"],
             FileAction::ExportAnimation => &["anim.png", "anim.gif", "no-folder/a.webp"],
         };
         Answer::Chosen(self.dir.join(self.rng.pick(names)))

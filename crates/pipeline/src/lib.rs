@@ -22,7 +22,7 @@ use project::{Canvas, HandleSpec, MetricChoice, Middle, Project};
 use render::Picture;
 
 pub use arap::{ArapOptions, ArapRig, ArapTimes};
-pub use layers::{Artwork, write_ora};
+pub use layers::{Artwork, Layer, write_ora};
 pub use mesh::Mesh;
 pub use method::{
     Backdrop, Controls, Deformer, Follow, Listener, Method, Output, SkinTable, Skinning,

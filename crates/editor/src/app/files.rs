@@ -17,6 +17,7 @@ impl EditorApp {
         let suggested = match action {
             FileAction::SaveProject => self.suggested_name("json"),
             FileAction::ExportPng => self.suggested_name("warped.png"),
+            FileAction::ExportLayers => self.suggested_name("warped.ora"),
             FileAction::ExportAnimation => self.suggested_animation_name(),
             FileAction::OpenImage | FileAction::OpenProject => String::new(),
         };
@@ -66,6 +67,7 @@ impl EditorApp {
             FileAction::OpenImage | FileAction::OpenProject => self.request_open(path),
             FileAction::SaveProject => self.save_to(&path),
             FileAction::ExportPng => self.export_in_background(path),
+            FileAction::ExportLayers => self.export_layers_in_background(path),
             FileAction::ExportAnimation => self.export_animation_to(path),
         }
     }
@@ -139,6 +141,72 @@ impl EditorApp {
             return;
         };
         self.start_job(format!("Exporting {}", file_name(&path)), cancel, work);
+    }
+
+    /// Asks where to export the layers, then writes them.
+    pub fn export_layers(&mut self) {
+        self.ask_file(FileAction::ExportLayers);
+    }
+
+    /// Writes each layer of the picture warped on a layer of its own to `path` (an
+    /// OpenRaster file), atomically, now: what `c2warp render --layers` writes for the
+    /// saved project.
+    pub fn export_layers_to(&mut self, path: &Path) {
+        let Some(work) = self.export_layers_work(path.to_path_buf(), CancelFlag::default()) else {
+            return;
+        };
+        self.finish(work());
+    }
+
+    /// As [`EditorApp::export_layers_to`], on a worker thread.
+    pub fn export_layers_in_background(&mut self, path: PathBuf) {
+        let cancel = CancelFlag::default();
+        let Some(work) = self.export_layers_work(path.clone(), cancel.clone()) else {
+            return;
+        };
+        self.start_job(format!("Exporting {}", file_name(&path)), cancel, work);
+    }
+
+    /// The layers' export of the current document to `path`, ready to run anywhere; it
+    /// writes nothing once `cancel` is set.
+    pub(super) fn export_layers_work(
+        &mut self,
+        path: PathBuf,
+        cancel: CancelFlag,
+    ) -> Option<impl FnOnce() -> Outcome + Send + 'static> {
+        if let Err(e) = self.refuse_sources(&path) {
+            self.error(&e);
+            return None;
+        }
+        let doc = self.doc.as_ref()?;
+        let project = doc.project_for_saving(None);
+        let image = doc.image.clone();
+        let layers = doc.layers.clone().unwrap_or_else(|| {
+            let picture = match &doc.deep {
+                Some(deep) => deep.as_ref().clone(),
+                None => render::Picture::Rgba8(doc.image.as_ref().clone()),
+            };
+            Arc::new(pipeline::Artwork::from_picture("lizard", picture))
+        });
+        let cage = ExportSetup::of(doc, &project);
+        Some(move || {
+            let clock = Instant::now();
+            let result = (|| -> Result<()> {
+                let warper = cage.warper(&image, &project, &cancel)?;
+                let warped = pipeline::warp_layers(&layers, &warper)?;
+                if cancel.is_set() {
+                    anyhow::bail!("cancelled");
+                }
+                pipeline::write_ora(&path, &warped)?;
+                Ok(())
+            })()
+            .with_context(|| format!("cannot export {}", path.display()));
+            Outcome::Exported {
+                path,
+                result,
+                ms: clock.elapsed().as_secs_f64() * 1e3,
+            }
+        })
     }
 
     /// The export of the current document to `path`, ready to run anywhere; it writes

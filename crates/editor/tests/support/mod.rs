@@ -34,6 +34,7 @@ impl Dialogs for Scripted {
             FileAction::OpenImage => "lizard.png",
             FileAction::OpenProject | FileAction::SaveProject => "project.json",
             FileAction::ExportPng => "warped.png",
+            FileAction::ExportLayers => "warped.ora",
             FileAction::ExportAnimation => "animation.png",
         };
         Answer::Chosen(self.dir.join(name))
