@@ -17,6 +17,9 @@ pub struct Timeline {
     pub time: f64,
     /// Playing: since when, and from which time.
     pub(crate) playing: Option<(Instant, f64)>,
+    /// The pose shown is a frame of playback, not yet solved in full (see
+    /// [`crate::document::Document::play_time`]).
+    pub(crate) played: bool,
     /// Playback starts again at the first key after the last.
     pub looping: bool,
     /// Show the previous and next keys' pictures ghosted behind the current one.
@@ -46,6 +49,7 @@ impl Default for Timeline {
             pressed_at: None,
             time: 0.0,
             playing: None,
+            played: false,
             looping: true,
             onion: false,
             clipboard: None,

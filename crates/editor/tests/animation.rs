@@ -329,6 +329,31 @@ fn every_handle_method_shows_its_own_answer_between_keys() {
         .expect("the method")
         .deformed();
         assert_eq!(shown, fresh, "{label}");
+        // Played (live frames, as a drag's) and paused: what shows is again the
+        // method's answer set up afresh for the time shown.
+        h.key_press(Key::Space);
+        h.step();
+        std::thread::sleep(std::time::Duration::from_millis(80));
+        h.step();
+        assert!(h.state().timeline.is_playing(), "{label}");
+        h.key_press(Key::Space);
+        h.run();
+        let time = h.state().timeline.time;
+        let doc = h.state().document().expect("doc");
+        let project = doc.project().clone();
+        assert_eq!(
+            Pose::of(&project),
+            animation::pose_at(&project, time).expect("a pose"),
+            "{label}"
+        );
+        let fresh = pipeline::on_handles(
+            &animation::posed_at(&project, time),
+            doc.rig().clone(),
+            Some(&doc.image),
+        )
+        .expect("the method")
+        .deformed();
+        assert_eq!(doc.deformer().deformed(), fresh, "{label} after playback");
     }
 }
 

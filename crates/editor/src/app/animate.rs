@@ -45,6 +45,20 @@ impl EditorApp {
         }
     }
 
+    /// Shows the keys' pose at the timeline's time as a frame of playback (live; solved
+    /// in full when playback stops).
+    fn play_current_time(&mut self) {
+        let time = self.timeline.time;
+        let Some(doc) = &mut self.doc else { return };
+        match doc.play_time(time) {
+            Ok(_) => self.timeline.played = true,
+            Err(e) => {
+                self.timeline.playing = None;
+                self.error(&e.context(format!("the pose at {time:.2} s")));
+            }
+        }
+    }
+
     /// Starts or pauses playback (from the start when at or after the last key).
     pub fn toggle_play(&mut self) {
         if self.timeline.playing.is_some() {
@@ -97,6 +111,16 @@ impl EditorApp {
         if self.is_busy() {
             self.timeline.playing = None;
         }
+        if self.timeline.played && self.timeline.playing.is_none() {
+            // Playback stopped (however it did): the pose shown is solved in full, as a
+            // file of it renders.
+            self.timeline.played = false;
+            if let Some(doc) = &mut self.doc
+                && let Err(e) = doc.settle()
+            {
+                self.error(&e);
+            }
+        }
         if let Some((since, from)) = self.timeline.playing {
             let keys = self.keys();
             let (first, last) = match (keys.first(), keys.last()) {
@@ -117,7 +141,7 @@ impl EditorApp {
             }
             // Unsnapped: playback shows every instant the screen can.
             self.timeline.time = time;
-            self.show_current_time();
+            self.play_current_time();
             ctx.request_repaint();
         }
         // A take samples each pose a drag shows (every frame of it, holding still too),

@@ -28,6 +28,27 @@ impl Document {
         self.show_pose(&pose)
     }
 
+    /// Shows the keys' pose at `time` as a frame of playback: live, as a drag's frame
+    /// is ([`Document::preview`]: a method that iterates to its answer starts from the
+    /// frame before and stops early), so that playback keeps up; [`Document::settle`]
+    /// solves the pose shown in full when playback stops. Returns whether the pose
+    /// changed.
+    ///
+    /// # Errors
+    /// As [`Document::show_time`].
+    pub fn play_time(&mut self, time: f64) -> Result<bool> {
+        let Some(pose) = animation::pose_at(&self.project, time) else {
+            return Ok(false);
+        };
+        if Pose::of(&self.project) == pose {
+            return Ok(false);
+        }
+        let mut project = self.project.clone();
+        pose.apply(&mut project);
+        self.preview(project)?;
+        Ok(true)
+    }
+
     /// Shows `pose` (a pose only, no undo step). Returns whether it changed.
     ///
     /// # Errors
