@@ -54,7 +54,7 @@ pub(crate) trait Texel: Copy + Default + PartialEq + Send + Sync + 'static {
 }
 
 impl Texel for u8 {
-    #[inline]
+    #[inline(always)]
     fn blend(taps: &[([u8; 4], u64); 4]) -> [u8; 4] {
         blend(taps)
     }
@@ -66,7 +66,7 @@ impl Texel for u8 {
 }
 
 impl Texel for u16 {
-    #[inline]
+    #[inline(always)]
     fn blend(taps: &[([u16; 4], u64); 4]) -> [u16; 4] {
         blend16(taps)
     }
@@ -173,7 +173,7 @@ fn to_u8(v: f32) -> u8 {
 
 /// Weighted premultiplied average of texels; the weights sum to
 /// `WEIGHT_ONE²`.
-#[inline]
+#[inline(always)]
 fn blend(taps: &[([u8; 4], u64); 4]) -> [u8; 4] {
     const SHIFT: u32 = 2 * WEIGHT_BITS;
     const HALF: u64 = 1 << (SHIFT - 1);
@@ -215,7 +215,7 @@ fn blend(taps: &[([u8; 4], u64); 4]) -> [u8; 4] {
 }
 
 /// [`blend`] for 16-bit channels.
-#[inline]
+#[inline(always)]
 fn blend16(taps: &[([u16; 4], u64); 4]) -> [u16; 4] {
     const SHIFT: u32 = 2 * WEIGHT_BITS;
     const HALF: u64 = 1 << (SHIFT - 1);
