@@ -21,6 +21,11 @@ use crate::fem::{Elements, Factor};
 /// by the tiny mass term: the divergence of any field sums to zero exactly). `φ` is
 /// shifted to zero at the source, negative values (rounding) clamped to zero.
 ///
+/// A mesh in pieces (a cage's inside cut through) has no path from a source to the
+/// pieces it does not lie in: there the distance is 1, the farthest, so that no
+/// coordinate reaches across (the heat never gets there, and the Poisson solve leaves
+/// an arbitrary constant).
+///
 /// # Errors
 /// [`LbcError::Factorization`] only on a bug.
 pub fn geodesic_distances(domain: &Domain) -> Result<Vec<Vec<f64>>, LbcError> {
@@ -78,17 +83,50 @@ pub fn geodesic_distances(domain: &Domain) -> Result<Vec<Vec<f64>>, LbcError> {
     )?;
     poisson.solve_in_place(phi.as_mut());
 
+    let piece = pieces(nv, triangles);
     Ok((0..n)
         .into_par_iter()
         .map(|i| {
             let source = domain.cage_vertices()[i] as usize;
             let at = phi[(source, i)];
+            let reached = |v: usize| piece[v] == piece[source];
             let mut d: Vec<f64> = (0..nv).map(|v| (phi[(v, i)] - at).max(0.0)).collect();
-            let max = d.iter().copied().fold(0.0, f64::max);
-            if max > 0.0 {
-                d.iter_mut().for_each(|x| *x /= max);
+            let max = (0..nv)
+                .filter(|&v| reached(v))
+                .map(|v| d[v])
+                .fold(0.0, f64::max);
+            for (v, x) in d.iter_mut().enumerate() {
+                *x = match (reached(v), max > 0.0) {
+                    (false, _) => 1.0,
+                    (true, true) => *x / max,
+                    (true, false) => *x,
+                };
             }
             d
         })
         .collect())
+}
+
+/// The connected piece of each of `nv` vertices (a representative vertex), joined
+/// through `triangles`.
+fn pieces(nv: usize, triangles: &[[u32; 3]]) -> Vec<u32> {
+    let mut parent: Vec<u32> = (0..nv as u32).collect();
+    fn root(parent: &mut [u32], mut v: u32) -> u32 {
+        while parent[v as usize] != v {
+            let up = parent[parent[v as usize] as usize];
+            parent[v as usize] = up;
+            v = up;
+        }
+        v
+    }
+    for t in triangles {
+        let a = root(&mut parent, t[0]);
+        for &w in &t[1..] {
+            let b = root(&mut parent, w);
+            if a != b {
+                parent[b as usize] = a;
+            }
+        }
+    }
+    (0..nv as u32).map(|v| root(&mut parent, v)).collect()
 }

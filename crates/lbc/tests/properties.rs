@@ -469,3 +469,59 @@ fn locality_statistics_of_a_triangle() {
     assert!(stats.q[2] > 0.9, "{:?}", stats.q);
     assert!(stats.q.windows(2).all(|w| w[0] >= w[1]), "{:?}", stats.q);
 }
+
+/// A cage's inside in two pieces (cut through, its vertices along the cut doubled):
+/// from a cage vertex, the piece it does not lie in is at distance 1, the farthest,
+/// and the distances in its own piece are as without the other.
+#[test]
+fn a_piece_out_of_reach_is_the_farthest() {
+    let cage = Cage::new(vec![
+        DVec2::new(0.0, 0.0),
+        DVec2::new(1.0, 0.0),
+        DVec2::new(2.0, 0.0),
+        DVec2::new(2.0, 1.0),
+        DVec2::new(1.0, 1.0),
+        DVec2::new(0.0, 1.0),
+    ])
+    .expect("a cage");
+    let positions = vec![
+        // The left square and its centre.
+        DVec2::new(0.0, 0.0),
+        DVec2::new(1.0, 0.0),
+        DVec2::new(1.0, 1.0),
+        DVec2::new(0.0, 1.0),
+        DVec2::new(0.5, 0.5),
+        // The right square, its own copies of the cut's ends, and its centre.
+        DVec2::new(1.0, 0.0),
+        DVec2::new(2.0, 0.0),
+        DVec2::new(2.0, 1.0),
+        DVec2::new(1.0, 1.0),
+        DVec2::new(1.5, 0.5),
+    ];
+    let triangles = vec![
+        [0, 1, 4],
+        [1, 2, 4],
+        [2, 3, 4],
+        [3, 0, 4],
+        [5, 6, 9],
+        [6, 7, 9],
+        [7, 8, 9],
+        [8, 5, 9],
+    ];
+    let domain = Domain::from_mesh(&cage, positions, triangles).expect("a mesh in two pieces");
+    let d = geodesic_distances(&domain).expect("geodesics");
+    // Cage vertex 2 is (2, 0), in the right piece; cage vertex 0, (0, 0), in the left.
+    for v in [0, 3, 4] {
+        assert_eq!(d[2][v], 1.0, "vertex {v} is out of reach of (2, 0)");
+        assert!(d[0][v] < 1.0 || v == 0 && d[0][v] == 0.0);
+    }
+    for v in [6, 7, 9] {
+        assert_eq!(d[0][v], 1.0, "vertex {v} is out of reach of (0, 0)");
+        assert!(d[2][v] < 1.0, "vertex {v}: {}", d[2][v]);
+    }
+    assert!(
+        d.iter()
+            .flatten()
+            .all(|x| x.is_finite() && (0.0..=1.0).contains(x))
+    );
+}

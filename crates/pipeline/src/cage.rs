@@ -80,7 +80,8 @@ pub fn solver_settings(tau: Tau) -> lbc::Settings {
 
 /// Where the mesh of the cage's inside comes from.
 pub enum CageMesh {
-    /// Triangulate the inside to about this many vertices.
+    /// Triangulate the inside to about this many vertices (split along the rig file's
+    /// cuts, if it has any: [`cut_inside`]).
     Triangulate {
         /// Target vertex count.
         target_vertices: usize,
@@ -149,7 +150,13 @@ pub fn cage_coordinates(
         CageMesh::Triangulate { target_vertices } => {
             let target = target_vertices.min(cage_vertex_cap(cage.area()));
             check_work(target, cage.len())?;
-            lbc::Domain::triangulate(&cage, target).context("cannot triangulate the cage")?
+            if project.cuts.is_empty() {
+                lbc::Domain::triangulate(&cage, target).context("cannot triangulate the cage")?
+            } else {
+                let (positions, triangles) = cut_inside(&cage, target, &project.cuts)?;
+                lbc::Domain::from_mesh(&cage, positions, triangles)
+                    .context("cannot mesh the cage along its cuts")?
+            }
         }
         CageMesh::Given {
             positions,
@@ -177,6 +184,52 @@ pub fn cage_coordinates(
         tau,
         pose,
     })
+}
+
+/// The inside of `cage` triangulated to about `target` vertices and split along `cuts`
+/// as a picture's mesh is ([`crate::mesh_picture`]): each stroke's parts inside the
+/// cage meshed as edges, then the vertices along them doubled, one copy per side
+/// ([`mesh::split_along`]), so that no distance and no coordinate crosses a cut and
+/// the two sides move apart where the cage pulls them apart. The cage's vertices are
+/// vertices of the mesh, at their positions.
+///
+/// # Errors
+/// A failure of the triangulator.
+pub fn cut_inside(
+    cage: &lbc::Cage,
+    target: usize,
+    cuts: &[project::Cut],
+) -> Result<(Vec<DVec2>, Vec<[u32; 3]>)> {
+    let outer = cage.vertices().to_vec();
+    let far = outer.iter().fold(DVec2::ZERO, |m, p| m.max(p.abs())).ceil();
+    let domain = mesh::Domain {
+        polygons: vec![mesh::Polygon {
+            outer,
+            holes: Vec::new(),
+        }],
+        is_full_rectangle: false,
+        width: far.x as u32,
+        height: far.y as u32,
+    };
+    let pieces: Vec<Vec<DVec2>> = cuts
+        .iter()
+        .flat_map(|cut| {
+            let stroke: Vec<DVec2> = cut.stroke.iter().map(|&p| DVec2::from(p)).collect();
+            mesh::clip_to_domain(&domain, &stroke)
+        })
+        .collect();
+    let options = mesh::MeshOptions {
+        target_vertices: target,
+        ..mesh::MeshOptions::default()
+    };
+    let constraints = mesh::Constraints {
+        points: &[],
+        polylines: &pieces,
+    };
+    let mut meshed = mesh::triangulate(&domain, &constraints, &options)
+        .context("cannot triangulate the cage along its cuts")?;
+    mesh::split_along(&mut meshed.mesh, &meshed.polyline_paths);
+    Ok((meshed.mesh.vertices, meshed.mesh.triangles))
 }
 
 /// LBC behind the method seam: a cage's solved coordinates and the cage's pose.

@@ -125,3 +125,74 @@ fn a_piece_cut_free_of_every_handle_stays_where_it_is_except_under_mls() {
         }
     }
 }
+
+/// Under LBC a cut splits the cage's inside too: cut through from one cage vertex to
+/// another, the inside is two pieces, each moved by its own cage vertices; the cut's
+/// vertices are doubled, and the copies part where the pieces move apart.
+#[test]
+fn a_cut_splits_the_inside_of_a_cage() {
+    let warped = |cuts: Vec<Cut>| {
+        let rest = vec![
+            [4.0, 4.0],
+            [60.0, 4.0],
+            [116.0, 16.0],
+            [116.0, 44.0],
+            [60.0, 56.0],
+            [4.0, 56.0],
+        ];
+        let mut pose = rest.clone();
+        pose[2][1] += 25.0;
+        pose[3][1] += 25.0;
+        let project = Project {
+            method: Method::Lbc,
+            cage: Some(project::CageSpec {
+                rest,
+                pose: Some(pose),
+            }),
+            lbc: Some(project::LbcSettings {
+                density: Some(1_500),
+                ..project::LbcSettings::default()
+            }),
+            cuts,
+            ..Project::default()
+        };
+        let warper = pipeline::prepare_warper(&touching(), &project, None, &())
+            .unwrap_or_else(|e| panic!("{}", pipeline::error_line(&e)));
+        let deformed = warper.deformer.deformed();
+        assert!(deformed.iter().all(|p| p.is_finite()));
+        (warper.deformer.rest().to_vec(), deformed)
+    };
+    // The largest distance between two vertices at the same rest position, and the
+    // largest move of a vertex left of the cut.
+    let measure = |(rest, deformed): (Vec<glam::DVec2>, Vec<glam::DVec2>)| {
+        let mut gap = 0.0f64;
+        let mut order: Vec<usize> = (0..rest.len()).collect();
+        order.sort_by(|&a, &b| {
+            rest[a]
+                .x
+                .total_cmp(&rest[b].x)
+                .then(rest[a].y.total_cmp(&rest[b].y))
+        });
+        for pair in order.windows(2) {
+            if rest[pair[0]] == rest[pair[1]] {
+                gap = gap.max(deformed[pair[0]].distance(deformed[pair[1]]));
+            }
+        }
+        let left = rest
+            .iter()
+            .zip(&deformed)
+            .filter(|(r, _)| r.x < 59.0)
+            .map(|(r, d)| r.distance(*d))
+            .fold(0.0, f64::max);
+        (gap, left)
+    };
+    let (joined_gap, joined_left) = measure(warped(Vec::new()));
+    let (cut_gap, cut_left) = measure(warped(across()));
+    assert_eq!(joined_gap, 0.0, "no vertex is doubled without a cut");
+    assert!(cut_gap > 0.5, "the cut opens ({cut_gap} px)");
+    // The left piece's cage vertices stay; what moves it is the solve's tolerance.
+    assert!(
+        cut_left < 1.5 && joined_left < 1.5,
+        "{joined_left} / {cut_left}"
+    );
+}

@@ -12,8 +12,9 @@ use project::{CageSpec, LbcSettings, Project, Tau};
 
 use super::Document;
 
-/// What a cage's coordinates are solved for: the rest cage, τ and the number of mesh
-/// vertices inside it (as `c2warp render` reads them from the rig file).
+/// What a cage's coordinates are solved for: the rest cage, τ, the number of mesh
+/// vertices inside it and the cuts it is split along (as `c2warp render` reads them
+/// from the rig file).
 #[derive(Clone, Debug, PartialEq)]
 pub struct CageKey {
     /// The rest cage, image pixels.
@@ -22,6 +23,8 @@ pub struct CageKey {
     pub tau: Tau,
     /// Target mesh vertices inside the cage.
     pub vertices: usize,
+    /// The rig file's cuts (the cage's inside is split along them).
+    pub cuts: Vec<project::Cut>,
 }
 
 impl CageKey {
@@ -32,6 +35,7 @@ impl CageKey {
             rest: cage.rest.clone(),
             tau: project.lbc.unwrap_or_default().tau,
             vertices: pipeline::cage::cage_vertices(project, None),
+            cuts: project.cuts.clone(),
         })
     }
 
@@ -71,6 +75,7 @@ pub fn solve_cage(
             tau: key.tau,
             density: Some(key.vertices),
         }),
+        cuts: key.cuts.clone(),
         ..Project::default()
     };
     let mesh = CageMesh::Triangulate {
