@@ -211,25 +211,13 @@ pub fn cut_inside(
         width: far.x as u32,
         height: far.y as u32,
     };
-    let pieces: Vec<Vec<DVec2>> = cuts
-        .iter()
-        .flat_map(|cut| {
-            let stroke: Vec<DVec2> = cut.stroke.iter().map(|&p| DVec2::from(p)).collect();
-            mesh::clip_to_domain(&domain, &stroke)
-        })
-        .collect();
     let options = mesh::MeshOptions {
         target_vertices: target,
         ..mesh::MeshOptions::default()
     };
-    let constraints = mesh::Constraints {
-        points: &[],
-        polylines: &pieces,
-    };
-    let mut meshed = mesh::triangulate(&domain, &constraints, &options)
+    let (mesh, _) = crate::mesh_along_cuts(&domain, &options, cuts)
         .context("cannot triangulate the cage along its cuts")?;
-    mesh::split_along(&mut meshed.mesh, &meshed.polyline_paths);
-    Ok((meshed.mesh.vertices, meshed.mesh.triangles))
+    Ok((mesh.vertices, mesh.triangles))
 }
 
 /// LBC behind the method seam: a cage's solved coordinates and the cage's pose.

@@ -153,18 +153,32 @@ pub fn mesh_picture(
     }
     let domain =
         mesh::domain_for_density(image, &DomainOptions::default(), options.target_vertices)?;
+    mesh_along_cuts(&domain, options, cuts)
+}
+
+/// `domain` meshed at `options` with each of `cuts`' parts inside it as edges, then
+/// split along them ([`mesh::split_along`]); and whether the result is convex (never
+/// with a cut inside).
+///
+/// # Errors
+/// A failure of the triangulator.
+pub(crate) fn mesh_along_cuts(
+    domain: &mesh::Domain,
+    options: &MeshOptions,
+    cuts: &[project::Cut],
+) -> Result<(Mesh, bool), mesh::MeshError> {
     let pieces: Vec<Vec<DVec2>> = cuts
         .iter()
         .flat_map(|cut| {
             let stroke: Vec<DVec2> = cut.stroke.iter().map(|&p| DVec2::from(p)).collect();
-            mesh::clip_to_domain(&domain, &stroke)
+            mesh::clip_to_domain(domain, &stroke)
         })
         .collect();
     let constraints = Constraints {
         points: &[],
         polylines: &pieces,
     };
-    let mut meshed = mesh::triangulate(&domain, &constraints, options)?;
+    let mut meshed = mesh::triangulate(domain, &constraints, options)?;
     mesh::split_along(&mut meshed.mesh, &meshed.polyline_paths);
     let convex = meshed.is_convex && pieces.is_empty();
     Ok((meshed.mesh, convex))

@@ -79,6 +79,18 @@ fn total_ms(frames: &[Frame]) -> f64 {
         .sum()
 }
 
+/// Whether the big-endian 16-bit samples `decoded` are those of `picture` (a 16-bit
+/// frame).
+fn is_frame(decoded: &[u8], picture: &Picture) -> bool {
+    let Picture::Rgba16(expected) = picture else {
+        panic!("16-bit frames")
+    };
+    decoded
+        .chunks_exact(2)
+        .map(|b| u16::from_be_bytes([b[0], b[1]]))
+        .eq(expected.as_raw().iter().copied())
+}
+
 fn decode_apng(path: &Path) -> Vec<Frame> {
     let file = BufReader::new(File::open(path).expect("open"));
     PngDecoder::new(file)
@@ -174,14 +186,7 @@ fn apng_16_bit_round_trip_is_exact() {
         assert_eq!((control.delay_num, control.delay_den), (1, 24));
         assert_eq!(control.blend_op, png::BlendOp::Source);
         assert_eq!(control.dispose_op, png::DisposeOp::None);
-        let samples: Vec<u16> = buffer[..output.buffer_size()]
-            .chunks_exact(2)
-            .map(|b| u16::from_be_bytes([b[0], b[1]]))
-            .collect();
-        let Picture::Rgba16(expected) = picture else {
-            panic!("16-bit frames")
-        };
-        assert_eq!(&samples, expected.as_raw());
+        assert!(is_frame(&buffer[..output.buffer_size()], picture));
     }
 }
 
@@ -214,14 +219,7 @@ fn apng_16_bit_frames_of_many_chunks_round_trip_exactly() {
     let mut buffer = vec![0; reader.output_buffer_size().expect("size")];
     for picture in &frames {
         let output = reader.next_frame(&mut buffer).expect("frame");
-        let samples: Vec<u16> = buffer[..output.buffer_size()]
-            .chunks_exact(2)
-            .map(|b| u16::from_be_bytes([b[0], b[1]]))
-            .collect();
-        let Picture::Rgba16(expected) = picture else {
-            panic!("16-bit frames")
-        };
-        assert!(samples == *expected.as_raw());
+        assert!(is_frame(&buffer[..output.buffer_size()], picture));
     }
 }
 

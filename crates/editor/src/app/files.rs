@@ -128,19 +128,12 @@ impl EditorApp {
     /// Writes the warped picture at full resolution to `path` atomically, now: the
     /// same pixels as `c2warp render` of the saved project.
     pub fn export_to(&mut self, path: &Path) {
-        let Some(work) = self.export_work(path.to_path_buf(), CancelFlag::default()) else {
-            return;
-        };
-        self.finish(work());
+        self.export_now(path, Export::Picture);
     }
 
     /// As [`EditorApp::export_to`], on a worker thread (the editor shows progress).
     pub fn export_in_background(&mut self, path: PathBuf) {
-        let cancel = CancelFlag::default();
-        let Some(work) = self.export_work(path.clone(), cancel.clone()) else {
-            return;
-        };
-        self.start_job(format!("Exporting {}", file_name(&path)), cancel, work);
+        self.export_on_worker(path, Export::Picture);
     }
 
     /// Asks where to export the layers, then writes them.
@@ -152,69 +145,34 @@ impl EditorApp {
     /// OpenRaster file), atomically, now: what `c2warp render --layers` writes for the
     /// saved project.
     pub fn export_layers_to(&mut self, path: &Path) {
-        let Some(work) = self.export_layers_work(path.to_path_buf(), CancelFlag::default()) else {
-            return;
-        };
-        self.finish(work());
+        self.export_now(path, Export::Layers);
     }
 
     /// As [`EditorApp::export_layers_to`], on a worker thread.
     pub fn export_layers_in_background(&mut self, path: PathBuf) {
-        let cancel = CancelFlag::default();
-        let Some(work) = self.export_layers_work(path.clone(), cancel.clone()) else {
-            return;
-        };
-        self.start_job(format!("Exporting {}", file_name(&path)), cancel, work);
+        self.export_on_worker(path, Export::Layers);
     }
 
-    /// The layers' export of the current document to `path`, ready to run anywhere; it
-    /// writes nothing once `cancel` is set.
-    pub(super) fn export_layers_work(
-        &mut self,
-        path: PathBuf,
-        cancel: CancelFlag,
-    ) -> Option<impl FnOnce() -> Outcome + Send + 'static> {
-        if let Err(e) = self.refuse_sources(&path) {
-            self.error(&e);
-            return None;
+    fn export_now(&mut self, path: &Path, what: Export) {
+        if let Some(work) = self.export_work(path.to_path_buf(), CancelFlag::default(), what) {
+            self.finish(work());
         }
-        let doc = self.doc.as_ref()?;
-        let project = doc.project_for_saving(None);
-        let image = doc.image.clone();
-        let layers = doc.layers.clone().unwrap_or_else(|| {
-            let picture = match &doc.deep {
-                Some(deep) => deep.as_ref().clone(),
-                None => render::Picture::Rgba8(doc.image.as_ref().clone()),
-            };
-            Arc::new(pipeline::Artwork::from_picture("lizard", picture))
-        });
-        let cage = ExportSetup::of(doc, &project);
-        Some(move || {
-            let clock = Instant::now();
-            let result = (|| -> Result<()> {
-                let warper = cage.warper(&image, &project, &cancel)?;
-                let warped = pipeline::warp_layers(&layers, &warper)?;
-                if cancel.is_set() {
-                    anyhow::bail!("cancelled");
-                }
-                pipeline::write_ora(&path, &warped)?;
-                Ok(())
-            })()
-            .with_context(|| format!("cannot export {}", path.display()));
-            Outcome::Exported {
-                path,
-                result,
-                ms: clock.elapsed().as_secs_f64() * 1e3,
-            }
-        })
     }
 
-    /// The export of the current document to `path`, ready to run anywhere; it writes
-    /// nothing once `cancel` is set.
+    fn export_on_worker(&mut self, path: PathBuf, what: Export) {
+        let cancel = CancelFlag::default();
+        if let Some(work) = self.export_work(path.clone(), cancel.clone(), what) {
+            self.start_job(format!("Exporting {}", file_name(&path)), cancel, work);
+        }
+    }
+
+    /// The export of the current document to `path` as `what`, ready to run anywhere;
+    /// it writes nothing once `cancel` is set.
     pub(super) fn export_work(
         &mut self,
         path: PathBuf,
         cancel: CancelFlag,
+        what: Export,
     ) -> Option<impl FnOnce() -> Outcome + Send + 'static> {
         if let Err(e) = self.refuse_sources(&path) {
             self.error(&e);
@@ -224,20 +182,34 @@ impl EditorApp {
         let project = doc.project_for_saving(None);
         let image = doc.image.clone();
         let deep = doc.deep.clone();
+        let layers = match what {
+            Export::Picture => None,
+            Export::Layers => Some(doc.layers.clone().unwrap_or_else(|| {
+                let picture = match &doc.deep {
+                    Some(deep) => deep.as_ref().clone(),
+                    None => render::Picture::Rgba8(doc.image.as_ref().clone()),
+                };
+                Arc::new(pipeline::Artwork::from_picture("lizard", picture))
+            })),
+        };
         let cage = ExportSetup::of(doc, &project);
         Some(move || {
             let clock = Instant::now();
             let result = (|| -> Result<()> {
                 let warper = cage.warper(&image, &project, &cancel)?;
-                // A 16-bit picture exports with 16 bits, as `c2warp render` does.
-                let warped = match &deep {
-                    Some(deep) => pipeline::warp_picture(deep, &warper)?,
-                    None => render::Picture::Rgba8(pipeline::warp(&image, &warper)?),
-                };
-                if cancel.is_set() {
-                    anyhow::bail!("cancelled");
+                if let Some(layers) = layers {
+                    let warped = pipeline::warp_layers(&layers, &warper)?;
+                    anyhow::ensure!(!cancel.is_set(), "cancelled");
+                    pipeline::write_ora(&path, &warped)?;
+                } else {
+                    // A 16-bit picture exports with 16 bits, as `c2warp render` does.
+                    let warped = match &deep {
+                        Some(deep) => pipeline::warp_picture(deep, &warper)?,
+                        None => render::Picture::Rgba8(pipeline::warp(&image, &warper)?),
+                    };
+                    anyhow::ensure!(!cancel.is_set(), "cancelled");
+                    render::save_png_atomic(&path, &warped)?;
                 }
-                render::save_png_atomic(&path, &warped)?;
                 Ok(())
             })()
             .with_context(|| format!("cannot export {}", path.display()));
@@ -274,6 +246,15 @@ impl EditorApp {
             format!("{stem}.{extension}")
         }
     }
+}
+
+/// What an export writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Export {
+    /// The warped picture, as a PNG.
+    Picture,
+    /// Each layer warped on its own, as OpenRaster.
+    Layers,
 }
 
 /// A path's file name, for messages.
