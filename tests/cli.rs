@@ -196,6 +196,54 @@ fn render_writes_the_warped_layers_as_openraster() {
     assert!(share < 0.002, "{share}");
 }
 
+/// With the canvas grown to fit the warp, the layers are drawn into the same grown
+/// frame as the PNG, and hidden layers keep their place on the picture.
+#[test]
+fn warped_layers_grow_with_the_canvas() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let rig = dir.path().join("fit.json");
+    // The body pulled up and left, past the canvas's corner.
+    fs::write(
+        &rig,
+        r#"{"version":1,"canvas":"fit","handles":[{"type":"point","rest":[60,35]},{"type":"point","rest":[30,20],"translate":[-40,-25]}]}"#,
+    )
+    .expect("write rig");
+    let (png, ora) = (dir.path().join("fit.png"), dir.path().join("fit.ora"));
+    let source = layered("krita-like.ora");
+    ok(&render_args(
+        &source,
+        &rig,
+        &png,
+        &["--layers", ora.to_str().expect("a path")],
+    ));
+    let limits = render::ImageLimits::default();
+    let before = layers::load(&source, &limits).expect("the source");
+    let after = layers::load(&ora, &limits).expect("the written layers");
+    let warped = load(&png);
+    assert_eq!((after.width, after.height), warped.dimensions());
+    assert!(after.width > before.width && after.height > before.height);
+    // Within rounding: each layer's edge pixels are filtered before its opacity is
+    // applied, the flattened picture's after.
+    let (worst, share) = difference(
+        &premultiplied(&after.flatten().into_rgba8()),
+        &premultiplied(&warped),
+        2,
+    );
+    assert_eq!(share, 0.0, "largest difference {worst}");
+    // The canvas grew left and up by as much as it grew (the warp went nowhere else),
+    // and the hidden layer moved with the picture's origin.
+    let (grown_x, grown_y) = (
+        (after.width - before.width) as i32,
+        (after.height - before.height) as i32,
+    );
+    for (kept, was) in after.layers.iter().zip(&before.layers) {
+        if !was.visible {
+            assert_eq!((kept.x, kept.y), (was.x + grown_x, was.y + grown_y));
+            assert!(kept.pixels == was.pixels);
+        }
+    }
+}
+
 #[test]
 fn render_refuses_layers_it_cannot_write() {
     let dir = tempfile::tempdir().expect("temp dir");
