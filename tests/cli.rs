@@ -130,29 +130,58 @@ fn a_layered_file_at_rest_renders_as_its_layers_flattened() {
     }
 }
 
-/// `render --layers OUT.ora` writes each layer warped on its own: the file another
-/// program wrote, posed, comes back with its layers' names, order, opacity and
-/// visibility, and those layers flattened are the picture `-o` writes.
-#[test]
-fn render_writes_the_warped_layers_as_openraster() {
+/// The Krita-like ORA rendered by the rig `rig` (JSON) with `-o` and `--layers`: the
+/// source's layers, the written layers and the PNG.
+fn render_layered(rig: &str) -> (layers::Artwork, layers::Artwork, image::RgbaImage) {
     let dir = tempfile::tempdir().expect("temp dir");
-    let rig = dir.path().join("pose.json");
-    fs::write(
-        &rig,
-        r#"{"version":1,"handles":[{"type":"point","rest":[34,8]},{"type":"point","rest":[30,25],"translate":[6,3]}]}"#,
-    )
-    .expect("write rig");
+    let rig_path = dir.path().join("pose.json");
+    fs::write(&rig_path, rig).expect("write rig");
     let (png, ora) = (dir.path().join("posed.png"), dir.path().join("posed.ora"));
     let source = layered("krita-like.ora");
     ok(&render_args(
         &source,
-        &rig,
+        &rig_path,
         &png,
         &["--layers", ora.to_str().expect("a path")],
     ));
     let limits = render::ImageLimits::default();
     let before = layers::load(&source, &limits).expect("the source");
     let after = layers::load(&ora, &limits).expect("the written layers");
+    (before, after, load(&png))
+}
+
+/// The written layers flattened are the PNG within `tolerance` levels (premultiplied),
+/// and each hidden layer is kept as it was, moved by `shift`.
+fn assert_layers_match(
+    before: &layers::Artwork,
+    after: &layers::Artwork,
+    warped: &image::RgbaImage,
+    tolerance: u8,
+    shift: (i32, i32),
+) {
+    let (worst, share) = difference(
+        &premultiplied(&after.flatten().into_rgba8()),
+        &premultiplied(warped),
+        tolerance,
+    );
+    assert_eq!(share, 0.0, "largest difference {worst}");
+    // A hidden layer is not meshed: it is kept as it was, nothing of it lost.
+    for (kept, was) in after.layers.iter().zip(&before.layers) {
+        if !was.visible {
+            assert_eq!((kept.x, kept.y), (was.x + shift.0, was.y + shift.1));
+            assert!(kept.pixels == was.pixels, "{}", was.name);
+        }
+    }
+}
+
+/// `render --layers OUT.ora` writes each layer warped on its own: the file another
+/// program wrote, posed, comes back with its layers' names, order, opacity and
+/// visibility, and those layers flattened are the picture `-o` writes.
+#[test]
+fn render_writes_the_warped_layers_as_openraster() {
+    let (before, after, warped) = render_layered(
+        r#"{"version":1,"handles":[{"type":"point","rest":[34,8]},{"type":"point","rest":[30,25],"translate":[6,3]}]}"#,
+    );
     assert_eq!((after.width, after.height), (before.width, before.height));
     let describe = |artwork: &layers::Artwork| -> Vec<(String, bool, f32)> {
         artwork
@@ -162,24 +191,12 @@ fn render_writes_the_warped_layers_as_openraster() {
             .collect()
     };
     assert_eq!(describe(&after), describe(&before));
-    // A hidden layer is not meshed: it is kept as it was, nothing of it lost.
-    for (kept, was) in after.layers.iter().zip(&before.layers) {
-        if !was.visible {
-            assert_eq!((kept.x, kept.y), (was.x, was.y));
-            assert!(kept.pixels == was.pixels, "{}", was.name);
-        }
-    }
-    let warped = load(&png);
-    let (worst, share) = difference(
-        &premultiplied(&after.flatten().into_rgba8()),
-        &premultiplied(&warped),
-        1,
-    );
-    assert_eq!(share, 0.0, "largest difference {worst}");
+    assert_layers_match(&before, &after, &warped, 1, (0, 0));
     // Each layer moved: the pose is in every visible layer, not only the composite.
     let (_, moved) = difference(&warped, &premultiplied(&before.flatten().into_rgba8()), 8);
     assert!(moved > 0.01, "the pose moved almost nothing ({moved})");
     // `--layers` alone; a flat picture is one layer.
+    let dir = tempfile::tempdir().expect("temp dir");
     let alone = dir.path().join("flat.ora");
     ok(&[
         os("render"),
@@ -189,7 +206,7 @@ fn render_writes_the_warped_layers_as_openraster() {
         os("--layers"),
         alone.as_os_str(),
     ]);
-    let flat = layers::load(&alone, &limits).expect("one layer");
+    let flat = layers::load(&alone, &render::ImageLimits::default()).expect("one layer");
     assert_eq!(flat.layers.len(), 1);
     let golden = load(&data("dino-warped.png"));
     let (_, share) = difference(&flat.flatten().into_rgba8(), &golden, 8);
@@ -200,48 +217,21 @@ fn render_writes_the_warped_layers_as_openraster() {
 /// frame as the PNG, and hidden layers keep their place on the picture.
 #[test]
 fn warped_layers_grow_with_the_canvas() {
-    let dir = tempfile::tempdir().expect("temp dir");
-    let rig = dir.path().join("fit.json");
     // The body pulled up and left, past the canvas's corner.
-    fs::write(
-        &rig,
+    let (before, after, warped) = render_layered(
         r#"{"version":1,"canvas":"fit","handles":[{"type":"point","rest":[60,35]},{"type":"point","rest":[30,20],"translate":[-40,-25]}]}"#,
-    )
-    .expect("write rig");
-    let (png, ora) = (dir.path().join("fit.png"), dir.path().join("fit.ora"));
-    let source = layered("krita-like.ora");
-    ok(&render_args(
-        &source,
-        &rig,
-        &png,
-        &["--layers", ora.to_str().expect("a path")],
-    ));
-    let limits = render::ImageLimits::default();
-    let before = layers::load(&source, &limits).expect("the source");
-    let after = layers::load(&ora, &limits).expect("the written layers");
-    let warped = load(&png);
+    );
     assert_eq!((after.width, after.height), warped.dimensions());
     assert!(after.width > before.width && after.height > before.height);
-    // Within rounding: each layer's edge pixels are filtered before its opacity is
-    // applied, the flattened picture's after.
-    let (worst, share) = difference(
-        &premultiplied(&after.flatten().into_rgba8()),
-        &premultiplied(&warped),
-        2,
-    );
-    assert_eq!(share, 0.0, "largest difference {worst}");
     // The canvas grew left and up by as much as it grew (the warp went nowhere else),
-    // and the hidden layer moved with the picture's origin.
-    let (grown_x, grown_y) = (
+    // so the hidden layer moves with the picture's origin by that much. Within
+    // rounding: each layer's edge pixels are filtered before its opacity is applied,
+    // the flattened picture's after.
+    let grown = (
         (after.width - before.width) as i32,
         (after.height - before.height) as i32,
     );
-    for (kept, was) in after.layers.iter().zip(&before.layers) {
-        if !was.visible {
-            assert_eq!((kept.x, kept.y), (was.x + grown_x, was.y + grown_y));
-            assert!(kept.pixels == was.pixels);
-        }
-    }
+    assert_layers_match(&before, &after, &warped, 2, grown);
 }
 
 #[test]

@@ -7,6 +7,8 @@
 
 #[path = "../tests/support/energy.rs"]
 mod energy;
+#[path = "../tests/support/figure.rs"]
+mod figure;
 
 use std::time::Instant;
 

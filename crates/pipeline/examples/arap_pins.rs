@@ -3,6 +3,8 @@
 //! [ARAP settings as JSON, e.g. '{"pin_radius": 0}'] [FOLDER]`; with a folder, the
 //! warped pictures at each density are written there as PNG.
 
+#[path = "../tests/support/figure.rs"]
+mod figure;
 #[path = "../tests/support/pins.rs"]
 mod pins;
 
