@@ -94,6 +94,23 @@ impl Domain {
             });
             triangles.push(tri);
         }
+        // Number the vertices along a Z-order curve and the triangles by their first
+        // vertex, so that neighbours sit near each other in memory (spade refines in
+        // no spatial order; the solve's passes over the triangles read their
+        // corners' rows).
+        let order = z_order(&positions);
+        let mut renumber = vec![0u32; positions.len()];
+        for (new, &old) in order.iter().enumerate() {
+            renumber[old as usize] = new as u32;
+        }
+        let positions: Vec<DVec2> = order.iter().map(|&old| positions[old as usize]).collect();
+        for t in &mut triangles {
+            *t = t.map(|v| renumber[v as usize]);
+        }
+        triangles.sort_unstable_by_key(|t| (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2])));
+        for i in index.iter_mut().filter(|i| **i != u32::MAX) {
+            *i = renumber[*i as usize];
+        }
         let cage_vertices = handles
             .iter()
             .enumerate()
@@ -282,4 +299,29 @@ impl Domain {
 
 fn p_of(p: Point2<f64>) -> DVec2 {
     DVec2::new(p.x, p.y)
+}
+
+/// The points' indices sorted along a Z-order (Morton) curve over their bounding box.
+fn z_order(points: &[DVec2]) -> Vec<u32> {
+    let lo = points.iter().copied().fold(DVec2::INFINITY, DVec2::min);
+    let hi = points.iter().copied().fold(DVec2::NEG_INFINITY, DVec2::max);
+    let scale = 65535.0 / (hi - lo).max_element().max(f64::MIN_POSITIVE);
+    let spread = |x: u32| {
+        let mut x = u64::from(x);
+        x = (x | (x << 16)) & 0x0000_ffff_0000_ffff;
+        x = (x | (x << 8)) & 0x00ff_00ff_00ff_00ff;
+        x = (x | (x << 4)) & 0x0f0f_0f0f_0f0f_0f0f;
+        x = (x | (x << 2)) & 0x3333_3333_3333_3333;
+        (x | (x << 1)) & 0x5555_5555_5555_5555
+    };
+    let mut keyed: Vec<(u64, u32)> = points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let q = (*p - lo) * scale;
+            (spread(q.x as u32) | (spread(q.y as u32) << 1), i as u32)
+        })
+        .collect();
+    keyed.sort_unstable();
+    keyed.into_iter().map(|(_, i)| i).collect()
 }

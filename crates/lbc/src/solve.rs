@@ -3,14 +3,13 @@
 
 use std::time::{Duration, Instant};
 
-use faer::MatMut;
 use glam::{DMat3, DVec2, DVec3};
 use rayon::prelude::*;
 
 use crate::compact::Coordinates;
 use crate::domain::Domain;
 use crate::error::LbcError;
-use crate::fem::{Elements, Factor};
+use crate::fem::{Elements, RowFactor};
 use crate::geodesic::geodesic_distances;
 use crate::projection::project_row;
 use crate::report::{Progress, Report};
@@ -354,7 +353,7 @@ impl Problem {
         });
     }
 
-    fn factorise(&self, domain: &Domain) -> Result<Factor, LbcError> {
+    fn factorise(&self, domain: &Domain) -> Result<RowFactor, LbcError> {
         let mut ones = vec![0.0; self.q.len()];
         for (j, &v) in self.interior.iter().enumerate() {
             ones[v as usize] = self.split[j];
@@ -362,7 +361,7 @@ impl Problem {
         let row_of = &self.row_of;
         let map = |v: u32| row_of[v as usize].map(|r| r as usize);
         let elements = Elements::new(&self.q, domain.triangles());
-        Factor::new(
+        RowFactor::new(
             self.interior.len(),
             &elements.lower_triplets(&self.triangles, &map, 1.0, &ones, 1.0),
         )
@@ -409,7 +408,7 @@ impl Problem {
     /// last call, the dual residual's square over `μ²`: with `L = GᵀG + βM` and
     /// `L Y = R`, it is `ΔY · ΔR`, a sum over the unknown rows rather than a pass over
     /// every triangle.
-    fn y_update(&self, factor: &Factor, t: &[f64], b: &mut YBuffers, z: &mut [f64]) -> f64 {
+    fn y_update(&self, factor: &RowFactor, t: &[f64], b: &mut YBuffers, z: &mut [f64]) -> f64 {
         let n = self.n;
         let t2 = &t[self.triangle_part()..];
         let gt = &b.gt;
@@ -430,12 +429,7 @@ impl Problem {
             }
         });
         b.r.copy_from_slice(&b.rhs);
-        let y = MatMut::from_row_major_slice_mut(&mut b.rhs, self.interior.len(), n);
-        let (left, right) = y.split_at_col_mut(n / 2);
-        rayon::join(
-            || factor.solve_in_place(left),
-            || factor.solve_in_place(right),
-        );
+        factor.solve_rows(&mut b.rhs, n, &mut b.scratch);
         for ((y, &v), h) in b
             .rhs
             .chunks_exact(n)
@@ -478,7 +472,7 @@ impl Problem {
     #[allow(clippy::too_many_arguments)]
     fn iterate(
         &self,
-        factor: &Factor,
+        factor: &RowFactor,
         t: &[f64],
         z: &mut [f64],
         next: &mut [f64],
@@ -683,7 +677,7 @@ impl Problem {
     /// ([`Problem::iterate`]).
     fn admm(
         &self,
-        factor: &Factor,
+        factor: &RowFactor,
         z: &mut [f64],
         settings: &Settings,
         progress: &mut dyn FnMut(&Progress) -> bool,
@@ -700,6 +694,7 @@ impl Problem {
             r_previous: vec![0.0; mi * n],
             y_previous: vec![0.0; mi * n],
             has_previous: false,
+            scratch: Vec::new(),
         };
         // Start from the smoothest coordinates: the Y-update with every split
         // variable and multiplier zero (a regularised harmonic solve), and the state
@@ -884,6 +879,8 @@ struct YBuffers {
     r_previous: Vec<f64>,
     y_previous: Vec<f64>,
     has_previous: bool,
+    /// The factor's working rows.
+    scratch: Vec<Vec<f64>>,
 }
 
 /// Chunk length of the parallel sums over the unknown rows.
