@@ -161,7 +161,9 @@ impl RowFactor {
             )
             .map_err(|e| failed(&e))?;
         let SymbolicCholeskyRaw::Simplicial(s) = symbolic.raw() else {
-            return Err(LbcError::Factorization("expected a simplicial factor".into()));
+            return Err(LbcError::Factorization(
+                "expected a simplicial factor".into(),
+            ));
         };
         let col_ptr: Vec<usize> = s.col_ptr().to_vec();
         let row_idx: Vec<u32> = s.row_idx().iter().map(|&r| r as u32).collect();
@@ -200,7 +202,10 @@ impl RowFactor {
             let d = 1.0 / self.values[start];
             let xj = x[j].map(|v| v * d);
             x[j] = xj;
-            for (&i, &l) in self.row_idx[start + 1..end].iter().zip(&self.values[start + 1..end]) {
+            for (&i, &l) in self.row_idx[start + 1..end]
+                .iter()
+                .zip(&self.values[start + 1..end])
+            {
                 let xi = &mut x[i as usize];
                 for c in 0..W {
                     xi[c] -= l * xj[c];
@@ -212,7 +217,10 @@ impl RowFactor {
             let (start, end) = (self.col_ptr[j], self.col_ptr[j + 1]);
             let d = 1.0 / self.values[start];
             let mut xj = x[j];
-            for (&i, &l) in self.row_idx[start + 1..end].iter().zip(&self.values[start + 1..end]) {
+            for (&i, &l) in self.row_idx[start + 1..end]
+                .iter()
+                .zip(&self.values[start + 1..end])
+            {
                 let xi = &x[i as usize];
                 for c in 0..W {
                     xj[c] -= l * xi[c];
@@ -276,7 +284,12 @@ mod tests {
                         lower.push(Triplet::new(j, i, -1.0));
                     }
                 }
-                for (nx, ny) in [(x.wrapping_sub(1), y), (x + 1, y), (x, y.wrapping_sub(1)), (x, y + 1)] {
+                for (nx, ny) in [
+                    (x.wrapping_sub(1), y),
+                    (x + 1, y),
+                    (x, y.wrapping_sub(1)),
+                    (x, y + 1),
+                ] {
                     if nx < k && ny < k {
                         degree += 1.0;
                     }
@@ -309,7 +322,11 @@ mod tests {
                     }
                 }
             }
-            let worst = ax.iter().zip(&b).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+            let worst = ax
+                .iter()
+                .zip(&b)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
             assert!(worst < 1e-12, "width {width}: residual {worst}");
         }
     }
