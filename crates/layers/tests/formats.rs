@@ -333,3 +333,49 @@ fn empty_layers_are_skipped_and_layers_past_the_canvas_clipped() {
         .collect();
     assert_eq!(kept, [("half off", 4, (2, 4))]);
 }
+
+#[test]
+fn the_sample_character_opens_as_its_parts_in_order() {
+    // assets/puppet.ora (scripts/puppet_ora.py): seven parts, each drawn whole on its
+    // own layer and cropped to its pixels, as Krita writes them.
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../assets/puppet.ora");
+    let artwork = layers::load(&path, &ImageLimits::default()).expect("the sample opens");
+    assert_eq!((artwork.width, artwork.height), (640, 720));
+    let names: Vec<&str> = artwork.layers.iter().map(|l| l.name.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "tail",
+            "arm (back)",
+            "leg (back)",
+            "body",
+            "leg (front)",
+            "head",
+            "arm (front)"
+        ],
+        "bottom first"
+    );
+    assert!(artwork.layers.iter().all(|l| l.visible && l.opacity == 1.0));
+    // The front arm starts under the body's outline: drawn whole, partly hidden.
+    let arm = &artwork.layers[6];
+    let body = &artwork.layers[3];
+    let (aw, ah) = arm.dimensions();
+    let (bw, _) = body.dimensions();
+    assert!(arm.x + aw as i32 > body.x && arm.x < body.x + bw as i32);
+    assert!(arm.y < body.y + 40 && arm.y + ah as i32 > body.y);
+    // Its layers flattened are the merged picture the file carries (Pillow's).
+    let bytes = std::fs::read(&path).expect("read");
+    let mut zip = zip::ZipArchive::new(std::io::Cursor::new(bytes)).expect("a zip");
+    let mut merged = Vec::new();
+    std::io::Read::read_to_end(
+        &mut zip.by_name("mergedimage.png").expect("merged"),
+        &mut merged,
+    )
+    .expect("merged picture");
+    let merged = image::load_from_memory(&merged).expect("png").to_rgba8();
+    let diff = premultiplied_difference(&artwork.flatten().into_rgba8(), &merged);
+    assert!(
+        diff <= 1,
+        "differs from the file's merged picture by {diff} levels"
+    );
+}
