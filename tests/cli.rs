@@ -258,6 +258,62 @@ fn render_refuses_layers_it_cannot_write() {
 }
 
 #[test]
+fn render_parts_warps_the_sample_character_part_by_part() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let rig = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../assets/puppet-rig.json");
+    let (png, ora) = (dir.path().join("cat.png"), dir.path().join("cat.ora"));
+    let arg = |p: &Path| p.as_os_str().to_owned();
+    let args = [
+        "render".into(),
+        arg(&rig),
+        "--parts".into(),
+        "--density".into(),
+        "6000".into(),
+        "-o".into(),
+        arg(&png),
+        "--layers".into(),
+        arg(&ora),
+    ];
+    let args: Vec<&OsStr> = args.iter().map(|a| a.as_os_str()).collect();
+    ok(&args);
+    let warped = layers::load(&ora, &render::ImageLimits::default()).expect("the parts");
+    assert_eq!(warped.layers.len(), 7);
+    // The layers written flatten to the PNG written.
+    let (worst, _) = difference(
+        &premultiplied(&warped.flatten().into_rgba8()),
+        &premultiplied(&load(&png)),
+        1,
+    );
+    assert!(
+        worst <= 1,
+        "the parts flatten to the PNG within {worst} levels"
+    );
+    // The back leg's handles (its hip, a joint with the body, and its foot) do not
+    // move: it is drawn where it was, pixel for pixel.
+    let source = layers::load(
+        &PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../assets/puppet.ora"),
+        &render::ImageLimits::default(),
+    )
+    .expect("the sample");
+    let rest = &source.layers[2];
+    let moved = &warped.layers[2];
+    assert_eq!(
+        (moved.x, moved.y, moved.dimensions()),
+        (rest.x, rest.y, rest.dimensions()),
+        "the back leg keeps its place and size"
+    );
+    assert_eq!(
+        moved.pixels.to_rgba8(),
+        rest.pixels.to_rgba8(),
+        "the back leg, pixel for pixel"
+    );
+    // Refused: the GPU, a grown canvas.
+    let mut gpu = args.clone();
+    gpu.push(OsStr::new("--gpu"));
+    assert!(fails(&gpu).contains("--gpu"));
+}
+
+#[test]
 fn weights_from_a_mesh_are_a_partition_of_unity_that_interpolates() {
     let dir = tempfile::tempdir().expect("temp dir");
     // A 4 × 3 grid of unit squares.

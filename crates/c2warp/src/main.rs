@@ -63,6 +63,12 @@ enum Command {
         /// and GIMP open it; replaced atomically like the PNG.
         #[arg(long, value_name = "OUT.ora")]
         layers: Option<PathBuf>,
+        /// Warp a layered picture as parts: every visible layer meshed along its own
+        /// outline and deformed by the handles on it (a handle where two layers
+        /// overlap binds both), then composited in order; the density is shared among
+        /// the parts by area, the canvas kept. Not with a cage (LBC) or `--gpu`.
+        #[arg(long)]
+        parts: bool,
         /// Target number of mesh vertices (overrides the rig's `density`).
         #[arg(long, allow_negative_numbers = true, value_parser = flags::density)]
         density: Option<usize>,
@@ -358,6 +364,7 @@ fn run(command: Command) -> Result<()> {
             rig,
             output,
             layers,
+            parts,
             density,
             gpu,
             method,
@@ -368,6 +375,7 @@ fn run(command: Command) -> Result<()> {
             Outputs {
                 png: output.as_deref(),
                 layers: layers.as_deref(),
+                parts,
             },
             density,
             gpu,
@@ -487,6 +495,8 @@ struct Outputs<'a> {
     png: Option<&'a Path>,
     /// The OpenRaster file of warped layers.
     layers: Option<&'a Path>,
+    /// Whether the layers are warped as parts ([`pipeline::warp_parts`]).
+    parts: bool,
 }
 
 fn render(
@@ -526,6 +536,15 @@ fn render(
         project.canvas = canvas;
     }
     let artwork = load_artwork_noting(&image)?;
+    if outputs.parts {
+        if gpu {
+            bail!("--parts draws on the CPU: leave out --gpu");
+        }
+        if canvas == Some(project::Canvas::Fit) {
+            bail!("--parts keeps the picture's canvas: leave out --canvas fit");
+        }
+        return render_parts(&artwork, &project, outputs, density);
+    }
     let picture = artwork.flatten();
     let steps = 1 + 2 * u64::from(outputs.png.is_some()) + u64::from(outputs.layers.is_some());
     let progress = progress::Steps::new(steps);
@@ -549,6 +568,29 @@ fn render(
         progress.step("rendering and writing the layers");
         let warped = pipeline::warp_layers(&artwork, &warper)?;
         pipeline::write_ora(output, &warped)?;
+    }
+    progress.finish();
+    Ok(())
+}
+
+/// `render --parts`: each visible layer warped as a part, the parts composited.
+fn render_parts(
+    artwork: &pipeline::Artwork,
+    project: &project::Project,
+    outputs: Outputs,
+    density: Option<usize>,
+) -> Result<()> {
+    let steps = 1 + u64::from(outputs.png.is_some()) + u64::from(outputs.layers.is_some());
+    let progress = progress::Steps::new(steps);
+    progress.step("meshing, weighting and warping every part");
+    let parts = pipeline::warp_parts(artwork, project, density, &progress)?;
+    if let Some(output) = outputs.png {
+        progress.step("writing");
+        write_png(output, &parts.warped.flatten())?;
+    }
+    if let Some(output) = outputs.layers {
+        progress.step("writing the layers");
+        pipeline::write_ora(output, &parts.warped)?;
     }
     progress.finish();
     Ok(())

@@ -10,6 +10,7 @@ pub mod deformer;
 pub mod method;
 pub mod mls;
 pub mod order;
+pub mod parts;
 
 use std::io::{BufReader, Read};
 use std::path::Path;
@@ -29,6 +30,7 @@ pub use method::{
     SolveProgress, Source, WeightsListing, beside_rig, on_handles, setup,
 };
 pub use order::draw_order;
+pub use parts::{Parts, warp_parts};
 
 use weights_core::{
     Basis, Domain, Handle, Metric, MiddleControls, Placement, Rig, RigOptions, Similarity,

@@ -1,0 +1,143 @@
+//! Layered artwork warped as parts (`pipeline::warp_parts`): a handle binds the layers
+//! under it, a part moves with its own handles only, a joint binds both parts, and at
+//! rest the parts composite to the layers flattened.
+
+use image::{Rgba, RgbaImage};
+use pipeline::{Artwork, Layer, warp_parts};
+use project::Project;
+use render::Picture;
+
+/// A layer of `w × h` opaque pixels of `colour` at (`x`, `y`).
+fn block(name: &str, x: i32, y: i32, w: u32, h: u32, colour: [u8; 3]) -> Layer {
+    let [r, g, b] = colour;
+    Layer {
+        name: name.into(),
+        x,
+        y,
+        opacity: 1.0,
+        visible: true,
+        pixels: Picture::Rgba8(RgbaImage::from_pixel(w, h, Rgba([r, g, b, 255]))),
+    }
+}
+
+/// Two parts side by side on a 200 × 120 canvas: `left` (x 10..90) and `right` (x 80..190),
+/// overlapping on x 80..90, the right one on top.
+fn two_parts() -> Artwork {
+    Artwork {
+        width: 200,
+        height: 120,
+        layers: vec![
+            block("left", 10, 20, 80, 80, [200, 40, 40]),
+            block("right", 80, 20, 110, 80, [40, 40, 200]),
+        ],
+        notes: Vec::new(),
+    }
+}
+
+fn rig(handles: &str) -> Project {
+    Project::from_json(&format!(
+        r#"{{"version": 1, "density": 1200, "handles": [{handles}]}}"#
+    ))
+    .expect("a rig")
+}
+
+fn rgba8(layer: &Layer) -> &RgbaImage {
+    match &layer.pixels {
+        Picture::Rgba8(im) => im,
+        Picture::Rgba16(_) => panic!("8-bit test layers"),
+    }
+}
+
+#[test]
+fn a_handle_binds_the_layers_under_it_and_a_joint_binds_both() {
+    let project = rig(r#"{"type": "point", "rest": [30, 60]},
+           {"type": "point", "rest": [85, 60]},
+           {"type": "point", "rest": [170, 60]},
+           {"type": "bar", "rest": [[120, 40], [160, 80]]}"#);
+    let parts = warp_parts(&two_parts(), &project, None, &()).expect("warps");
+    assert_eq!(parts.bindings, vec![vec![0, 1], vec![1, 2, 3]]);
+}
+
+#[test]
+fn moving_one_parts_handle_leaves_the_other_part_where_it_was() {
+    for method in ["c2", "arap", "mls"] {
+        let project = rig(r#"{"type": "point", "rest": [30, 40]},
+               {"type": "point", "rest": [30, 80], "translate": [-8, 25], "rotate": 0.3},
+               {"type": "point", "rest": [120, 60]},
+               {"type": "point", "rest": [170, 60]}"#);
+        let mut project = project;
+        project.method = method.parse().expect("a method");
+        let artwork = two_parts();
+        let parts = warp_parts(&artwork, &project, None, &()).expect("warps");
+        // The right part: its own handles did not move, so it is the layer as it was,
+        // pixel for pixel, at its place on the canvas.
+        let right = rgba8(&parts.warped.layers[1]);
+        for (x, y, p) in right.enumerate_pixels() {
+            let inside = (80..190).contains(&x) && (20..100).contains(&y);
+            let expected = if inside { [40, 40, 200, 255] } else { [0; 4] };
+            assert_eq!(p.0, expected, "{method}: the right part at ({x}, {y})");
+        }
+        // The left part moved: its bottom-left corner went down with its handle.
+        let left = rgba8(&parts.warped.layers[0]);
+        let below = (0..200).any(|x| left.get_pixel(x, 110)[3] > 0);
+        assert!(below, "{method}: the left part's moved handle took it down");
+    }
+}
+
+#[test]
+fn at_rest_the_parts_composite_to_the_layers_flattened() {
+    let project = rig(r#"{"type": "point", "rest": [30, 60]},
+           {"type": "point", "rest": [85, 60]},
+           {"type": "point", "rest": [170, 60]}"#);
+    let artwork = two_parts();
+    let parts = warp_parts(&artwork, &project, None, &()).expect("warps");
+    let (a, b) = (
+        parts.warped.flatten().into_rgba8(),
+        artwork.flatten().into_rgba8(),
+    );
+    let worst = a
+        .pixels()
+        .zip(b.pixels())
+        .flat_map(|(p, q)| (0..4).map(move |c| p[c].abs_diff(q[c])))
+        .max()
+        .unwrap_or(0);
+    assert!(
+        worst <= 1,
+        "differs from the layers flattened by {worst} levels"
+    );
+}
+
+#[test]
+fn a_handle_on_no_part_or_a_cage_is_refused() {
+    let project = rig(r#"{"type": "point", "rest": [195, 5]}"#);
+    let error = warp_parts(&two_parts(), &project, None, &())
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(
+        error.contains("handle 1 lies on no visible layer"),
+        "{error}"
+    );
+    let cage = Project::from_json(
+        r#"{"version": 1, "method": "lbc", "handles": [], "cage": {"rest": [[0, 0], [199, 0], [199, 119], [0, 119]]}}"#,
+    )
+    .expect("a cage rig");
+    let error = warp_parts(&two_parts(), &cage, None, &())
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(error.contains("cage"), "{error}");
+}
+
+#[test]
+fn a_hidden_layer_is_kept_as_it_was() {
+    let mut artwork = two_parts();
+    artwork.layers[0].visible = false;
+    let project = rig(r#"{"type": "point", "rest": [170, 60], "translate": [5, 0]}"#);
+    let parts = warp_parts(&artwork, &project, None, &()).expect("warps");
+    let hidden = &parts.warped.layers[0];
+    assert!(!hidden.visible);
+    assert_eq!((hidden.x, hidden.y), (10, 20));
+    assert_eq!(hidden.pixels, artwork.layers[0].pixels);
+    assert!(parts.bindings[0].is_empty());
+}
