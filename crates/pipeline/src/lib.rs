@@ -673,7 +673,7 @@ pub(crate) fn placed(picture: &Picture, frame: Frame, at: [i64; 2]) -> Result<Pi
 ///
 /// # Errors
 /// Not enough memory for it.
-fn blank(bits: u8, frame: Frame) -> Result<Picture> {
+pub(crate) fn blank(bits: u8, frame: Frame) -> Result<Picture> {
     let (width, height) = (frame.width, frame.height);
     let len = 4 * width as usize * height as usize;
     let too_large = || anyhow!("a {width} × {height} picture is too large to allocate");

@@ -7,18 +7,24 @@
 //! a hip — binds both: a joint. Each part is set up by the project's method on its own
 //! layer alone, with the handles that bind it, so distances stay inside the part; the
 //! rig's density is shared among the parts by visible area. A part that no handle
-//! binds stays where it is. Hidden layers are kept as they are.
+//! binds follows the part beneath it that it overlaps most at rest (the most pixels
+//! visible in both; the nearer layer on a tie): its own mesh's vertices go where that
+//! part's warped mesh takes them (barycentrically inside it; outside it, by the
+//! displacement of its nearest vertex). A part that no handle binds and that overlaps
+//! no bound part beneath it stays where it is. Hidden layers are kept as they are.
 //!
-//! Not yet: a part that no handle binds following the part beneath it, parts in the
-//! editor, automatic depth between parts (the ARAP paper's §5.1), LBC cages over
-//! parts.
+//! Not yet: parts in the editor, automatic depth between parts (the ARAP paper's §5.1),
+//! LBC cages over parts.
 
 use anyhow::{Context, Result, bail};
-use glam::DVec2;
+use glam::{DVec2, Vec2};
 use project::{Canvas, Controls, HandleSpec, Hold, Project};
 use render::Picture;
+use weights_core::{Domain, Metric};
 
-use crate::{DEFAULT_DENSITY, Frame, Listener, placed, prepare_warper, warp_picture};
+use crate::{
+    DEFAULT_DENSITY, Frame, Listener, Warper, blank, placed, prepare_warper, warp_picture,
+};
 
 /// The fewest vertices a part is meshed with, whatever its share of the density.
 const MIN_PART_DENSITY: usize = 200;
@@ -31,6 +37,8 @@ pub struct Parts {
     /// For each layer, the handles (indices into the project's) that bind it; empty
     /// for a hidden layer.
     pub bindings: Vec<Vec<usize>>,
+    /// For each layer that no handle binds, the layer it follows (if any).
+    pub followed: Vec<Option<usize>>,
 }
 
 /// Warps each visible layer of `artwork` as a part by `project`'s handles (see the
@@ -90,46 +98,95 @@ pub fn warp_parts(
         .collect();
     let total_area = areas.iter().sum::<u64>().max(1);
     let total = density.or(project.density).unwrap_or(DEFAULT_DENSITY);
-    let mut warped = Vec::with_capacity(artwork.layers.len());
+    let share = |area: u64| {
+        ((total as u128 * u128::from(area) / u128::from(total_area)) as usize).max(MIN_PART_DENSITY)
+    };
+    // The visible layers on the canvas, and the bound parts set up and warped.
+    let mut on_canvas = Vec::with_capacity(artwork.layers.len());
+    let mut warpers: Vec<Option<Warper>> = Vec::with_capacity(artwork.layers.len());
+    let mut pixels = Vec::with_capacity(artwork.layers.len());
     for ((layer, bound), &area) in artwork.layers.iter().zip(&bindings).zip(&areas) {
-        let pixels = if !layer.visible {
-            layer.pixels.clone()
-        } else {
-            let on_canvas = placed(
-                &layer.pixels,
-                canvas,
-                [i64::from(layer.x), i64::from(layer.y)],
-            )?;
-            if bound.is_empty() {
-                on_canvas
-            } else {
-                let share = (total as u128 * u128::from(area) / u128::from(total_area)) as usize;
-                let part = part_project(project, bound);
-                let warper = prepare_warper(
-                    &on_canvas.to_rgba8(),
-                    &part,
-                    Some(share.max(MIN_PART_DENSITY)),
-                    listener,
+        if !layer.visible {
+            on_canvas.push(None);
+            warpers.push(None);
+            pixels.push(Some(layer.pixels.clone()));
+            continue;
+        }
+        let placed_layer = placed(
+            &layer.pixels,
+            canvas,
+            [i64::from(layer.x), i64::from(layer.y)],
+        )?;
+        if bound.is_empty() {
+            on_canvas.push(Some(placed_layer));
+            warpers.push(None);
+            pixels.push(None);
+            continue;
+        }
+        let part = part_project(project, bound);
+        let warper = prepare_warper(&placed_layer.to_rgba8(), &part, Some(share(area)), listener)
+            .with_context(|| format!("part \"{}\"", layer.name))?;
+        pixels.push(Some(
+            warp_picture(&placed_layer, &warper)
+                .with_context(|| format!("part \"{}\"", layer.name))?,
+        ));
+        on_canvas.push(Some(placed_layer));
+        warpers.push(Some(warper));
+    }
+    // The parts no handle binds follow the bound part beneath them they overlap most.
+    let mut followed = vec![None; artwork.layers.len()];
+    for k in 0..artwork.layers.len() {
+        if pixels[k].is_some() {
+            continue;
+        }
+        let layer = &artwork.layers[k];
+        let Some(own) = on_canvas[k].as_ref() else {
+            continue;
+        };
+        let beneath = (0..k)
+            .rev()
+            .filter(|&j| warpers[j].is_some())
+            .map(|j| {
+                (
+                    j,
+                    overlap(own, on_canvas[j].as_ref().expect("a visible part")),
                 )
-                .with_context(|| format!("part \"{}\"", layer.name))?;
-                warp_picture(&on_canvas, &warper)
+            })
+            .filter(|&(_, n)| n > 0)
+            .fold(None, |best: Option<(usize, u64)>, (j, n)| match best {
+                Some((_, m)) if m >= n => best,
+                _ => Some((j, n)),
+            });
+        pixels[k] = Some(match beneath {
+            Some((j, _)) => {
+                followed[k] = Some(j);
+                let leader = warpers[j].as_ref().expect("a bound part");
+                follow(own, leader, project, share(areas[k]), listener)
                     .with_context(|| format!("part \"{}\"", layer.name))?
             }
-        };
-        let (x, y) = if layer.visible {
-            (0, 0)
-        } else {
-            (layer.x, layer.y)
-        };
-        warped.push(layers::Layer {
-            name: layer.name.clone(),
-            x,
-            y,
-            opacity: layer.opacity,
-            visible: layer.visible,
-            pixels,
+            None => own.clone(),
         });
     }
+    let warped = artwork
+        .layers
+        .iter()
+        .zip(pixels)
+        .map(|(layer, pixels)| {
+            let (x, y) = if layer.visible {
+                (0, 0)
+            } else {
+                (layer.x, layer.y)
+            };
+            layers::Layer {
+                name: layer.name.clone(),
+                x,
+                y,
+                opacity: layer.opacity,
+                visible: layer.visible,
+                pixels: pixels.expect("every layer drawn"),
+            }
+        })
+        .collect();
     Ok(Parts {
         warped: layers::Artwork {
             width: artwork.width,
@@ -138,7 +195,80 @@ pub fn warp_parts(
             notes: Vec::new(),
         },
         bindings,
+        followed,
     })
+}
+
+/// `part` (on the canvas) meshed on its own and drawn where `leader`'s warped mesh
+/// takes its vertices.
+fn follow(
+    part: &Picture,
+    leader: &Warper,
+    project: &Project,
+    density: usize,
+    listener: &dyn Listener,
+) -> Result<Picture> {
+    // Its own mesh: the method's setup with no handle is the identity on it.
+    let mut still = part_project(project, &[]);
+    still.method = project::Method::C2;
+    let own = prepare_warper(&part.to_rgba8(), &still, Some(density), listener)?;
+    let rest = own.deformer.rest();
+    let lead = Domain::new(
+        leader.deformer.rest().to_vec(),
+        leader.deformer.triangles().to_vec(),
+        Metric::Euclidean,
+    )
+    .map_err(|e| anyhow::anyhow!("the part beneath: {e}"))?;
+    let lead_deformed = leader.deformer.deformed();
+    let lead_rest = leader.deformer.rest();
+    let moved: Vec<DVec2> = rest
+        .iter()
+        .map(|&p| match lead.locate(p) {
+            Some((t, b)) => {
+                let tri = lead.triangles()[t];
+                (0..3).map(|i| lead_deformed[tri[i] as usize] * b[i]).sum()
+            }
+            None => lead
+                .nearest_vertex(p)
+                .map_or(p, |v| p + lead_deformed[v as usize] - lead_rest[v as usize]),
+        })
+        .collect();
+    if moved.iter().any(|p| !p.is_finite()) {
+        anyhow::bail!("the deformation produced non-finite positions");
+    }
+    let rest: Vec<Vec2> = rest.iter().map(|p| p.as_vec2()).collect();
+    let moved: Vec<Vec2> = moved.iter().map(|p| p.as_vec2()).collect();
+    let (w, h) = part.dimensions();
+    let mut out = blank(
+        part.bits_per_channel(),
+        Frame {
+            origin: [0, 0],
+            width: w,
+            height: h,
+        },
+    )?;
+    render::warp_picture_over(
+        part,
+        &render::WarpMesh {
+            rest: &rest,
+            deformed: &moved,
+            triangles: own.deformer.triangles(),
+        },
+        &mut out,
+    )?;
+    Ok(out)
+}
+
+/// The number of canvas pixels visible in both `a` and `b` (the same size).
+fn overlap(a: &Picture, b: &Picture) -> u64 {
+    let (w, h) = a.dimensions();
+    let mut n = 0;
+    for y in 0..h {
+        for x in 0..w {
+            n += u64::from(alpha(a, x, y) > 0 && alpha(b, x, y) > 0);
+        }
+    }
+    n
 }
 
 /// `project` with the handles `bound` alone (their holds and overlay kept, renumbered),

@@ -141,3 +141,35 @@ fn a_hidden_layer_is_kept_as_it_was() {
     assert_eq!(hidden.pixels, artwork.layers[0].pixels);
     assert!(parts.bindings[0].is_empty());
 }
+
+#[test]
+fn a_part_no_handle_binds_follows_the_part_beneath_it() {
+    // A patch on the left part, and a lone dot over nothing.
+    let mut artwork = two_parts();
+    artwork
+        .layers
+        .push(block("patch", 30, 40, 20, 16, [20, 160, 20]));
+    artwork.layers.push(block("dot", 194, 2, 4, 4, [0, 0, 0]));
+    let project = rig(
+        r#"{"type": "point", "rest": [20, 30], "translate": [10, 6]},
+           {"type": "point", "rest": [70, 90], "translate": [10, 6]},
+           {"type": "point", "rest": [170, 60]}"#,
+    );
+    let parts = warp_parts(&artwork, &project, None, &()).expect("warps");
+    assert_eq!(parts.followed, vec![None, None, Some(0), None]);
+    // The left part moved by (10, 6) as a whole, and the patch with it.
+    let patch = rgba8(&parts.warped.layers[2]);
+    for (x, y, p) in patch.enumerate_pixels() {
+        let inside = (40..60).contains(&x) && (46..62).contains(&y);
+        let expected = if inside { [20, 160, 20, 255] } else { [0; 4] };
+        let worst = (0..4)
+            .map(|c| p[c].abs_diff(expected[c]))
+            .max()
+            .unwrap_or(0);
+        assert!(worst <= 1, "the patch at ({x}, {y}): {:?}", p.0);
+    }
+    // The dot overlaps no part: it stays.
+    let dot = rgba8(&parts.warped.layers[3]);
+    assert_eq!(dot.get_pixel(195, 3).0, [0, 0, 0, 255]);
+    assert_eq!(dot.get_pixel(190, 3).0, [0; 4]);
+}
