@@ -314,6 +314,116 @@ fn render_parts_warps_the_sample_character_part_by_part() {
 }
 
 #[test]
+fn deform_parts_writes_one_object_per_part() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let rig = root.join("assets/puppet-rig.json");
+    let obj = dir.path().join("cat.obj");
+    ok(&[
+        OsStr::new("deform"),
+        OsStr::new("--parts"),
+        OsStr::new("--rig"),
+        rig.as_os_str(),
+        OsStr::new("-o"),
+        obj.as_os_str(),
+    ]);
+    let text = fs::read_to_string(&obj).expect("the OBJ");
+    // Objects in the layers' order, each with its own vertices and triangles.
+    /// An OBJ object: its name, vertices and faces.
+    type Object = (String, Vec<[f64; 2]>, Vec<[usize; 3]>);
+    let mut objects: Vec<Object> = Vec::new();
+    let mut total = 0;
+    for line in text.lines() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("o") => objects.push((line[2..].to_owned(), Vec::new(), Vec::new())),
+            Some("v") => {
+                let mut n = || {
+                    words
+                        .next()
+                        .expect("a coordinate")
+                        .parse()
+                        .expect("a number")
+                };
+                objects.last_mut().expect("an object").1.push([n(), n()]);
+                total += 1;
+            }
+            Some("f") => {
+                let mut n = || {
+                    words
+                        .next()
+                        .expect("an index")
+                        .parse::<usize>()
+                        .expect("an index")
+                };
+                let f = [n(), n(), n()];
+                assert!(
+                    f.iter().all(|&i| i >= 1 && i <= total),
+                    "a face of its own vertices"
+                );
+                objects.last_mut().expect("an object").2.push(f);
+            }
+            _ => {}
+        }
+    }
+    let names: Vec<&str> = objects.iter().map(|o| o.0.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "tail",
+            "arm (back)",
+            "leg (back)",
+            "body",
+            "leg (front)",
+            "head",
+            "arm (front)"
+        ]
+    );
+    assert!(objects.iter().all(|o| !o.1.is_empty() && !o.2.is_empty()));
+    // The back leg's handles stay: its vertices are where the rig at rest puts them.
+    let posed = fs::read_to_string(&rig).expect("the rig");
+    let project = project::Project::from_json(&posed).expect("a rig");
+    let mut rest = project.clone();
+    for h in &mut rest.handles {
+        match h {
+            project::HandleSpec::Point {
+                translate,
+                rotate,
+                scale,
+                ..
+            } => (*translate, *rotate, *scale) = ([0.0; 2], 0.0, 1.0),
+            project::HandleSpec::Bar { pose, .. } => *pose = None,
+        }
+    }
+    rest.image = Some(root.join("assets/puppet.ora"));
+    let rest_rig = dir.path().join("rest.json");
+    fs::write(&rest_rig, rest.to_json()).expect("write the rest rig");
+    let rest_obj = dir.path().join("rest.obj");
+    ok(&[
+        OsStr::new("deform"),
+        OsStr::new("--parts"),
+        OsStr::new("--rig"),
+        rest_rig.as_os_str(),
+        OsStr::new("-o"),
+        rest_obj.as_os_str(),
+    ]);
+    let at_rest = fs::read_to_string(&rest_obj).expect("the OBJ at rest");
+    let object = |text: &str, name: &str| -> Vec<String> {
+        text.lines()
+            .skip_while(|l| *l != format!("o {name}"))
+            .skip(1)
+            .take_while(|l| !l.starts_with("o "))
+            .map(str::to_owned)
+            .collect()
+    };
+    assert_eq!(object(&text, "leg (back)"), object(&at_rest, "leg (back)"));
+    assert_ne!(
+        object(&text, "arm (front)"),
+        object(&at_rest, "arm (front)")
+    );
+}
+
+#[test]
 fn weights_from_a_mesh_are_a_partition_of_unity_that_interpolates() {
     let dir = tempfile::tempdir().expect("temp dir");
     // A 4 × 3 grid of unit squares.

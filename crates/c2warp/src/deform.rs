@@ -6,6 +6,7 @@ use std::path::Path;
 use anyhow::{Result, bail};
 use glam::DVec2;
 use pipeline::{Method, load_project};
+use project::Project;
 
 use crate::{Input, Source};
 
@@ -13,13 +14,25 @@ use crate::{Input, Source};
 /// rig's) for the rig's controls and pose, and writes one `v x y 0` line per vertex in
 /// full precision — the file's vertices in its order, then those the command inserted
 /// — and the triangles as `f a b c` (1-based).
-pub fn run(source: &Source, rig_path: &Path, method: Option<Method>, output: &Path) -> Result<()> {
+pub fn run(
+    source: &Source,
+    rig_path: &Path,
+    method: Option<Method>,
+    parts: bool,
+    output: &Path,
+) -> Result<()> {
     let mut project = load_project(rig_path)?;
     if let Some(method) = method {
         project.method = method;
     }
     let file = source.file(rig_path, &project)?;
     render::refuse_input_as_output(output, &[rig_path, &file])?;
+    if parts {
+        if source.mesh.is_some() {
+            bail!("--parts meshes each layer of a picture: give --image, not --mesh");
+        }
+        return run_parts(&file, source.density, &project, output);
+    }
     let input = Input::load(source, &file)?;
     let progress = crate::progress::Steps::new(3);
     progress.step("meshing and weighting");
@@ -32,6 +45,60 @@ pub fn run(source: &Source, rig_path: &Path, method: Option<Method>, output: &Pa
     let deformed = deformer.deformed();
     progress.step("writing");
     write_obj(output, project.method, &deformed, deformer.triangles())?;
+    progress.finish();
+    Ok(())
+}
+
+/// `deform --parts`: every visible layer of the picture `file` set up as a part
+/// ([`pipeline::set_up_parts`]), each written as an OBJ object (`o` and the layer's
+/// name) of its deformed vertices and triangles, in the layers' order.
+fn run_parts(file: &Path, density: Option<usize>, project: &Project, output: &Path) -> Result<()> {
+    let artwork = crate::load_artwork_noting(file)?;
+    let progress = crate::progress::Steps::new(2);
+    progress.step("meshing, weighting and posing every part");
+    let set = pipeline::set_up_parts(&artwork, project, density, &progress)?;
+    progress.step("writing");
+    let parts: Vec<(&str, &pipeline::PartMesh)> = artwork
+        .layers
+        .iter()
+        .zip(&set.meshes)
+        .filter_map(|(layer, mesh)| Some((layer.name.as_str(), mesh.as_ref()?)))
+        .collect();
+    let vertices: usize = parts.iter().map(|(_, m)| m.deformed.len()).sum();
+    let triangles: usize = parts.iter().map(|(_, m)| m.triangles.len()).sum();
+    let mut text = String::with_capacity(vertices * 40 + triangles * 24);
+    let _ = writeln!(
+        text,
+        "# c2warp deform --parts, method {}: {} parts, {vertices} vertices, {triangles} triangles",
+        project.method.name(),
+        parts.len(),
+    );
+    let mut first = 1;
+    for (name, mesh) in parts {
+        if let Some(v) = mesh.deformed.iter().position(|p| !p.is_finite()) {
+            bail!("the deformation sent vertex {v} of part \"{name}\" to a non-finite position");
+        }
+        // An object's name is the rest of its line: one line, whatever the layer's.
+        let name: String = name
+            .chars()
+            .map(|c| if c.is_control() { ' ' } else { c })
+            .collect();
+        let _ = writeln!(text, "o {name}");
+        for p in &mesh.deformed {
+            let _ = writeln!(text, "v {} {} 0", p.x, p.y);
+        }
+        for t in &mesh.triangles {
+            let _ = writeln!(
+                text,
+                "f {} {} {}",
+                t[0] as usize + first,
+                t[1] as usize + first,
+                t[2] as usize + first
+            );
+        }
+        first += mesh.deformed.len();
+    }
+    crate::write_text(output, text.as_bytes())?;
     progress.finish();
     Ok(())
 }

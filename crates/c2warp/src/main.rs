@@ -132,6 +132,10 @@ enum Command {
         /// The warping method (overrides the rig's `method`).
         #[arg(long, value_parser = methods())]
         method: Option<Method>,
+        /// Deform a layered picture part by part (as `render --parts`): one OBJ
+        /// object (`o` and the layer's name) per visible layer, in the layers' order.
+        #[arg(long)]
+        parts: bool,
         /// Where to write the OBJ (`-`: standard output).
         #[arg(short, long)]
         output: PathBuf,
@@ -401,8 +405,9 @@ fn run(command: Command) -> Result<()> {
             source,
             rig,
             method,
+            parts,
             output,
-        } => deform::run(&source, &rig, method, &output),
+        } => deform::run(&source, &rig, method, parts, &output),
         Command::Weights {
             source,
             rig,

@@ -22,12 +22,32 @@ use project::{Canvas, Controls, HandleSpec, Hold, Project};
 use render::Picture;
 use weights_core::{Domain, Metric};
 
-use crate::{
-    DEFAULT_DENSITY, Frame, Listener, Warper, blank, placed, prepare_warper, warp_picture,
-};
+use crate::{DEFAULT_DENSITY, Frame, Listener, Warper, blank, placed, prepare_warper};
 
 /// The fewest vertices a part is meshed with, whatever its share of the density.
 const MIN_PART_DENSITY: usize = 200;
+
+/// One part's mesh, at rest and warped (canvas pixels).
+#[derive(Clone, Debug)]
+pub struct PartMesh {
+    /// Its vertices at rest.
+    pub rest: Vec<DVec2>,
+    /// Where the warp takes them.
+    pub deformed: Vec<DVec2>,
+    /// Its triangles, in the order they are drawn (back to front).
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// The parts of a layered picture, set up and posed ([`set_up_parts`]).
+pub struct PartSet {
+    /// For each layer, its part's mesh; `None` for a hidden layer.
+    pub meshes: Vec<Option<PartMesh>>,
+    /// For each layer, the handles (indices into the project's) that bind it; empty
+    /// for a hidden layer.
+    pub bindings: Vec<Vec<usize>>,
+    /// For each layer that no handle binds, the layer it follows (if any).
+    pub followed: Vec<Option<usize>>,
+}
 
 /// What [`warp_parts`] made.
 pub struct Parts {
@@ -46,23 +66,65 @@ pub struct Parts {
 /// total over the parts. The canvas is kept (the artwork's).
 ///
 /// # Errors
-/// An LBC project (its cage deforms the picture as a whole), a handle bound to no
-/// part (off every visible layer), or what setting up or warping a part fails with,
-/// naming the layer.
+/// As [`set_up_parts`], and a warp that cannot be drawn (non-finite positions).
 pub fn warp_parts(
     artwork: &layers::Artwork,
     project: &Project,
     density: Option<usize>,
     listener: &dyn Listener,
 ) -> Result<Parts> {
-    if project.method.controls() == Controls::Cage {
-        bail!("a cage (LBC) deforms the picture as a whole: render it without parts");
+    let set = set_up_parts(artwork, project, density, listener)?;
+    let canvas = canvas_of(artwork);
+    let mut warped = Vec::with_capacity(artwork.layers.len());
+    for (layer, mesh) in artwork.layers.iter().zip(&set.meshes) {
+        let (x, y, pixels) = match mesh {
+            None => (layer.x, layer.y, layer.pixels.clone()),
+            Some(mesh) => {
+                let on_canvas = on(layer, canvas)?;
+                let drawn =
+                    draw(&on_canvas, mesh).with_context(|| format!("part \"{}\"", layer.name))?;
+                (0, 0, drawn)
+            }
+        };
+        warped.push(layers::Layer {
+            name: layer.name.clone(),
+            x,
+            y,
+            opacity: layer.opacity,
+            visible: layer.visible,
+            pixels,
+        });
     }
-    let canvas = Frame {
-        origin: [0, 0],
-        width: artwork.width,
-        height: artwork.height,
-    };
+    Ok(Parts {
+        warped: layers::Artwork {
+            width: artwork.width,
+            height: artwork.height,
+            layers: warped,
+            notes: Vec::new(),
+        },
+        bindings: set.bindings,
+        followed: set.followed,
+    })
+}
+
+/// Meshes, sets up and poses each visible layer of `artwork` as a part by `project`'s
+/// handles (see the module documentation); `density` (else the project's, else the
+/// default) is the total over the parts.
+///
+/// # Errors
+/// An LBC project (its cage deforms the picture as a whole), a handle bound to no
+/// part (off every visible layer), or what setting up a part fails with, naming the
+/// layer.
+pub fn set_up_parts(
+    artwork: &layers::Artwork,
+    project: &Project,
+    density: Option<usize>,
+    listener: &dyn Listener,
+) -> Result<PartSet> {
+    if project.method.controls() == Controls::Cage {
+        bail!("a cage (LBC) deforms the picture as a whole: use it without parts");
+    }
+    let canvas = canvas_of(artwork);
     let bindings: Vec<Vec<usize>> = artwork
         .layers
         .iter()
@@ -101,48 +163,46 @@ pub fn warp_parts(
     let share = |area: u64| {
         ((total as u128 * u128::from(area) / u128::from(total_area)) as usize).max(MIN_PART_DENSITY)
     };
-    // The visible layers on the canvas, and the bound parts set up and warped.
+    // The visible layers on the canvas, and the bound parts set up.
     let mut on_canvas = Vec::with_capacity(artwork.layers.len());
     let mut warpers: Vec<Option<Warper>> = Vec::with_capacity(artwork.layers.len());
-    let mut pixels = Vec::with_capacity(artwork.layers.len());
     for ((layer, bound), &area) in artwork.layers.iter().zip(&bindings).zip(&areas) {
         if !layer.visible {
             on_canvas.push(None);
             warpers.push(None);
-            pixels.push(Some(layer.pixels.clone()));
             continue;
         }
-        let placed_layer = placed(
-            &layer.pixels,
-            canvas,
-            [i64::from(layer.x), i64::from(layer.y)],
-        )?;
+        let placed_layer = on(layer, canvas)?;
         if bound.is_empty() {
             on_canvas.push(Some(placed_layer));
             warpers.push(None);
-            pixels.push(None);
             continue;
         }
         let part = part_project(project, bound);
         let warper = prepare_warper(&placed_layer.to_rgba8(), &part, Some(share(area)), listener)
             .with_context(|| format!("part \"{}\"", layer.name))?;
-        pixels.push(Some(
-            warp_picture(&placed_layer, &warper)
-                .with_context(|| format!("part \"{}\"", layer.name))?,
-        ));
         on_canvas.push(Some(placed_layer));
         warpers.push(Some(warper));
     }
+    let mut meshes: Vec<Option<PartMesh>> = warpers
+        .iter()
+        .map(|w| {
+            w.as_ref().map(|w| PartMesh {
+                rest: w.deformer.rest().to_vec(),
+                deformed: w.deformer.deformed(),
+                triangles: w.triangles.clone(),
+            })
+        })
+        .collect();
     // The parts no handle binds follow the bound part beneath them they overlap most.
     let mut followed = vec![None; artwork.layers.len()];
     for k in 0..artwork.layers.len() {
-        if pixels[k].is_some() {
-            continue;
-        }
-        let layer = &artwork.layers[k];
         let Some(own) = on_canvas[k].as_ref() else {
             continue;
         };
+        if warpers[k].is_some() {
+            continue;
+        }
         let beneath = (0..k)
             .rev()
             .filter(|&j| warpers[j].is_some())
@@ -157,106 +217,108 @@ pub fn warp_parts(
                 Some((_, m)) if m >= n => best,
                 _ => Some((j, n)),
             });
-        pixels[k] = Some(match beneath {
-            Some((j, _)) => {
-                followed[k] = Some(j);
-                let leader = warpers[j].as_ref().expect("a bound part");
-                follow(own, leader, project, share(areas[k]), listener)
-                    .with_context(|| format!("part \"{}\"", layer.name))?
-            }
-            None => own.clone(),
-        });
+        followed[k] = beneath.map(|(j, _)| j);
+        let leader = beneath.and_then(|(j, _)| warpers[j].as_ref());
+        meshes[k] = Some(
+            follow(own, leader, project, share(areas[k]), listener)
+                .with_context(|| format!("part \"{}\"", artwork.layers[k].name))?,
+        );
     }
-    let warped = artwork
-        .layers
-        .iter()
-        .zip(pixels)
-        .map(|(layer, pixels)| {
-            let (x, y) = if layer.visible {
-                (0, 0)
-            } else {
-                (layer.x, layer.y)
-            };
-            layers::Layer {
-                name: layer.name.clone(),
-                x,
-                y,
-                opacity: layer.opacity,
-                visible: layer.visible,
-                pixels: pixels.expect("every layer drawn"),
-            }
-        })
-        .collect();
-    Ok(Parts {
-        warped: layers::Artwork {
-            width: artwork.width,
-            height: artwork.height,
-            layers: warped,
-            notes: Vec::new(),
-        },
+    Ok(PartSet {
+        meshes,
         bindings,
         followed,
     })
 }
 
-/// `part` (on the canvas) meshed on its own and drawn where `leader`'s warped mesh
-/// takes its vertices.
-fn follow(
-    part: &Picture,
-    leader: &Warper,
-    project: &Project,
-    density: usize,
-    listener: &dyn Listener,
-) -> Result<Picture> {
-    // Its own mesh: the method's setup with no handle is the identity on it.
-    let mut still = part_project(project, &[]);
-    still.method = project::Method::C2;
-    let own = prepare_warper(&part.to_rgba8(), &still, Some(density), listener)?;
-    let rest = own.deformer.rest();
-    let lead = Domain::new(
-        leader.deformer.rest().to_vec(),
-        leader.deformer.triangles().to_vec(),
-        Metric::Euclidean,
-    )
-    .map_err(|e| anyhow::anyhow!("the part beneath: {e}"))?;
-    let lead_deformed = leader.deformer.deformed();
-    let lead_rest = leader.deformer.rest();
-    let moved: Vec<DVec2> = rest
-        .iter()
-        .map(|&p| match lead.locate(p) {
-            Some((t, b)) => {
-                let tri = lead.triangles()[t];
-                (0..3).map(|i| lead_deformed[tri[i] as usize] * b[i]).sum()
-            }
-            None => lead
-                .nearest_vertex(p)
-                .map_or(p, |v| p + lead_deformed[v as usize] - lead_rest[v as usize]),
-        })
-        .collect();
-    if moved.iter().any(|p| !p.is_finite()) {
-        anyhow::bail!("the deformation produced non-finite positions");
+/// The artwork's canvas as a frame.
+fn canvas_of(artwork: &layers::Artwork) -> Frame {
+    Frame {
+        origin: [0, 0],
+        width: artwork.width,
+        height: artwork.height,
     }
-    let rest: Vec<Vec2> = rest.iter().map(|p| p.as_vec2()).collect();
-    let moved: Vec<Vec2> = moved.iter().map(|p| p.as_vec2()).collect();
-    let (w, h) = part.dimensions();
+}
+
+/// `layer` on the canvas, at its offset.
+fn on(layer: &layers::Layer, canvas: Frame) -> Result<Picture> {
+    placed(
+        &layer.pixels,
+        canvas,
+        [i64::from(layer.x), i64::from(layer.y)],
+    )
+}
+
+/// `picture` (on the canvas) drawn through `mesh` onto a transparent canvas.
+fn draw(picture: &Picture, mesh: &PartMesh) -> Result<Picture> {
+    if mesh.deformed.iter().any(|p| !p.is_finite()) {
+        bail!("the deformation produced non-finite positions");
+    }
+    let rest: Vec<Vec2> = mesh.rest.iter().map(|p| p.as_vec2()).collect();
+    let moved: Vec<Vec2> = mesh.deformed.iter().map(|p| p.as_vec2()).collect();
+    let (width, height) = picture.dimensions();
     let mut out = blank(
-        part.bits_per_channel(),
+        picture.bits_per_channel(),
         Frame {
             origin: [0, 0],
-            width: w,
-            height: h,
+            width,
+            height,
         },
     )?;
     render::warp_picture_over(
-        part,
+        picture,
         &render::WarpMesh {
             rest: &rest,
             deformed: &moved,
-            triangles: own.deformer.triangles(),
+            triangles: &mesh.triangles,
         },
         &mut out,
     )?;
     Ok(out)
+}
+
+/// `part` (on the canvas) meshed on its own, its vertices where `leader`'s warped mesh
+/// takes them (where they are, without a leader).
+fn follow(
+    part: &Picture,
+    leader: Option<&Warper>,
+    project: &Project,
+    density: usize,
+    listener: &dyn Listener,
+) -> Result<PartMesh> {
+    // Its own mesh: the method's setup with no handle is the identity on it.
+    let mut still = part_project(project, &[]);
+    still.method = project::Method::C2;
+    let own = prepare_warper(&part.to_rgba8(), &still, Some(density), listener)?;
+    let rest = own.deformer.rest().to_vec();
+    let deformed = match leader {
+        None => rest.clone(),
+        Some(leader) => {
+            let lead = Domain::new(
+                leader.deformer.rest().to_vec(),
+                leader.deformer.triangles().to_vec(),
+                Metric::Euclidean,
+            )
+            .map_err(|e| anyhow::anyhow!("the part beneath: {e}"))?;
+            let (lead_rest, lead_deformed) = (leader.deformer.rest(), leader.deformer.deformed());
+            rest.iter()
+                .map(|&p| match lead.locate(p) {
+                    Some((t, b)) => {
+                        let tri = lead.triangles()[t];
+                        (0..3).map(|i| lead_deformed[tri[i] as usize] * b[i]).sum()
+                    }
+                    None => lead
+                        .nearest_vertex(p)
+                        .map_or(p, |v| p + lead_deformed[v as usize] - lead_rest[v as usize]),
+                })
+                .collect()
+        }
+    };
+    Ok(PartMesh {
+        rest,
+        deformed,
+        triangles: own.triangles.clone(),
+    })
 }
 
 /// The number of canvas pixels visible in both `a` and `b` (the same size).
