@@ -42,6 +42,7 @@ mod area;
 mod distance;
 mod intersect;
 pub mod lattice;
+mod order;
 mod similarity;
 mod simplify;
 
@@ -51,5 +52,6 @@ pub use distance::{
     polyline_distance_squared, segment_distance,
 };
 pub use intersect::{segments_cross, segments_touch};
+pub use order::z_order;
 pub use similarity::Similarity;
 pub use simplify::{douglas_peucker, farthest_from_chord};

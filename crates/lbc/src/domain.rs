@@ -98,7 +98,7 @@ impl Domain {
         // vertex, so that neighbours sit near each other in memory (spade refines in
         // no spatial order; the solve's passes over the triangles read their
         // corners' rows).
-        let order = z_order(&positions);
+        let order = geometry::z_order(&positions);
         let mut renumber = vec![0u32; positions.len()];
         for (new, &old) in order.iter().enumerate() {
             renumber[old as usize] = new as u32;
@@ -299,29 +299,4 @@ impl Domain {
 
 fn p_of(p: Point2<f64>) -> DVec2 {
     DVec2::new(p.x, p.y)
-}
-
-/// The points' indices sorted along a Z-order (Morton) curve over their bounding box.
-fn z_order(points: &[DVec2]) -> Vec<u32> {
-    let lo = points.iter().copied().fold(DVec2::INFINITY, DVec2::min);
-    let hi = points.iter().copied().fold(DVec2::NEG_INFINITY, DVec2::max);
-    let scale = 65535.0 / (hi - lo).max_element().max(f64::MIN_POSITIVE);
-    let spread = |x: u32| {
-        let mut x = u64::from(x);
-        x = (x | (x << 16)) & 0x0000_ffff_0000_ffff;
-        x = (x | (x << 8)) & 0x00ff_00ff_00ff_00ff;
-        x = (x | (x << 4)) & 0x0f0f_0f0f_0f0f_0f0f;
-        x = (x | (x << 2)) & 0x3333_3333_3333_3333;
-        (x | (x << 1)) & 0x5555_5555_5555_5555
-    };
-    let mut keyed: Vec<(u64, u32)> = points
-        .iter()
-        .enumerate()
-        .map(|(i, p)| {
-            let q = (*p - lo) * scale;
-            (spread(q.x as u32) | (spread(q.y as u32) << 1), i as u32)
-        })
-        .collect();
-    keyed.sort_unstable();
-    keyed.into_iter().map(|(_, i)| i).collect()
 }

@@ -780,7 +780,7 @@ fn build_mesh(
     }
     // Vertices in Z order (by position), so that mesh neighbours are mostly near in
     // memory too: graph searches over the mesh then run from cache.
-    let order = z_order(&vertices);
+    let order = geometry::z_order(&vertices);
     let mut rank = vec![0u32; vertices.len()];
     for (r, &v) in order.iter().enumerate() {
         rank[v as usize] = r as u32;
@@ -802,38 +802,6 @@ fn build_mesh(
         new_index,
         paths,
     })
-}
-
-/// The indices of `points` sorted along the Z-order (Morton) curve of their positions
-/// quantised to a 65536 × 65536 grid over their bounding box (ties by index).
-fn z_order(points: &[DVec2]) -> Vec<u32> {
-    let (lo, hi) = points.iter().fold(
-        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
-        |(lo, hi), &p| (lo.min(p), hi.max(p)),
-    );
-    let scale = 65535.0 / (hi - lo).max_element().max(f64::MIN_POSITIVE);
-    let spread = |x: u32| -> u64 {
-        let mut x = u64::from(x);
-        x = (x | (x << 16)) & 0x0000_ffff_0000_ffff;
-        x = (x | (x << 8)) & 0x00ff_00ff_00ff_00ff;
-        x = (x | (x << 4)) & 0x0f0f_0f0f_0f0f_0f0f;
-        x = (x | (x << 2)) & 0x3333_3333_3333_3333;
-        (x | (x << 1)) & 0x5555_5555_5555_5555
-    };
-    let mut keyed: Vec<(u64, u32)> = points
-        .iter()
-        .enumerate()
-        .map(|(i, &p)| {
-            let q = (p - lo) * scale;
-            let (x, y) = (
-                q.x.clamp(0.0, 65535.0) as u32,
-                q.y.clamp(0.0, 65535.0) as u32,
-            );
-            (spread(x) | (spread(y) << 1), i as u32)
-        })
-        .collect();
-    keyed.sort_unstable();
-    keyed.into_iter().map(|(_, i)| i).collect()
 }
 
 /// Whether a ring is convex (collinear vertices allowed).
