@@ -319,14 +319,17 @@ fn deform_parts_writes_one_object_per_part() {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
     let rig = root.join("assets/puppet-rig.json");
     let obj = dir.path().join("cat.obj");
-    ok(&[
-        OsStr::new("deform"),
-        OsStr::new("--parts"),
-        OsStr::new("--rig"),
-        rig.as_os_str(),
-        OsStr::new("-o"),
-        obj.as_os_str(),
-    ]);
+    let deform_parts = |rig: &Path, obj: &Path| {
+        ok(&[
+            OsStr::new("deform"),
+            OsStr::new("--parts"),
+            OsStr::new("--rig"),
+            rig.as_os_str(),
+            OsStr::new("-o"),
+            obj.as_os_str(),
+        ]);
+    };
+    deform_parts(&rig, &obj);
     let text = fs::read_to_string(&obj).expect("the OBJ");
     // Objects in the layers' order, each with its own vertices and triangles.
     /// An OBJ object: its name, vertices and faces.
@@ -399,14 +402,7 @@ fn deform_parts_writes_one_object_per_part() {
     let rest_rig = dir.path().join("rest.json");
     fs::write(&rest_rig, rest.to_json()).expect("write the rest rig");
     let rest_obj = dir.path().join("rest.obj");
-    ok(&[
-        OsStr::new("deform"),
-        OsStr::new("--parts"),
-        OsStr::new("--rig"),
-        rest_rig.as_os_str(),
-        OsStr::new("-o"),
-        rest_obj.as_os_str(),
-    ]);
+    deform_parts(&rest_rig, &rest_obj);
     let at_rest = fs::read_to_string(&rest_obj).expect("the OBJ at rest");
     let object = |text: &str, name: &str| -> Vec<String> {
         text.lines()
