@@ -83,7 +83,7 @@ pub fn warp_parts(
                 let on_canvas = on(layer, canvas)?;
                 let drawn =
                     draw(&on_canvas, mesh).with_context(|| format!("part \"{}\"", layer.name))?;
-                (0, 0, drawn)
+                cropped(drawn, &mesh.deformed)
             }
         };
         warped.push(layers::Layer {
@@ -163,25 +163,17 @@ pub fn set_up_parts(
     let share = |area: u64| {
         ((total as u128 * u128::from(area) / u128::from(total_area)) as usize).max(MIN_PART_DENSITY)
     };
-    // The visible layers on the canvas, and the bound parts set up.
-    let mut on_canvas = Vec::with_capacity(artwork.layers.len());
+    // The bound parts set up, each layer put on the canvas only while it is meshed.
     let mut warpers: Vec<Option<Warper>> = Vec::with_capacity(artwork.layers.len());
     for ((layer, bound), &area) in artwork.layers.iter().zip(&bindings).zip(&areas) {
-        if !layer.visible {
-            on_canvas.push(None);
-            warpers.push(None);
-            continue;
-        }
-        let placed_layer = on(layer, canvas)?;
-        if bound.is_empty() {
-            on_canvas.push(Some(placed_layer));
+        if !layer.visible || bound.is_empty() {
             warpers.push(None);
             continue;
         }
         let part = part_project(project, bound);
+        let placed_layer = on(layer, canvas)?;
         let warper = prepare_warper(&placed_layer.to_rgba8(), &part, Some(share(area)), listener)
             .with_context(|| format!("part \"{}\"", layer.name))?;
-        on_canvas.push(Some(placed_layer));
         warpers.push(Some(warper));
     }
     let mut meshes: Vec<Option<PartMesh>> = warpers
@@ -196,22 +188,14 @@ pub fn set_up_parts(
         .collect();
     // The parts no handle binds follow the bound part beneath them they overlap most.
     let mut followed = vec![None; artwork.layers.len()];
-    for k in 0..artwork.layers.len() {
-        let Some(own) = on_canvas[k].as_ref() else {
-            continue;
-        };
-        if warpers[k].is_some() {
+    for (k, layer) in artwork.layers.iter().enumerate() {
+        if !layer.visible || warpers[k].is_some() {
             continue;
         }
         let beneath = (0..k)
             .rev()
             .filter(|&j| warpers[j].is_some())
-            .map(|j| {
-                (
-                    j,
-                    overlap(own, on_canvas[j].as_ref().expect("a visible part")),
-                )
-            })
+            .map(|j| (j, overlap(layer, &artwork.layers[j])))
             .filter(|&(_, n)| n > 0)
             .fold(None, |best: Option<(usize, u64)>, (j, n)| match best {
                 Some((_, m)) if m >= n => best,
@@ -220,8 +204,14 @@ pub fn set_up_parts(
         followed[k] = beneath.map(|(j, _)| j);
         let leader = beneath.and_then(|(j, _)| warpers[j].as_ref());
         meshes[k] = Some(
-            follow(own, leader, project, share(areas[k]), listener)
-                .with_context(|| format!("part \"{}\"", artwork.layers[k].name))?,
+            follow(
+                &on(layer, canvas)?,
+                leader,
+                project,
+                share(areas[k]),
+                listener,
+            )
+            .with_context(|| format!("part \"{}\"", layer.name))?,
         );
     }
     Ok(PartSet {
@@ -247,6 +237,36 @@ fn on(layer: &layers::Layer, canvas: Frame) -> Result<Picture> {
         canvas,
         [i64::from(layer.x), i64::from(layer.y)],
     )
+}
+
+/// `drawn` (a part on the whole canvas) cut to the pixels its warped mesh `deformed`
+/// can touch, with their offset on the canvas: flattening and writing the parts then
+/// handles each part's own rectangle, not the canvas.
+fn cropped(drawn: Picture, deformed: &[DVec2]) -> (i32, i32, Picture) {
+    let (w, h) = drawn.dimensions();
+    let lo = deformed.iter().copied().fold(DVec2::INFINITY, DVec2::min);
+    let hi = deformed
+        .iter()
+        .copied()
+        .fold(DVec2::NEG_INFINITY, DVec2::max);
+    // A pixel is touched where its square meets a triangle: one pixel of margin.
+    let x0 = (lo.x.floor() - 1.0).clamp(0.0, f64::from(w)) as u32;
+    let y0 = (lo.y.floor() - 1.0).clamp(0.0, f64::from(h)) as u32;
+    let x1 = (hi.x.ceil() + 1.0).clamp(f64::from(x0), f64::from(w)) as u32;
+    let y1 = (hi.y.ceil() + 1.0).clamp(f64::from(y0), f64::from(h)) as u32;
+    if (x0, y0, x1, y1) == (0, 0, w, h) {
+        return (0, 0, drawn);
+    }
+    let (cw, ch) = (x1 - x0, y1 - y0);
+    let pixels = match &drawn {
+        Picture::Rgba8(im) => {
+            Picture::Rgba8(image::imageops::crop_imm(im, x0, y0, cw, ch).to_image())
+        }
+        Picture::Rgba16(im) => {
+            Picture::Rgba16(image::imageops::crop_imm(im, x0, y0, cw, ch).to_image())
+        }
+    };
+    (x0 as i32, y0 as i32, pixels)
 }
 
 /// `picture` (on the canvas) drawn through `mesh` onto a transparent canvas.
@@ -321,13 +341,29 @@ fn follow(
     })
 }
 
-/// The number of canvas pixels visible in both `a` and `b` (the same size).
-fn overlap(a: &Picture, b: &Picture) -> u64 {
-    let (w, h) = a.dimensions();
+/// The number of canvas pixels where both layers have a visible pixel.
+fn overlap(a: &layers::Layer, b: &layers::Layer) -> u64 {
+    let rect = |l: &layers::Layer| {
+        let (w, h) = l.dimensions();
+        (
+            i64::from(l.x),
+            i64::from(l.y),
+            i64::from(l.x) + i64::from(w),
+            i64::from(l.y) + i64::from(h),
+        )
+    };
+    let ((ax0, ay0, ax1, ay1), (bx0, by0, bx1, by1)) = (rect(a), rect(b));
     let mut n = 0;
-    for y in 0..h {
-        for x in 0..w {
-            n += u64::from(alpha(a, x, y) > 0 && alpha(b, x, y) > 0);
+    for y in ay0.max(by0)..ay1.min(by1) {
+        for x in ax0.max(bx0)..ax1.min(bx1) {
+            let seen = |l: &layers::Layer| {
+                alpha(
+                    &l.pixels,
+                    (x - i64::from(l.x)) as u32,
+                    (y - i64::from(l.y)) as u32,
+                ) > 0
+            };
+            n += u64::from(seen(a) && seen(b));
         }
     }
     n

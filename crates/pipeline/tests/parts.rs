@@ -41,11 +41,15 @@ fn rig(handles: &str) -> Project {
     .expect("a rig")
 }
 
-fn rgba8(layer: &Layer) -> &RgbaImage {
-    match &layer.pixels {
-        Picture::Rgba8(im) => im,
-        Picture::Rgba16(_) => panic!("8-bit test layers"),
-    }
+/// A warped layer on the 200 × 120 canvas (the warped parts come cut to their own
+/// rectangles, with their offsets).
+fn rgba8(layer: &Layer) -> RgbaImage {
+    let Picture::Rgba8(pixels) = &layer.pixels else {
+        panic!("8-bit test layers");
+    };
+    let mut canvas = RgbaImage::new(200, 120);
+    image::imageops::replace(&mut canvas, pixels, i64::from(layer.x), i64::from(layer.y));
+    canvas
 }
 
 #[test]
@@ -104,6 +108,14 @@ fn at_rest_the_parts_composite_to_the_layers_flattened() {
     assert!(
         worst <= 1,
         "differs from the layers flattened by {worst} levels"
+    );
+    // Each part comes cut to the rectangle its mesh can touch, not the whole canvas.
+    let right = &parts.warped.layers[1];
+    let (w, h) = right.dimensions();
+    assert!(
+        right.x >= 76 && right.y >= 16 && w <= 118 && h <= 88,
+        "{:?}",
+        (right.x, right.y, w, h)
     );
 }
 
