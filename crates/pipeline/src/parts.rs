@@ -370,7 +370,7 @@ fn overlap(a: &layers::Layer, b: &layers::Layer) -> u64 {
 }
 
 /// `project` with the handles `bound` alone (their holds and overlay kept, renumbered),
-/// no animation, on the canvas as it is.
+/// no virtual handle, no animation, on the canvas as it is.
 fn part_project(project: &Project, bound: &[usize]) -> Project {
     let index = |h: usize| bound.iter().position(|&b| b == h);
     let mut part = project.clone();
@@ -386,6 +386,10 @@ fn part_project(project: &Project, bound: &[usize]) -> Project {
             })
         })
         .collect();
+    // Virtual handles were placed on the whole picture, some off this part: each part
+    // places its own (the C² paper's Algorithm 1 on its shape).
+    part.virtual_handles.clear();
+    part.virtual_placed_for.clear();
     part.animation = None;
     part.canvas = Canvas::Keep;
     part

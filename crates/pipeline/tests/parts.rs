@@ -185,3 +185,15 @@ fn a_part_no_handle_binds_follows_the_part_beneath_it() {
     assert_eq!(dot.get_pixel(195, 3).0, [0, 0, 0, 255]);
     assert_eq!(dot.get_pixel(190, 3).0, [0; 4]);
 }
+
+#[test]
+fn virtual_handles_of_the_whole_picture_do_not_reach_the_parts() {
+    // A project saved from the flattened picture keeps its virtual handles; one lies
+    // on the left part only, for the right part's handle.
+    let mut project = rig(r#"{"type": "point", "rest": [30, 60]},
+           {"type": "point", "rest": [170, 60], "translate": [4, 0]}"#);
+    project.virtual_handles = vec![[20.0, 30.0]];
+    project.virtual_placed_for = vec![Some(1)];
+    let parts = warp_parts(&two_parts(), &project, None, &()).expect("warps");
+    assert_eq!(parts.bindings, vec![vec![0], vec![1]]);
+}
