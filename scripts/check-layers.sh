@@ -3,7 +3,7 @@
 # drawing know no UI; fail if a dependency tree says otherwise (see ARCHITECTURE.md).
 set -euo pipefail
 status=0
-for crate in geometry weights-core arap lbc mls animation; do
+for crate in geometry weights-core arap lbc mls animation depth; do
   tree=$(cargo tree -p "$crate" -e normal --prefix none)
   if echo "$tree" | grep -Eq '^(egui|eframe|wgpu|rfd|winit|image) '; then
     echo "layering: $crate depends on: $(echo "$tree" | grep -Eo '^(egui|eframe|wgpu|rfd|winit|image) ' | sort -u | tr '\n' ' ')"
