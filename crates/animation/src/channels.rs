@@ -111,7 +111,11 @@ impl<'a> Layout<'a> {
                 .map(|p| [p[0], p[1]])
                 .collect()
         });
-        Pose { handles, cage }
+        Pose {
+            handles,
+            cage,
+            overlaps: Vec::new(),
+        }
     }
 }
 
@@ -161,6 +165,7 @@ mod tests {
                 },
             ],
             cage: None,
+            overlaps: Vec::new(),
         };
         let mut c = Vec::new();
         layout.channels(&pose, None, &mut c);

@@ -179,6 +179,7 @@ mod tests {
                         },
                     ],
                     cage: None,
+                    overlaps: Vec::new(),
                 }
             })
             .collect()

@@ -132,7 +132,11 @@ impl SpatialBlend {
                 *b += w * c;
             }
         }
-        Some(layout.pose(&blend))
+        // Overlap orders do not blend: the key weighing most lends its own.
+        let heaviest = (0..keys.len()).max_by(|&a, &b| weights[a].total_cmp(&weights[b]));
+        let mut pose = layout.pose(&blend);
+        pose.overlaps = heaviest.map_or_else(Vec::new, |k| keys[k].pose.overlaps.clone());
+        Some(pose)
     }
 }
 
@@ -199,6 +203,7 @@ mod tests {
                     HandlePose::Bar { pose: bar },
                 ],
                 cage: None,
+                overlaps: Vec::new(),
             },
         };
         p.animation = Some(Animation {

@@ -52,7 +52,11 @@ pub fn pose_at(project: &Project, time: f64) -> Option<Pose> {
                 .collect()
         }
     };
-    Some(layout.pose(&channels))
+    // Overlap orders do not interpolate: between two keys, the earlier key's hold
+    // while its regions last.
+    let mut pose = layout.pose(&channels);
+    pose.overlaps = a.pose.overlaps.clone();
+    Some(pose)
 }
 
 /// The cubic Hermite basis at `u`: `(h00, h10, h01, h11)`.
@@ -161,7 +165,11 @@ mod tests {
         Key {
             time,
             hold: false,
-            pose: Pose { handles, cage },
+            pose: Pose {
+                handles,
+                cage,
+                overlaps: Vec::new(),
+            },
         }
     }
 
@@ -260,6 +268,7 @@ mod tests {
                     bar([30.0, 7.5], [30.0, 32.5])
                 ],
                 cage: Some(vec![[0.0, 0.0], [57.5, 0.0], [50.0, 42.5]]),
+                overlaps: Vec::new(),
             },
             1e-12
         ));

@@ -25,6 +25,7 @@ fn pose(p: [f64; 6]) -> Pose {
             },
         ],
         cage: None,
+        overlaps: Vec::new(),
     }
 }
 

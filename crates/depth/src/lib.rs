@@ -149,8 +149,11 @@ fn grow_regions(triangles: &[[u32; 3]], pairs: &[overlap::Pair]) -> Grown {
         pairs_of.entry(p.s).or_default().push(k);
         pairs_of.entry(p.t).or_default().push(k);
     }
+    // (In the triangles' order: the regions must not depend on a hash's order.)
+    let mut involved: Vec<u32> = pairs_of.keys().copied().collect();
+    involved.sort_unstable();
     let mut at_vertex: HashMap<u32, Vec<u32>> = HashMap::new();
-    for &t in pairs_of.keys() {
+    for &t in &involved {
         for v in triangles[t as usize] {
             at_vertex.entry(v).or_default().push(t);
         }
@@ -162,11 +165,18 @@ fn grow_regions(triangles: &[[u32; 3]], pairs: &[overlap::Pair]) -> Grown {
     let mut sides: Vec<Option<(usize, bool)>> = vec![None; pairs.len()];
     let mut count = 0;
     let mut stack = Vec::new();
+    // The sheet (true: A) each triangle is on in the region being grown: a pair that
+    // would put a triangle on both sheets (where a fold's crease joins them) is left
+    // to a region of its own.
+    let mut sheet: HashMap<u32, bool> = HashMap::new();
     for start in 0..pairs.len() {
         if sides[start].is_some() {
             continue;
         }
+        sheet.clear();
         sides[start] = Some((count, true));
+        sheet.insert(pairs[start].s, true);
+        sheet.insert(pairs[start].t, false);
         stack.push(start);
         while let Some(k) = stack.pop() {
             let (_, s_in_a) = sides[k].expect("visited");
@@ -186,8 +196,11 @@ fn grow_regions(triangles: &[[u32; 3]], pairs: &[overlap::Pair]) -> Grown {
                         } else {
                             pairs[j].s
                         };
-                        if touch(other, b) {
+                        let fits = |t: u32, on_a: bool| sheet.get(&t).is_none_or(|&s| s == on_a);
+                        if touch(other, b) && fits(a2, true) && fits(other, false) {
                             sides[j] = Some((count, pairs[j].s == a2));
+                            sheet.insert(a2, true);
+                            sheet.insert(other, false);
                             stack.push(j);
                         }
                     }

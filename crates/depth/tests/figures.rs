@@ -303,3 +303,28 @@ fn no_overlap_keeps_the_predefined_order_and_three_sheets_in_a_cycle_are_drawn()
     sorted.sort_unstable();
     assert_eq!(sorted, predefined, "every triangle drawn once");
 }
+
+#[test]
+fn the_arrangement_is_a_function_of_the_pose_alone() {
+    // A strip wound into a spiral, each turn over the one before.
+    let mut scene = Scene::default();
+    scene.piece(120, 2, |u, v| {
+        let angle = u * 0.12;
+        let radius = 4.0 + u * 0.02 + v;
+        DVec2::new(radius * angle.cos(), radius * angle.sin())
+    });
+    let predefined: Vec<u32> = (0..scene.triangles.len() as u32).collect();
+    let first = arrange(&scene.positions, &scene.triangles, &predefined, &[]);
+    assert!(!first.regions.is_empty());
+    for _ in 0..8 {
+        let again = arrange(&scene.positions, &scene.triangles, &predefined, &[]);
+        assert_eq!(again, first);
+        let kept = arrange(
+            &scene.positions,
+            &scene.triangles,
+            &predefined,
+            &first.regions,
+        );
+        assert_eq!(kept.order, first.order);
+    }
+}

@@ -60,7 +60,11 @@ fn pose(project: &Project, k: f64) -> Pose {
             })
             .collect()
     });
-    Pose { handles, cage }
+    Pose {
+        handles,
+        cage,
+        overlaps: Vec::new(),
+    }
 }
 
 /// Median, 90th percentile and largest of `times` (milliseconds).

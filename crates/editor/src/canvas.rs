@@ -100,6 +100,9 @@ impl EditorApp {
                 Color32::LIGHT_RED,
             );
         }
+        if self.show.overlaps {
+            self.paint_overlaps(&painter);
+        }
         if cage_view {
             let pointer = ui.input(|i| i.pointer.latest_pos());
             let active = self.tool == Tool::Cage;
@@ -370,6 +373,55 @@ pub(crate) fn node_name(rig: &weights_core::Rig, k: usize) -> String {
 }
 
 impl EditorApp {
+    /// The overlap regions of the shown pose outlined: each sheet's boundary (its
+    /// triangles' edges that no other triangle of the sheet shares), the front sheet
+    /// in yellow, the back one in blue.
+    fn paint_overlaps(&mut self, painter: &egui::Painter) {
+        let Some(doc) = &mut self.doc else { return };
+        let cage = doc.method().controls() == pipeline::Controls::Cage;
+        let (positions, triangles): (Vec<DVec2>, Vec<[u32; 3]>) = if cage {
+            match doc.cage_deformer() {
+                Some(c) => (
+                    pipeline::Deformer::deformed(c),
+                    pipeline::Deformer::triangles(c).to_vec(),
+                ),
+                None => return,
+            }
+        } else {
+            let triangles = doc.deformer().triangles().to_vec();
+            (doc.deformed().to_vec(), triangles)
+        };
+        let viewport = &self.viewport;
+        let outline = |sheet: &[u32], colour: Color32| {
+            let mut edges: std::collections::HashMap<(u32, u32), u32> =
+                std::collections::HashMap::new();
+            for &t in sheet {
+                let Some(&[a, b, c]) = triangles.get(t as usize) else {
+                    continue;
+                };
+                for (u, v) in [(a, b), (b, c), (c, a)] {
+                    *edges.entry((u.min(v), u.max(v))).or_default() += 1;
+                }
+            }
+            for ((u, v), count) in edges {
+                let (Some(&p), Some(&q)) = (positions.get(u as usize), positions.get(v as usize))
+                else {
+                    continue;
+                };
+                if count == 1 {
+                    painter.line_segment(
+                        [viewport.to_screen(p), viewport.to_screen(q)],
+                        egui::Stroke::new(1.5, colour),
+                    );
+                }
+            }
+        };
+        for region in doc.overlap_regions() {
+            outline(&region.back, Color32::from_rgb(90, 160, 255));
+            outline(&region.front, Color32::from_rgb(255, 220, 60));
+        }
+    }
+
     /// The onion skin, when on (and not while playing): the previous and next keys'
     /// pictures ghosted under the current one.
     fn paint_onion(&mut self, ui: &Ui, painter: &egui::Painter) {

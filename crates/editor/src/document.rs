@@ -26,6 +26,7 @@ use weights_core::{Domain, NodeKind, Rig, VirtualHandle};
 mod animation;
 mod cage;
 mod checks;
+mod depth;
 #[cfg(test)]
 mod tests;
 
@@ -121,6 +122,8 @@ pub enum Edit {
     /// The animation: keys in time and on the canvas, rate, interpolation (`None`:
     /// none).
     Animation(Option<Box<project::Animation>>),
+    /// Automatic depth (the ARAP paper's §5.1) on or off.
+    AutoDepth(bool),
 }
 
 /// An open picture with its rig. Cloning copies the rig (tens of megabytes at a
@@ -162,6 +165,10 @@ pub struct Document {
     method: Option<(u64, Box<dyn Deformer>)>,
     /// Solved cages, the most recent last (at most [`SOLUTIONS_KEPT`]).
     solutions: Vec<(CageKey, Arc<CageCoordinates>)>,
+    /// Automatic depth's arrangement of the shown mesh (`None` with it off).
+    depth: Option<depth::Depth>,
+    /// Bumped whenever the drawing order may have changed.
+    pub order_version: u64,
 }
 
 impl Document {
@@ -214,6 +221,8 @@ impl Document {
             mesh_version: 1,
             method: None,
             solutions: Vec::new(),
+            depth: None,
+            order_version: 1,
         }
         .with_method()
     }
@@ -230,6 +239,13 @@ impl Document {
     /// when first chosen or with new settings); C² is the rig itself; a cage method is
     /// the solved cage's ([`Document::cage_solution`]).
     fn sync_method(&mut self) -> Result<()> {
+        self.sync_deformer()?;
+        self.rearrange();
+        Ok(())
+    }
+
+    /// [`Document::sync_method`]'s first half: the deformer alone.
+    fn sync_deformer(&mut self) -> Result<()> {
         if self.project.method.controls() == Controls::Cage {
             return self.sync_cage();
         }
@@ -251,8 +267,11 @@ impl Document {
     }
 
     /// The mesh's triangles in drawing order, back to front, by the handles' depths
-    /// (see [`pipeline::order`]).
+    /// and automatic depth (see [`pipeline::order`]).
     pub fn draw_order(&self) -> Vec<[u32; 3]> {
+        if let Some(depth) = self.depth.as_ref().filter(|d| !d.is_cage()) {
+            return depth.order.clone();
+        }
         let depths: Vec<i32> = self.project.handles.iter().map(HandleSpec::depth).collect();
         pipeline::draw_order(&self.rig, &depths)
     }
@@ -538,6 +557,10 @@ impl Document {
                 self.check_cage(&project)?;
             }
             Edit::Canvas(canvas) => project.canvas = canvas,
+            Edit::AutoDepth(on) => {
+                project.auto_depth = on;
+                project.overlaps.clear();
+            }
             Edit::Mls(settings) => {
                 project.mls = Some(settings);
                 project

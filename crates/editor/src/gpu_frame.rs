@@ -47,6 +47,8 @@ pub(crate) struct FrameBuilder {
 #[derive(Default, Clone)]
 struct Seen {
     weights: u64,
+    /// The document's drawing order.
+    order: u64,
     pose: u64,
     heat: Option<(usize, u64)>,
     cells: u64,
@@ -85,6 +87,7 @@ impl FrameBuilder {
         }
         let mesh_changed = image_is_new
             || weights != self.seen.weights
+            || doc.order_version != self.seen.order
             || view.cage_view != self.seen.cage_view
             || view.warping != self.seen.warping;
         if mesh_changed {
@@ -95,6 +98,7 @@ impl FrameBuilder {
         }
         self.update_overlays(doc, view);
         self.seen.weights = weights;
+        self.seen.order = doc.order_version;
         self.seen.pose = doc.pose_version;
         self.seen.cage_view = view.cage_view;
         self.seen.warping = view.warping;
@@ -105,7 +109,12 @@ impl FrameBuilder {
     fn update_mesh(&mut self, doc: &Document, cage_view: bool, cage: Option<&dyn Deformer>) {
         let size = [doc.image.width(), doc.image.height()];
         let mesh = match (cage_view, cage) {
-            (true, Some(cage)) => skinned_mesh(cage, cage.triangles().to_vec(), size),
+            (true, Some(cage)) => {
+                let order = doc
+                    .cage_draw_order()
+                    .unwrap_or_else(|| cage.triangles().to_vec());
+                skinned_mesh(cage, order, size)
+            }
             // No cage to warp by: the picture at rest alone.
             (true, None) => MeshData {
                 rows: vec![0],

@@ -177,6 +177,12 @@ pub fn describe_change(from: &Project, to: &Project) -> String {
     if from.canvas != to.canvas {
         parts.push("the export canvas".to_owned());
     }
+    if from.auto_depth != to.auto_depth {
+        parts.push(format!(
+            "automatic depth {}",
+            if to.auto_depth { "on" } else { "off" }
+        ));
+    }
     if from.arap != to.arap {
         parts.push("ARAP's settings".to_owned());
     }

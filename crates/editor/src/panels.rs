@@ -520,6 +520,11 @@ impl EditorApp {
                 "The selected handle's weight, with isolines every 0.1"
             });
         ui.checkbox(&mut self.show.folds, "Fold-overs");
+        ui.checkbox(&mut self.show.overlaps, "Overlap regions")
+            .on_hover_text(
+                "Where the warped picture overlaps itself: the part drawn in front outlined in \
+             yellow, the part behind in blue (automatic depth)",
+            );
         ui.checkbox(&mut self.show.hover_weights, "Weights under cursor");
         if !cage {
             ui.checkbox(&mut self.show.rigidity, "Painted rigidity");

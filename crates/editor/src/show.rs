@@ -15,6 +15,9 @@ pub struct Show {
     pub heat: bool,
     /// Fold-overs in red.
     pub folds: bool,
+    /// The overlap regions automatic depth orders: each front sheet outlined in
+    /// yellow, each back sheet in blue.
+    pub overlaps: bool,
     /// The weights under the cursor.
     pub hover_weights: bool,
     /// Painted rigidity, translucent.
@@ -34,6 +37,7 @@ impl Default for Show {
             dual_graph: false,
             heat: false,
             folds: true,
+            overlaps: false,
             hover_weights: true,
             rigidity: true,
             contour: true,

@@ -313,10 +313,11 @@ fn every_handle_method_shows_its_own_answer_between_keys() {
         let doc = h.state().document().expect("doc");
         let project = doc.project().clone();
         assert_eq!(keys(&h).len(), 2, "{label}");
-        assert_eq!(
-            Pose::of(&project),
-            animation::pose_at(&project, 0.25).expect("a pose"),
-            "{label}"
+        let between = animation::pose_at(&project, 0.25).expect("a pose");
+        assert!(
+            Pose::of(&project).same_controls(&between),
+            "{label}: {:?} {between:?}",
+            Pose::of(&project)
         );
         // What the view draws between the keys is the method's answer for the rig
         // posed at that time, set up afresh.
@@ -341,9 +342,8 @@ fn every_handle_method_shows_its_own_answer_between_keys() {
         let time = h.state().timeline.time;
         let doc = h.state().document().expect("doc");
         let project = doc.project().clone();
-        assert_eq!(
-            Pose::of(&project),
-            animation::pose_at(&project, time).expect("a pose"),
+        assert!(
+            Pose::of(&project).same_controls(&animation::pose_at(&project, time).expect("a pose")),
             "{label}"
         );
         let fresh = pipeline::on_handles(

@@ -421,7 +421,6 @@ impl Scene<'_> {
     fn follow(&self, warper: &mut Warper, time: f64) -> Result<()> {
         let posed = animation::posed_at(self.project, time);
         let followed = warper
-            .deformer
             .follow(&posed)
             .with_context(|| format!("the pose at {time} s"))?;
         if followed == Follow::NeedsSetup {

@@ -673,7 +673,11 @@ mod tests {
     /// The warper of `solved` with the cage in `pose`.
     fn warper(solved: &Arc<CageCoordinates>, pose: &[DVec2], canvas: Canvas) -> crate::Warper {
         let deformer = CageDeformer::new(solved.clone(), pose.to_vec()).expect("a pose");
-        crate::Warper::in_mesh_order(Box::new(deformer), canvas)
+        let project = Project {
+            canvas,
+            ..Project::default()
+        };
+        crate::Warper::in_mesh_order(Box::new(deformer), &project)
     }
 
     /// `image` warped by the cage of `solved` in `pose`.

@@ -581,6 +581,8 @@ pub struct Warper {
     pub triangles: Vec<[u32; 3]>,
     /// The frame drawn: the picture's own, or grown to fit the warp.
     pub canvas: Canvas,
+    /// Automatic depth (see [`order`]); `None` where the project turns it off.
+    arranger: Option<order::Arranger>,
 }
 
 impl Warper {
@@ -591,22 +593,75 @@ impl Warper {
     /// What the method refuses.
     pub fn on_rig(rig: Rig, project: &Project, picture: Option<&RgbaImage>) -> Result<Self> {
         let depths: Vec<i32> = project.handles.iter().map(HandleSpec::depth).collect();
-        let triangles = draw_order(&rig, &depths);
-        Ok(Self {
-            deformer: on_handles(project, rig, picture)?,
-            triangles,
-            canvas: project.canvas,
-        })
+        let predefined = order::predefined_order(&rig, &depths);
+        let deformer = on_handles(project, rig, picture)?;
+        Ok(Self::arranged(deformer, predefined, project))
     }
 
-    /// `deformer` with its triangles drawn in the mesh's order.
-    pub fn in_mesh_order(deformer: Box<dyn Deformer>, canvas: Canvas) -> Self {
-        let triangles = deformer.triangles().to_vec();
-        Self {
+    /// `deformer` with its triangles drawn in the mesh's order (and, with automatic
+    /// depth on in `project`, its overlaps arranged).
+    pub fn in_mesh_order(deformer: Box<dyn Deformer>, project: &Project) -> Self {
+        let predefined = (0..deformer.triangles().len() as u32).collect();
+        Self::arranged(deformer, predefined, project)
+    }
+
+    /// `deformer` drawn in the `predefined` order, adjusted by automatic depth where
+    /// `project` has it on, from the overlap orders it saved.
+    fn arranged(deformer: Box<dyn Deformer>, predefined: Vec<u32>, project: &Project) -> Self {
+        let triangles = order::as_triangles(&predefined, deformer.triangles());
+        let arranger = project.auto_depth.then(|| {
+            order::Arranger::new(
+                predefined,
+                &project.overlaps,
+                deformer.rest(),
+                deformer.triangles(),
+            )
+        });
+        let mut warper = Self {
             deformer,
             triangles,
-            canvas,
+            canvas: project.canvas,
+            arranger,
+        };
+        warper.arrange();
+        warper
+    }
+
+    /// Follows `project`'s pose ([`Deformer::follow`]) and arranges its overlaps
+    /// from the orders `project` keeps (as a new setup for `project` would: an
+    /// animation's frame is `render` of its pose).
+    ///
+    /// # Errors
+    /// As [`Deformer::follow`].
+    pub fn follow(&mut self, project: &Project) -> Result<Follow> {
+        let followed = self.deformer.follow(project)?;
+        if followed == Follow::Followed {
+            if let Some(arranger) = &mut self.arranger {
+                arranger.restart(
+                    &project.overlaps,
+                    self.deformer.rest(),
+                    self.deformer.triangles(),
+                );
+            }
+            self.arrange();
         }
+        Ok(followed)
+    }
+
+    /// Draws the current pose's overlaps in the order automatic depth gives them.
+    fn arrange(&mut self) {
+        if let Some(arranger) = &mut self.arranger {
+            let order = arranger.arrange(&self.deformer.deformed(), self.deformer.triangles());
+            self.triangles = order::as_triangles(&order, self.deformer.triangles());
+        }
+    }
+
+    /// The overlap regions' orders in the current pose, as a rig file keeps them
+    /// (none with automatic depth off).
+    pub fn overlaps(&self) -> Vec<project::OverlapOrder> {
+        self.arranger.as_ref().map_or_else(Vec::new, |a| {
+            a.overlaps(self.deformer.rest(), self.deformer.triangles())
+        })
     }
 
     /// The mesh's vertices at rest in f32: its texture coordinates.

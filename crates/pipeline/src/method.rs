@@ -46,7 +46,7 @@ pub fn setup(source: Source<'_>, project: &Project, listener: &dyn Listener) -> 
         // LBC is the one cage method.
         Controls::Cage => {
             let deformer = CageDeformer::set_up(source, project, listener)?;
-            Ok(Warper::in_mesh_order(Box::new(deformer), project.canvas))
+            Ok(Warper::in_mesh_order(Box::new(deformer), project))
         }
         Controls::Handles => {
             let weighting = |p| listener.weighting(p);

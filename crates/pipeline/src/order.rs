@@ -9,15 +9,33 @@
 //! takes the greatest. The triangles are then drawn in order of depth (a stable
 //! sort: equal depths keep the mesh's order), the same list on the CPU and on the GPU,
 //! so the exported picture equals the preview.
+//!
+//! That order is the *predefined* one. With automatic depth (the project's
+//! `auto_depth`, on by default), the `depth` crate orders each overlap region of the
+//! warped mesh wholly one way, starting from it, and keeps that order while the
+//! region lasts ([`Arranger`]); the project's `overlaps` keep the orders of the pose
+//! it holds, by a point at rest in each sheet.
 
+use glam::DVec2;
+use project::{OverlapOrder, Place};
 use weights_core::Rig;
 
 /// The triangles of `rig`'s mesh in drawing order for the handle depths `depths`
 /// (one per real handle; a missing one is 0): back to front.
 pub fn draw_order(rig: &Rig, depths: &[i32]) -> Vec<[u32; 3]> {
     let triangles = rig.domain().triangles();
+    predefined_order(rig, depths)
+        .into_iter()
+        .map(|t| triangles[t as usize])
+        .collect()
+}
+
+/// As [`draw_order`], each triangle by its index in the mesh's list.
+pub fn predefined_order(rig: &Rig, depths: &[i32]) -> Vec<u32> {
+    let triangles = rig.domain().triangles();
+    let all = 0..triangles.len() as u32;
     if depths.iter().all(|&d| d == 0) {
-        return triangles.to_vec();
+        return all.collect();
     }
     let node_depth: Vec<i32> = (0..rig.nodes().len())
         .map(|k| {
@@ -32,12 +50,125 @@ pub fn draw_order(rig: &Rig, depths: &[i32]) -> Vec<[u32; 3]> {
             .and_then(|&k| node_depth.get(k as usize).copied())
             .unwrap_or(0)
     };
-    let mut keyed: Vec<(i32, [u32; 3])> = triangles
-        .iter()
-        .map(|t| (t.iter().map(|&v| vertex_depth(v)).max().unwrap_or(0), *t))
+    let mut keyed: Vec<(i32, u32)> = all
+        .map(|t| {
+            let depth = triangles[t as usize].iter().map(|&v| vertex_depth(v)).max();
+            (depth.unwrap_or(0), t)
+        })
         .collect();
     keyed.sort_by_key(|&(d, _)| d);
     keyed.into_iter().map(|(_, t)| t).collect()
+}
+
+/// Automatic depth for one mesh: its predefined order and the overlap regions of the
+/// pose last arranged, which the next pose's regions continue.
+#[derive(Clone, Debug)]
+pub struct Arranger {
+    /// The triangles (indices) back to front without adjustment.
+    predefined: Vec<u32>,
+    /// The last pose's regions.
+    regions: Vec<depth::Region>,
+}
+
+impl Arranger {
+    /// Starts from `predefined` (every triangle's index, back to front) and the
+    /// region orders `overlaps` saved with a pose of the mesh whose rest positions
+    /// and triangles are `rest` and `triangles`.
+    pub fn new(
+        predefined: Vec<u32>,
+        overlaps: &[OverlapOrder],
+        rest: &[DVec2],
+        triangles: &[[u32; 3]],
+    ) -> Self {
+        let mut arranger = Self {
+            predefined,
+            regions: Vec::new(),
+        };
+        arranger.restart(overlaps, rest, triangles);
+        arranger
+    }
+
+    /// Forgets the last pose's regions and starts the next arrangement from the
+    /// orders `overlaps` saved (each sheet by the triangle whose rest centroid is
+    /// nearest its place).
+    pub fn restart(&mut self, overlaps: &[OverlapOrder], rest: &[DVec2], triangles: &[[u32; 3]]) {
+        if overlaps.is_empty() {
+            self.regions.clear();
+            return;
+        }
+        let centroids = centroids(rest, triangles);
+        let nearest = |place: &Place| {
+            let at = DVec2::from(place.at);
+            (0..centroids.len() as u32).min_by(|&a, &b| {
+                let d = |t: u32| centroids[t as usize].distance_squared(at);
+                d(a).total_cmp(&d(b))
+            })
+        };
+        self.regions = overlaps
+            .iter()
+            .filter_map(|o| {
+                Some(depth::Region {
+                    front: vec![nearest(&o.front)?],
+                    back: vec![nearest(&o.back)?],
+                })
+            })
+            .collect();
+    }
+
+    /// The triangles (indices) back to front for the mesh warped to `deformed`,
+    /// remembering its regions for the next pose. Positions that are not finite
+    /// leave the predefined order (and nothing is remembered).
+    pub fn arrange(&mut self, deformed: &[DVec2], triangles: &[[u32; 3]]) -> Vec<u32> {
+        if deformed.iter().any(|p| !p.is_finite()) {
+            self.regions.clear();
+            return self.predefined.clone();
+        }
+        let arranged = depth::arrange(deformed, triangles, &self.predefined, &self.regions);
+        self.regions = arranged.regions;
+        arranged.order
+    }
+
+    /// The overlap regions of the pose last arranged.
+    pub fn regions(&self) -> &[depth::Region] {
+        &self.regions
+    }
+
+    /// The regions' orders as a rig file keeps them: the rest centroid of the first
+    /// triangle of each sheet.
+    pub fn overlaps(&self, rest: &[DVec2], triangles: &[[u32; 3]]) -> Vec<OverlapOrder> {
+        let place = |sheet: &[u32]| {
+            sheet.first().map(|&t| {
+                let [a, b, c] = triangles[t as usize].map(|v| rest[v as usize]);
+                let at = (a + b + c) / 3.0;
+                Place {
+                    at: [at.x, at.y],
+                    part: None,
+                }
+            })
+        };
+        self.regions
+            .iter()
+            .filter_map(|r| {
+                Some(OverlapOrder {
+                    front: place(&r.front)?,
+                    back: place(&r.back)?,
+                })
+            })
+            .collect()
+    }
+}
+
+/// Each triangle's centroid.
+fn centroids(rest: &[DVec2], triangles: &[[u32; 3]]) -> Vec<DVec2> {
+    triangles
+        .iter()
+        .map(|t| t.iter().map(|&v| rest[v as usize]).sum::<DVec2>() / 3.0)
+        .collect()
+}
+
+/// `order` (triangle indices) as the triangles themselves.
+pub fn as_triangles(order: &[u32], triangles: &[[u32; 3]]) -> Vec<[u32; 3]> {
+    order.iter().map(|&t| triangles[t as usize]).collect()
 }
 
 #[cfg(test)]

@@ -136,6 +136,9 @@ pub struct Pose {
     pub handles: Vec<HandlePose>,
     /// The cage's posed vertices (`None`: the cage at rest, or no cage).
     pub cage: Option<Vec<[f64; 2]>>,
+    /// The order of the picture's overlap regions in this pose (automatic depth,
+    /// [`Project::overlaps`]).
+    pub overlaps: Vec<crate::OverlapOrder>,
 }
 
 /// One handle's pose: a point's transform about its rest position, or a bar's posed
@@ -239,7 +242,14 @@ impl Pose {
                 .cage
                 .as_ref()
                 .map(|c| c.pose.clone().unwrap_or_else(|| c.rest.clone())),
+            overlaps: project.overlaps.clone(),
         }
+    }
+
+    /// Whether the two poses put every handle and the cage in the same place (their
+    /// overlap orders aside, which follow from them).
+    pub fn same_controls(&self, other: &Pose) -> bool {
+        self.handles == other.handles && self.cage == other.cage
     }
 
     /// Poses `project`'s handles and cage.
@@ -250,6 +260,7 @@ impl Pose {
         if let Some(cage) = &mut project.cage {
             cage.pose = self.cage.clone().filter(|p| *p != cage.rest);
         }
+        project.overlaps = self.overlaps.clone();
     }
 }
 
@@ -286,6 +297,8 @@ struct KeyFields {
     pose: Vec<HandlePose>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     cage: Option<Vec<[f64; 2]>>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    overlaps: Vec<crate::OverlapOrder>,
 }
 
 /// [`SpatialKey`] as the file has it.
@@ -297,6 +310,8 @@ struct SpatialKeyFields {
     pose: Vec<HandlePose>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     cage: Option<Vec<[f64; 2]>>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    overlaps: Vec<crate::OverlapOrder>,
 }
 
 impl From<KeyFields> for Key {
@@ -307,6 +322,7 @@ impl From<KeyFields> for Key {
             pose: Pose {
                 handles: k.pose,
                 cage: k.cage,
+                overlaps: k.overlaps,
             },
         }
     }
@@ -319,6 +335,7 @@ impl From<Key> for KeyFields {
             hold: k.hold,
             pose: k.pose.handles,
             cage: k.pose.cage,
+            overlaps: k.pose.overlaps,
         }
     }
 }
@@ -330,6 +347,7 @@ impl From<SpatialKeyFields> for SpatialKey {
             pose: Pose {
                 handles: k.pose,
                 cage: k.cage,
+                overlaps: k.overlaps,
             },
         }
     }
@@ -341,6 +359,7 @@ impl From<SpatialKey> for SpatialKeyFields {
             at: k.at,
             pose: k.pose.handles,
             cage: k.pose.cage,
+            overlaps: k.pose.overlaps,
         }
     }
 }

@@ -587,7 +587,50 @@ pub struct Project {
     /// each stroke's parts inside the shape, so no distance crosses it.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub cuts: Vec<Cut>,
+    /// Automatic depth adjustment (the ARAP paper's §5.1): where the warped picture
+    /// overlaps itself, each overlap region is drawn wholly in front or wholly behind,
+    /// and keeps its order while it lasts. On unless `false`.
+    #[serde(default = "yes", skip_serializing_if = "is_true")]
+    pub auto_depth: bool,
+    /// The order of the overlap regions in the pose the handles hold (what automatic
+    /// depth decided, so that a reopened file draws what was shown).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub overlaps: Vec<OverlapOrder>,
 }
+
+fn yes() -> bool {
+    true
+}
+
+fn is_true(value: &bool) -> bool {
+    *value
+}
+
+/// One overlap region's order: a point of its front sheet and one of its back sheet,
+/// at rest (`{"front": {"at": [x, y]}, "back": {"at": [x, y]}}`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OverlapOrder {
+    /// A place in the sheet drawn in front.
+    pub front: Place,
+    /// A place in the sheet drawn behind.
+    pub back: Place,
+}
+
+/// A place on the picture at rest: a point, and for a layered picture drawn as parts,
+/// the part (its layer's index, bottom first) it lies on.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Place {
+    /// The point at rest, in pixels.
+    pub at: [f64; 2],
+    /// The part, for a layered picture drawn as parts.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub part: Option<usize>,
+}
+
+/// The most overlap regions a rig file may order.
+pub const MAX_OVERLAPS: usize = 10_000;
 
 /// The most points one cut's stroke may have.
 pub const MAX_CUT_POINTS: usize = 10_000;
@@ -655,6 +698,8 @@ impl Default for Project {
             holds: Vec::new(),
             overlaid: Vec::new(),
             cuts: Vec::new(),
+            auto_depth: true,
+            overlaps: Vec::new(),
         }
     }
 }
@@ -884,6 +929,21 @@ impl Project {
                 self.overlaid[i],
                 self.handles.len()
             ));
+        }
+        if self.overlaps.len() > MAX_OVERLAPS {
+            return bad(format!(
+                "{} overlaps; at most {MAX_OVERLAPS} are accepted",
+                self.overlaps.len()
+            ));
+        }
+        for (i, order) in self.overlaps.iter().enumerate() {
+            for (side, place) in [("front", &order.front), ("back", &order.back)] {
+                if !place.at.iter().all(|c| c.is_finite() && c.abs() <= 1e9) {
+                    return bad(format!(
+                        "overlaps[{i}].{side}.at is not a finite point within ±1e9"
+                    ));
+                }
+            }
         }
         if self.cuts.len() > MAX_CUTS {
             return bad(format!(

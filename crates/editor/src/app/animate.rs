@@ -306,7 +306,7 @@ impl EditorApp {
         }
         let time = snap(self.timeline.time, self.fps());
         let Some(doc) = &mut self.doc else { return };
-        if doc.keys().is_empty() || Pose::of(before) == Pose::of(doc.project()) {
+        if doc.keys().is_empty() || Pose::of(before).same_controls(&Pose::of(doc.project())) {
             return;
         }
         let animation = doc.keyed_at(time);

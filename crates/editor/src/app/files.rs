@@ -293,7 +293,7 @@ impl ExportSetup {
                     None => crate::document::solve_cage(&key, &mut |_| !cancel.is_set())?,
                 };
                 let deformer = pipeline::cage::CageDeformer::new(solution, pose)?;
-                pipeline::Warper::in_mesh_order(Box::new(deformer), project.canvas)
+                pipeline::Warper::in_mesh_order(Box::new(deformer), project)
             }
             None => pipeline::prepare_warper(image, project, None, &())?,
         })

@@ -40,7 +40,7 @@ impl Document {
         let Some(pose) = animation::pose_at(&self.project, time) else {
             return Ok(false);
         };
-        if Pose::of(&self.project) == pose {
+        if Pose::of(&self.project).same_controls(&pose) {
             return Ok(false);
         }
         let mut project = self.project.clone();
@@ -54,7 +54,7 @@ impl Document {
     /// # Errors
     /// As [`Document::show_time`].
     pub fn show_pose(&mut self, pose: &Pose) -> Result<bool> {
-        if Pose::of(&self.project) == *pose {
+        if Pose::of(&self.project).same_controls(pose) {
             return Ok(false);
         }
         let mut project = self.project.clone();

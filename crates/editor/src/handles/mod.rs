@@ -211,6 +211,7 @@ impl HandleTool {
     /// The selected handle: where it is, how it is posed, its overlap depth.
     fn handle_section(&mut self, host: &mut dyn Host, ui: &mut Ui) {
         let mut forward = None;
+        let mut toggled = None;
         if let Some(i) = host.selected()
             && let Some(doc) = host.document()
             && let Some(h) = doc.project().handles.get(i)
@@ -228,6 +229,18 @@ impl HandleTool {
                 }
                 if ui.button("Send backward").clicked() {
                     forward = Some(-1);
+                }
+                let mut automatic = doc.project().auto_depth;
+                if ui
+                    .checkbox(&mut automatic, "Automatic depth")
+                    .on_hover_text(
+                        "Where the warped picture overlaps itself, each overlap is drawn \
+                         wholly in front or wholly behind (by the depths when it appears) \
+                         and keeps its order while it lasts (the ARAP paper's §5.1)",
+                    )
+                    .changed()
+                {
+                    toggled = Some(automatic);
                 }
             });
             match h {
@@ -262,6 +275,15 @@ impl HandleTool {
         }
         if let (Some(i), Some(by)) = (host.selected(), forward) {
             self.change_depth(host, i, by);
+        }
+        if let Some(on) = toggled
+            && self.edit(host, Edit::AutoDepth(on))
+        {
+            host.info(if on {
+                "automatic depth on: overlaps keep their order while they last"
+            } else {
+                "automatic depth off: overlaps are drawn by the handles' depths alone"
+            });
         }
     }
 }

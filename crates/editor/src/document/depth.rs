@@ -1,0 +1,128 @@
+//! Automatic depth in the editor (the ARAP paper's §5.1, `pipeline::order`): after
+//! every change the shown mesh's overlap regions are arranged, continuing the last
+//! pose's, and their orders are written into the rig file (`overlaps`), so what is
+//! shown is what a save, an export or `c2warp render` draws.
+
+use pipeline::order::{Arranger, as_triangles, predefined_order};
+use pipeline::{Controls, Deformer};
+use project::{HandleSpec, OverlapOrder};
+
+use super::Document;
+
+/// The arrangement of the mesh shown, and what it was made for.
+#[derive(Clone)]
+pub(super) struct Depth {
+    /// Whether it is the cage's mesh (else the picture's, under handles).
+    cage: bool,
+    /// The handles' depths the predefined order came from.
+    depths: Vec<i32>,
+    /// The mesh's triangles (in its own order).
+    triangles: Vec<[u32; 3]>,
+    arranger: Arranger,
+    /// The triangles in drawing order.
+    pub(super) order: Vec<[u32; 3]>,
+    /// The orders written into the rig file: a rig file that holds others (an undo,
+    /// a file opened) starts the arrangement afresh from its own.
+    wrote: Vec<OverlapOrder>,
+}
+
+impl Depth {
+    /// Whether it arranges the cage's mesh.
+    pub(super) fn is_cage(&self) -> bool {
+        self.cage
+    }
+}
+
+impl Document {
+    /// Arranges the shown mesh's overlaps for the current pose (see the module
+    /// documentation); bumps [`Document::order_version`] when the drawing order
+    /// changed.
+    pub(super) fn rearrange(&mut self) {
+        let cage = self.project.method.controls() == Controls::Cage;
+        let mut previous = self.depth.take();
+        let old_order = previous.as_mut().map(|d| std::mem::take(&mut d.order));
+        let deformer: Option<&dyn Deformer> = if cage {
+            self.cage_deformer().map(|c| c as &dyn Deformer)
+        } else {
+            Some(self.deformer())
+        };
+        let Some(deformer) = deformer.filter(|_| self.project.auto_depth) else {
+            if !self.project.auto_depth {
+                self.project.overlaps.clear();
+            }
+            if previous.is_some() {
+                self.order_version += 1;
+            }
+            return;
+        };
+        let depths: Vec<i32> = if cage {
+            Vec::new()
+        } else {
+            self.project.handles.iter().map(HandleSpec::depth).collect()
+        };
+        let triangles = deformer.triangles();
+        // A handle's depth changed (not a file's or an undo's orders restored): the
+        // artist asks for another order, and every overlap is decided afresh by it.
+        let new_depths = previous.as_ref().is_some_and(|d| {
+            d.cage == cage
+                && d.depths.len() == depths.len()
+                && d.depths != depths
+                && d.wrote == self.project.overlaps
+        });
+        let kept = previous.filter(|d| {
+            d.cage == cage
+                && d.depths == depths
+                && d.triangles == triangles
+                && d.wrote == self.project.overlaps
+        });
+        let mut arranger = match kept {
+            Some(depth) => depth.arranger,
+            None => {
+                let predefined = if cage {
+                    (0..triangles.len() as u32).collect()
+                } else {
+                    predefined_order(&self.rig, &depths)
+                };
+                let saved: &[OverlapOrder] = if new_depths {
+                    &[]
+                } else {
+                    &self.project.overlaps
+                };
+                Arranger::new(predefined, saved, deformer.rest(), triangles)
+            }
+        };
+        let order = as_triangles(
+            &arranger.arrange(&deformer.deformed(), triangles),
+            triangles,
+        );
+        let wrote = arranger.overlaps(deformer.rest(), triangles);
+        let depth = Depth {
+            cage,
+            depths,
+            triangles: triangles.to_vec(),
+            arranger,
+            order,
+            wrote: wrote.clone(),
+        };
+        self.project.overlaps = wrote;
+        if old_order.as_ref() != Some(&depth.order) {
+            self.order_version += 1;
+        }
+        self.depth = Some(depth);
+    }
+
+    /// The cage's mesh's triangles in drawing order (with LBC chosen and solved).
+    pub fn cage_draw_order(&self) -> Option<Vec<[u32; 3]>> {
+        let cage = self.cage_deformer()?;
+        Some(match self.depth.as_ref().filter(|d| d.is_cage()) {
+            Some(depth) => depth.order.clone(),
+            None => cage.triangles().to_vec(),
+        })
+    }
+
+    /// The overlap regions of the shown pose, each as the triangles (indices into the
+    /// shown mesh's list) of its front and back sheets: the overlap view.
+    pub fn overlap_regions(&self) -> &[depth::Region] {
+        self.depth.as_ref().map_or(&[], |d| d.arranger.regions())
+    }
+}
