@@ -51,6 +51,20 @@ fn arrange(c: &mut Criterion) {
             &format!("depth/arrange/{}k_triangles_{name}", triangles.len() / 1000),
             |b| b.iter(|| depth::arrange(&positions, &triangles, &predefined, &first.regions)),
         );
+        let rest = scene(false).0;
+        let topology = depth::Topology::new(&rest, &triangles);
+        c.bench_function(
+            &format!(
+                "depth/arrange_on/{}k_triangles_{name}",
+                triangles.len() / 1000
+            ),
+            |b| {
+                b.iter(|| {
+                    let on = Some(&topology);
+                    depth::arrange_on(on, &positions, &triangles, &predefined, &first.regions)
+                })
+            },
+        );
     }
 }
 

@@ -32,11 +32,13 @@
 //! The crate knows no pictures: it takes positions and triangles and gives an order.
 
 mod overlap;
+mod topology;
 
 use std::cmp::Reverse;
-use std::collections::{BinaryHeap, HashMap};
+use std::collections::BinaryHeap;
 
 use glam::DVec2;
+pub use topology::Topology;
 
 /// One overlap region: the triangles (indices into the mesh's list, sorted) of the
 /// sheet drawn in front and of the sheet behind.
@@ -74,6 +76,35 @@ pub fn arrange(
     predefined: &[u32],
     remembered: &[Region],
 ) -> Arrangement {
+    arrange_on(None, positions, triangles, predefined, remembered)
+}
+
+/// As [`arrange`], first asking `topology` (made once for the mesh: its boundary,
+/// pieces and orientations) whether the pose can overlap at all — what a pose without
+/// overlaps costs is then a pass over the triangles' orientations and the boundary.
+///
+/// # Panics
+/// As [`arrange`].
+pub fn arrange_on(
+    topology: Option<&Topology>,
+    positions: &[DVec2],
+    triangles: &[[u32; 3]],
+    predefined: &[u32],
+    remembered: &[Region],
+) -> Arrangement {
+    if let Some(topology) = topology.filter(|t| t.is_for(triangles))
+        && !topology.may_overlap(positions)
+    {
+        assert_eq!(
+            predefined.len(),
+            triangles.len(),
+            "the predefined order lists every triangle"
+        );
+        return Arrangement {
+            order: predefined.to_vec(),
+            regions: Vec::new(),
+        };
+    }
     let n = triangles.len();
     assert_eq!(
         predefined.len(),
@@ -92,40 +123,149 @@ pub fn arrange(
             regions: Vec::new(),
         };
     }
-    let grown = grow_regions(triangles, &pairs);
-    let fronts = decide(&grown, &pairs, &rank, remembered);
-    // Each overlapping pair as (behind, in front).
-    let constraints: Vec<(u32, u32)> = pairs
-        .iter()
-        .zip(&grown.sides)
-        .map(|(p, &(region, s_in_a))| {
-            let (a, b) = if s_in_a { (p.s, p.t) } else { (p.t, p.s) };
-            if fronts[region] { (b, a) } else { (a, b) }
-        })
-        .collect();
+    let involved = Involved::new(triangles, &pairs);
+    let grown = grow_regions(&involved, &pairs);
+    let fronts = decide(&involved, &grown, &pairs, &rank, remembered);
+    // Each overlapping pair as (behind, in front), and each region's sheets.
+    let mut constraints: Vec<(u32, u32)> = Vec::with_capacity(pairs.len());
+    let mut regions: Vec<Region> = vec![Region::default(); grown.count];
+    for (p, &(region, s_in_a)) in pairs.iter().zip(&grown.sides) {
+        let (a, b) = if s_in_a { (p.s, p.t) } else { (p.t, p.s) };
+        let (front, back) = if fronts[region] { (a, b) } else { (b, a) };
+        constraints.push((back, front));
+        regions[region].front.push(front);
+        regions[region].back.push(back);
+    }
+    for region in &mut regions {
+        for sheet in [&mut region.front, &mut region.back] {
+            sheet.sort_unstable();
+            sheet.dedup();
+        }
+    }
     let order = sorted(predefined, &rank, &constraints);
-    let regions = (0..grown.count)
-        .map(|region| {
-            let (mut a, mut b) = (Vec::new(), Vec::new());
-            for (p, &(r, s_in_a)) in pairs.iter().zip(&grown.sides) {
-                if r == region {
-                    let (x, y) = if s_in_a { (p.s, p.t) } else { (p.t, p.s) };
-                    a.push(x);
-                    b.push(y);
-                }
-            }
-            for sheet in [&mut a, &mut b] {
-                sheet.sort_unstable();
-                sheet.dedup();
-            }
-            if fronts[region] {
-                Region { front: a, back: b }
-            } else {
-                Region { front: b, back: a }
-            }
-        })
-        .collect();
     Arrangement { order, regions }
+}
+
+/// The triangles that overlap something, numbered densely in increasing order, with
+/// the pairs each is in and the ones at each of their vertices: what growing and
+/// ordering the regions look up, in arrays rather than hashes.
+struct Involved {
+    /// The triangles, increasing.
+    triangles: Vec<u32>,
+    /// Each mesh triangle's dense number (`u32::MAX`: not involved).
+    local: Vec<u32>,
+    /// Pair lists: `pairs[pair_starts[i]..pair_starts[i + 1]]` for triangle `i`.
+    pair_starts: Vec<usize>,
+    pairs: Vec<usize>,
+    /// For each mesh vertex, the involved triangles (dense numbers) around it:
+    /// `around[around_starts[v]..around_starts[v + 1]]`.
+    around_starts: Vec<u32>,
+    around: Vec<u32>,
+    /// Each involved triangle's vertices.
+    corners: Vec<[u32; 3]>,
+}
+
+impl Involved {
+    fn new(triangles: &[[u32; 3]], pairs: &[overlap::Pair]) -> Self {
+        let mut local = vec![u32::MAX; triangles.len()];
+        for p in pairs {
+            local[p.s as usize] = 0;
+            local[p.t as usize] = 0;
+        }
+        let mut involved = Vec::new();
+        for (t, slot) in local.iter_mut().enumerate() {
+            if *slot == 0 {
+                *slot = involved.len() as u32;
+                involved.push(t as u32);
+            }
+        }
+        let k = involved.len();
+        let mut pair_starts = vec![0usize; k + 1];
+        for p in pairs {
+            pair_starts[local[p.s as usize] as usize + 1] += 1;
+            pair_starts[local[p.t as usize] as usize + 1] += 1;
+        }
+        for i in 0..k {
+            pair_starts[i + 1] += pair_starts[i];
+        }
+        let mut filled = pair_starts.clone();
+        let mut of = vec![0usize; pair_starts[k]];
+        for (j, p) in pairs.iter().enumerate() {
+            for t in [p.s, p.t] {
+                let slot = &mut filled[local[t as usize] as usize];
+                of[*slot] = j;
+                *slot += 1;
+            }
+        }
+        let corners: Vec<[u32; 3]> = involved.iter().map(|&t| triangles[t as usize]).collect();
+        let vertices = corners
+            .iter()
+            .flatten()
+            .max()
+            .map_or(0, |&v| v as usize + 1);
+        let mut around_starts = vec![0u32; vertices + 1];
+        for c in &corners {
+            for &v in c {
+                around_starts[v as usize + 1] += 1;
+            }
+        }
+        for v in 0..vertices {
+            around_starts[v + 1] += around_starts[v];
+        }
+        let mut filled = around_starts.clone();
+        let mut around = vec![0u32; around_starts[vertices] as usize];
+        for (i, c) in corners.iter().enumerate() {
+            for &v in c {
+                let slot = &mut filled[v as usize];
+                around[*slot as usize] = i as u32;
+                *slot += 1;
+            }
+        }
+        Self {
+            triangles: involved,
+            local,
+            pair_starts,
+            pairs: of,
+            around_starts,
+            around,
+            corners,
+        }
+    }
+
+    /// The dense number of triangle `t` (which is involved).
+    fn index(&self, t: u32) -> usize {
+        self.local[t as usize] as usize
+    }
+
+    /// The dense number of triangle `t`, if it is involved.
+    fn find(&self, t: u32) -> Option<usize> {
+        self.local
+            .get(t as usize)
+            .filter(|&&i| i != u32::MAX)
+            .map(|&i| i as usize)
+    }
+
+    /// The pairs triangle `i` is in.
+    fn pairs_of(&self, i: usize) -> &[usize] {
+        &self.pairs[self.pair_starts[i]..self.pair_starts[i + 1]]
+    }
+
+    /// The involved triangles that share a vertex with triangle `i` (itself included,
+    /// once per shared vertex).
+    fn around(&self, i: usize) -> impl Iterator<Item = usize> + '_ {
+        self.corners[i].into_iter().flat_map(move |v| {
+            let (from, to) = (
+                self.around_starts[v as usize] as usize,
+                self.around_starts[v as usize + 1] as usize,
+            );
+            self.around[from..to].iter().map(|&j| j as usize)
+        })
+    }
+
+    /// Whether triangles `i` and `j` share a vertex (or are one).
+    fn touch(&self, i: usize, j: usize) -> bool {
+        self.corners[i].iter().any(|v| self.corners[j].contains(v))
+    }
 }
 
 /// The overlapping pairs grouped into regions.
@@ -140,69 +280,74 @@ struct Grown {
 /// triangle of one is, or shares a vertex with, a triangle of the other, the triangles
 /// that touch staying on the same sheet. (Stepping one triangle across an edge at a
 /// time would be enough in general position, but meshes laid on one lattice — parts
-/// meshed on the picture's grid — overlap with edges and vertices in common.)
-fn grow_regions(triangles: &[[u32; 3]], pairs: &[overlap::Pair]) -> Grown {
-    // The pairs each triangle is in, and the triangles (that are in a pair) at each
-    // vertex.
-    let mut pairs_of: HashMap<u32, Vec<usize>> = HashMap::new();
-    for (k, p) in pairs.iter().enumerate() {
-        pairs_of.entry(p.s).or_default().push(k);
-        pairs_of.entry(p.t).or_default().push(k);
-    }
-    // (In the triangles' order: the regions must not depend on a hash's order.)
-    let mut involved: Vec<u32> = pairs_of.keys().copied().collect();
-    involved.sort_unstable();
-    let mut at_vertex: HashMap<u32, Vec<u32>> = HashMap::new();
-    for &t in &involved {
-        for v in triangles[t as usize] {
-            at_vertex.entry(v).or_default().push(t);
-        }
-    }
-    let touch = |x: u32, y: u32| {
-        let (x, y) = (triangles[x as usize], triangles[y as usize]);
-        x.iter().any(|v| y.contains(v))
-    };
+/// meshed on the picture's grid — overlap with edges and vertices in common.) A pair
+/// that would put a triangle on both sheets of the region being grown (where a fold's
+/// crease joins them) is left to a region of its own.
+fn grow_regions(involved: &Involved, pairs: &[overlap::Pair]) -> Grown {
+    let dense: Vec<(usize, usize)> = pairs
+        .iter()
+        .map(|p| (involved.index(p.s), involved.index(p.t)))
+        .collect();
     let mut sides: Vec<Option<(usize, bool)>> = vec![None; pairs.len()];
+    // How many of each triangle's pairs are not in a region yet: a triangle with none
+    // left is not looked through again.
+    let mut left: Vec<usize> = (0..involved.triangles.len())
+        .map(|i| involved.pairs_of(i).len())
+        .collect();
+    let take = |j: usize, left: &mut [usize]| {
+        let (x, y) = dense[j];
+        left[x] -= 1;
+        left[y] -= 1;
+    };
+    // Each triangle's sheet in the region being grown (0: none yet, 1: A, 2: B), and
+    // the triangles given one, to clear before the next region.
+    let mut sheet = vec![0u8; involved.triangles.len()];
+    let mut marked: Vec<usize> = Vec::new();
     let mut count = 0;
     let mut stack = Vec::new();
-    // The sheet (true: A) each triangle is on in the region being grown: a pair that
-    // would put a triangle on both sheets (where a fold's crease joins them) is left
-    // to a region of its own.
-    let mut sheet: HashMap<u32, bool> = HashMap::new();
     for start in 0..pairs.len() {
         if sides[start].is_some() {
             continue;
         }
-        sheet.clear();
+        for &i in &marked {
+            sheet[i] = 0;
+        }
+        marked.clear();
+        let (s, t) = dense[start];
         sides[start] = Some((count, true));
-        sheet.insert(pairs[start].s, true);
-        sheet.insert(pairs[start].t, false);
+        take(start, &mut left);
+        sheet[s] = 1;
+        sheet[t] = 2;
+        marked.extend([s, t]);
         stack.push(start);
         while let Some(k) = stack.pop() {
             let (_, s_in_a) = sides[k].expect("visited");
             let (a, b) = if s_in_a {
-                (pairs[k].s, pairs[k].t)
+                dense[k]
             } else {
-                (pairs[k].t, pairs[k].s)
+                (dense[k].1, dense[k].0)
             };
-            for v in triangles[a as usize] {
-                for &a2 in &at_vertex[&v] {
-                    for &j in &pairs_of[&a2] {
-                        if sides[j].is_some() {
-                            continue;
+            for a2 in involved.around(a) {
+                if left[a2] == 0 {
+                    continue;
+                }
+                for &j in involved.pairs_of(a2) {
+                    if sides[j].is_some() {
+                        continue;
+                    }
+                    let (x, y) = dense[j];
+                    let other = if x == a2 { y } else { x };
+                    let fits = |i: usize, side: u8| sheet[i] == 0 || sheet[i] == side;
+                    if involved.touch(other, b) && fits(a2, 1) && fits(other, 2) {
+                        sides[j] = Some((count, x == a2));
+                        take(j, &mut left);
+                        for (i, side) in [(a2, 1), (other, 2)] {
+                            if sheet[i] == 0 {
+                                sheet[i] = side;
+                                marked.push(i);
+                            }
                         }
-                        let other = if pairs[j].s == a2 {
-                            pairs[j].t
-                        } else {
-                            pairs[j].s
-                        };
-                        let fits = |t: u32, on_a: bool| sheet.get(&t).is_none_or(|&s| s == on_a);
-                        if touch(other, b) && fits(a2, true) && fits(other, false) {
-                            sides[j] = Some((count, pairs[j].s == a2));
-                            sheet.insert(a2, true);
-                            sheet.insert(other, false);
-                            stack.push(j);
-                        }
+                        stack.push(j);
                     }
                 }
             }
@@ -219,28 +364,34 @@ fn grow_regions(triangles: &[[u32; 3]], pairs: &[overlap::Pair]) -> Grown {
 }
 
 /// For each region, whether its sheet A is in front: as the remembered region it
-/// continues has it, else as the predefined order has most of its area.
+/// continues has it (the one sharing triangles with both its sheets; with several, the
+/// most shared), else as the predefined order has most of its area.
 fn decide(
+    involved: &Involved,
     grown: &Grown,
     pairs: &[overlap::Pair],
     rank: &[u32],
     remembered: &[Region],
 ) -> Vec<bool> {
-    // Each triangle's places in the remembered regions: (region, in front).
-    let mut was: HashMap<u32, Vec<(usize, bool)>> = HashMap::new();
+    // Where each involved triangle was: (dense triangle, remembered region, in front),
+    // sorted by triangle.
+    let mut was: Vec<(usize, usize, bool)> = Vec::new();
     for (r, region) in remembered.iter().enumerate() {
-        for &t in &region.front {
-            was.entry(t).or_default().push((r, true));
-        }
-        for &t in &region.back {
-            was.entry(t).or_default().push((r, false));
+        for (sheet, front) in [(&region.front, true), (&region.back, false)] {
+            for &t in sheet {
+                if let Some(i) = involved.find(t) {
+                    was.push((i, r, front));
+                }
+            }
         }
     }
-    // Per region: for each remembered region, triangles of A seen in its front and
-    // back, of B in its front and back.
-    let mut seen: Vec<HashMap<usize, [u64; 4]>> = vec![HashMap::new(); grown.count];
+    was.sort_unstable();
     let mut vote = vec![0.0f64; grown.count];
-    let mut counted = vec![std::collections::HashSet::new(); grown.count];
+    // For each region and remembered region: triangles of A seen in its front and
+    // back, of B in its front and back.
+    let mut seen: Vec<Vec<(usize, [u64; 4])>> = vec![Vec::new(); grown.count];
+    // The region (plus one) in which each triangle was last counted, per sheet.
+    let mut counted = vec![[0usize; 2]; involved.triangles.len()];
     for (p, &(region, s_in_a)) in pairs.iter().zip(&grown.sides) {
         let (a, b) = if s_in_a { (p.s, p.t) } else { (p.t, p.s) };
         vote[region] += if rank[a as usize] > rank[b as usize] {
@@ -248,20 +399,34 @@ fn decide(
         } else {
             -p.area
         };
+        if was.is_empty() {
+            continue;
+        }
         for (t, on_a) in [(a, true), (b, false)] {
-            if !counted[region].insert((t, on_a)) {
+            let i = involved.index(t);
+            let mark = &mut counted[i][usize::from(!on_a)];
+            if *mark == region + 1 {
                 continue;
             }
-            for &(r, front) in was.get(&t).into_iter().flatten() {
-                let counts = seen[region].entry(r).or_default();
-                counts[usize::from(!on_a) * 2 + usize::from(!front)] += 1;
+            *mark = region + 1;
+            let from = was.partition_point(|&(j, _, _)| j < i);
+            for &(_, r, front) in was[from..].iter().take_while(|&&(j, _, _)| j == i) {
+                let list = &mut seen[region];
+                let at = match list.iter().position(|&(q, _)| q == r) {
+                    Some(at) => at,
+                    None => {
+                        list.push((r, [0; 4]));
+                        list.len() - 1
+                    }
+                };
+                list[at].1[usize::from(!on_a) * 2 + usize::from(!front)] += 1;
             }
         }
     }
     (0..grown.count)
         .map(|region| {
             let (mut same, mut swapped) = (0u64, 0u64);
-            for &[a_front, a_back, b_front, b_back] in seen[region].values() {
+            for &(_, [a_front, a_back, b_front, b_back]) in &seen[region] {
                 if a_front > 0 && b_back > 0 {
                     same += a_front + b_back;
                 }
@@ -286,13 +451,17 @@ fn sorted(predefined: &[u32], rank: &[u32], constraints: &[(u32, u32)]) -> Vec<u
     let mut involved: Vec<u32> = constraints.iter().flat_map(|&(a, b)| [a, b]).collect();
     involved.sort_unstable_by_key(|&t| rank[t as usize]);
     involved.dedup();
-    let local: HashMap<u32, usize> = involved.iter().enumerate().map(|(i, &t)| (t, i)).collect();
+    let mut dense = vec![usize::MAX; rank.len()];
+    for (i, &t) in involved.iter().enumerate() {
+        dense[t as usize] = i;
+    }
+    let local = |t: u32| dense[t as usize];
     let k = involved.len();
     let mut starts = vec![0usize; k + 1];
     let mut indegree = vec![0usize; k];
     for &(a, b) in constraints {
-        starts[local[&a] + 1] += 1;
-        indegree[local[&b]] += 1;
+        starts[local(a) + 1] += 1;
+        indegree[local(b)] += 1;
     }
     for i in 1..=k {
         starts[i] += starts[i - 1];
@@ -300,8 +469,8 @@ fn sorted(predefined: &[u32], rank: &[u32], constraints: &[(u32, u32)]) -> Vec<u
     let mut filled = starts.clone();
     let mut after = vec![0usize; constraints.len()];
     for &(a, b) in constraints {
-        let slot = &mut filled[local[&a]];
-        after[*slot] = local[&b];
+        let slot = &mut filled[local(a)];
+        after[*slot] = local(b);
         *slot += 1;
     }
     // Local indices follow the predefined order, so the smallest available index is

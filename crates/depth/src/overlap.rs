@@ -3,6 +3,7 @@
 //! once, by clipping one triangle to the other.
 
 use glam::DVec2;
+use rayon::prelude::*;
 
 /// Two triangles (indices into the mesh's list, `s < t`) that overlap, and the area
 /// they have in common.
@@ -101,19 +102,20 @@ pub(crate) fn overlapping_pairs(positions: &[DVec2], triangles: &[[u32; 3]]) -> 
             }
         }
     }
-    let mut pairs = Vec::new();
-    for y in 0..rows {
+    // Each row of cells on a thread of its own.
+    let row_pairs = |y: usize| {
+        let mut pairs = Vec::new();
         for x in 0..columns {
-            let cell_members =
-                &members[starts[y * columns + x] as usize..starts[y * columns + x + 1] as usize];
+            let cell = y * columns + x;
+            let cell_members = &members[starts[cell] as usize..starts[cell + 1] as usize];
             for (k, &i) in cell_members.iter().enumerate() {
                 let (pi, min_i, max_i, area_i) = shapes[i as usize].expect("live");
                 for &j in &cell_members[k + 1..] {
                     let (pj, min_j, max_j, area_j) = shapes[j as usize].expect("live");
                     let (min, max) = (min_i.max(min_j), max_i.min(max_j));
-                    // Boxes apart, or the pair is tested in the cell where their
-                    // boxes' overlap starts.
-                    if min.x > max.x || min.y > max.y || index(min) != (x, y) {
+                    // Boxes apart or only touching (no area in common), or the pair
+                    // is tested in the cell where their boxes' overlap starts.
+                    if min.x >= max.x || min.y >= max.y || index(min) != (x, y) {
                         continue;
                     }
                     let (ti, tj) = (triangles[i as usize], triangles[j as usize]);
@@ -128,7 +130,9 @@ pub(crate) fn overlapping_pairs(positions: &[DVec2], triangles: &[[u32; 3]]) -> 
                 }
             }
         }
-    }
+        pairs
+    };
+    let mut pairs: Vec<Pair> = (0..rows).into_par_iter().flat_map_iter(row_pairs).collect();
     pairs.sort_unstable_by_key(|p| (p.s, p.t));
     pairs
 }
@@ -137,28 +141,33 @@ pub(crate) fn overlapping_pairs(positions: &[DVec2], triangles: &[[u32; 3]]) -> 
 /// of `b` in turn (Sutherland–Hodgman; both convex).
 pub(crate) fn common_area(a: [DVec2; 3], b: [DVec2; 3]) -> f64 {
     // A triangle clipped by three half-planes has at most six corners.
-    let mut polygon: Vec<DVec2> = a.to_vec();
-    let mut clipped: Vec<DVec2> = Vec::with_capacity(9);
+    let mut polygon = [DVec2::ZERO; 9];
+    let mut clipped = [DVec2::ZERO; 9];
+    polygon[..3].copy_from_slice(&a);
+    let mut len = 3;
     for e in 0..3 {
         let (p, q) = (b[e], b[(e + 1) % 3]);
         let side = |x: DVec2| geometry::orient(p, q, x);
-        clipped.clear();
-        for k in 0..polygon.len() {
-            let (u, v) = (polygon[k], polygon[(k + 1) % polygon.len()]);
+        let mut out = 0;
+        for k in 0..len {
+            let (u, v) = (polygon[k], polygon[(k + 1) % len]);
             let (su, sv) = (side(u), side(v));
             if su >= 0.0 {
-                clipped.push(u);
+                clipped[out] = u;
+                out += 1;
             }
             if (su >= 0.0) != (sv >= 0.0) {
-                clipped.push(u + (v - u) * (su / (su - sv)));
+                clipped[out] = u + (v - u) * (su / (su - sv));
+                out += 1;
             }
         }
         std::mem::swap(&mut polygon, &mut clipped);
-        if polygon.len() < 3 {
+        len = out;
+        if len < 3 {
             return 0.0;
         }
     }
-    geometry::signed_area(&polygon).max(0.0)
+    geometry::signed_area(&polygon[..len]).max(0.0)
 }
 
 #[cfg(test)]

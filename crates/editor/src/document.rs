@@ -169,6 +169,11 @@ pub struct Document {
     depth: Option<depth::Depth>,
     /// Bumped whenever the drawing order may have changed.
     pub order_version: u64,
+    /// Whether the poses come from a live drag (or playback).
+    live: bool,
+    /// Whether a live pose was left unarranged (a large mesh): the drag's end
+    /// arranges it.
+    depth_deferred: bool,
 }
 
 impl Document {
@@ -223,6 +228,8 @@ impl Document {
             solutions: Vec::new(),
             depth: None,
             order_version: 1,
+            live: false,
+            depth_deferred: false,
         }
         .with_method()
     }
@@ -650,10 +657,15 @@ impl Document {
     /// # Errors
     /// What the method refuses in the pose (as [`Document::restore`]).
     pub fn settle(&mut self) -> Result<()> {
-        self.set_live(false)
+        self.set_live(false)?;
+        if self.depth_deferred {
+            self.rearrange();
+        }
+        Ok(())
     }
 
     fn set_live(&mut self, live: bool) -> Result<()> {
+        self.live = live;
         if let Some((_, deformer)) = &mut self.method {
             deformer.set_live(live)?;
         }

@@ -132,6 +132,8 @@ const LABELS: &[&str] = &[
     "Clear rigidity",
     "Bring forward",
     "Send backward",
+    "Automatic depth",
+    "Overlap regions",
     "Painted rigidity",
     "Delete handle",
     "Clear all handles",

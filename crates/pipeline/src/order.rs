@@ -66,6 +66,8 @@ pub fn predefined_order(rig: &Rig, depths: &[i32]) -> Vec<u32> {
 pub struct Arranger {
     /// The triangles (indices) back to front without adjustment.
     predefined: Vec<u32>,
+    /// The mesh's boundary and pieces, so that a pose without overlaps costs little.
+    topology: depth::Topology,
     /// The last pose's regions.
     regions: Vec<depth::Region>,
 }
@@ -82,6 +84,7 @@ impl Arranger {
     ) -> Self {
         let mut arranger = Self {
             predefined,
+            topology: depth::Topology::new(rest, triangles),
             regions: Vec::new(),
         };
         arranger.restart(overlaps, rest, triangles);
@@ -123,7 +126,13 @@ impl Arranger {
             self.regions.clear();
             return self.predefined.clone();
         }
-        let arranged = depth::arrange(deformed, triangles, &self.predefined, &self.regions);
+        let arranged = depth::arrange_on(
+            Some(&self.topology),
+            deformed,
+            triangles,
+            &self.predefined,
+            &self.regions,
+        );
         self.regions = arranged.regions;
         arranged.order
     }

@@ -163,7 +163,8 @@ impl Document {
                 self.project.method.label()
             );
         }
-        if self.draw_order() != fresh.draw_order() {
+        // (Mid-drag on a large mesh the order waits for the drag's end.)
+        if !self.depth_deferred && self.draw_order() != fresh.draw_order() {
             bail!("reopened, the triangles are drawn in another order");
         }
         Ok(())

@@ -9,6 +9,11 @@ use project::{HandleSpec, OverlapOrder};
 
 use super::Document;
 
+/// The most triangles arranged on every frame of a live drag (a few milliseconds where
+/// the pose overlaps itself); a larger mesh keeps the drag's first order until the drag
+/// ends, and is arranged then.
+const LIVE_TRIANGLES: usize = 12_000;
+
 /// The arrangement of the mesh shown, and what it was made for.
 #[derive(Clone)]
 pub(super) struct Depth {
@@ -18,6 +23,8 @@ pub(super) struct Depth {
     depths: Vec<i32>,
     /// The mesh's triangles (in its own order).
     triangles: Vec<[u32; 3]>,
+    /// Where the shown mesh's triangles lay, how many, and the mesh's version.
+    mesh: (usize, usize, u64),
     arranger: Arranger,
     /// The triangles in drawing order.
     pub(super) order: Vec<[u32; 3]>,
@@ -39,6 +46,22 @@ impl Document {
     /// changed.
     pub(super) fn rearrange(&mut self) {
         let cage = self.project.method.controls() == Controls::Cage;
+        // (Compared by where the shown mesh's triangles lie, not element by element:
+        // a pose keeps the mesh, and this runs on every frame of a drag.)
+        let shown = if cage {
+            self.cage_deformer().map(Deformer::triangles)
+        } else {
+            Some(self.deformer().triangles())
+        };
+        let key = shown.map(|t| (t.as_ptr() as usize, t.len(), self.mesh_version));
+        let same_mesh = self.depth.as_ref().is_some_and(|d| {
+            d.cage == cage && d.triangles.len() > LIVE_TRIANGLES && Some(d.mesh) == key
+        });
+        if self.live && same_mesh && self.project.auto_depth {
+            self.depth_deferred = true;
+            return;
+        }
+        self.depth_deferred = false;
         let mut previous = self.depth.take();
         let old_order = previous.as_mut().map(|d| std::mem::take(&mut d.order));
         let deformer: Option<&dyn Deformer> = if cage {
@@ -99,6 +122,11 @@ impl Document {
         let depth = Depth {
             cage,
             depths,
+            mesh: (
+                triangles.as_ptr() as usize,
+                triangles.len(),
+                self.mesh_version,
+            ),
             triangles: triangles.to_vec(),
             arranger,
             order,
