@@ -591,7 +591,7 @@ fn render_parts(
     let parts = pipeline::warp_parts(artwork, project, density, &progress)?;
     if let Some(output) = outputs.png {
         progress.step("writing");
-        write_png(output, &parts.warped.flatten())?;
+        write_png(output, &parts.composite)?;
     }
     if let Some(output) = outputs.layers {
         progress.step("writing the layers");

@@ -68,6 +68,8 @@ pub struct Arranger {
     predefined: Vec<u32>,
     /// The mesh's boundary and pieces, so that a pose without overlaps costs little.
     topology: depth::Topology,
+    /// For a mesh joined from parts, each triangle's part (a layer's index).
+    part_of: Option<Vec<u32>>,
     /// The last pose's regions.
     regions: Vec<depth::Region>,
 }
@@ -85,6 +87,27 @@ impl Arranger {
         let mut arranger = Self {
             predefined,
             topology: depth::Topology::new(rest, triangles),
+            part_of: None,
+            regions: Vec::new(),
+        };
+        arranger.restart(overlaps, rest, triangles);
+        arranger
+    }
+
+    /// As [`Arranger::new`] for a mesh joined from parts (whose rest positions lie
+    /// over one another), `part_of` giving each triangle's part: a saved place names
+    /// the nearest triangle of its own part.
+    pub fn with_parts(
+        predefined: Vec<u32>,
+        overlaps: &[OverlapOrder],
+        rest: &[DVec2],
+        triangles: &[[u32; 3]],
+        part_of: Vec<u32>,
+    ) -> Self {
+        let mut arranger = Self {
+            predefined,
+            topology: depth::Topology::new(rest, triangles),
+            part_of: Some(part_of),
             regions: Vec::new(),
         };
         arranger.restart(overlaps, rest, triangles);
@@ -100,12 +123,19 @@ impl Arranger {
             return;
         }
         let centroids = centroids(rest, triangles);
+        let part_of = self.part_of.as_deref();
         let nearest = |place: &Place| {
             let at = DVec2::from(place.at);
-            (0..centroids.len() as u32).min_by(|&a, &b| {
-                let d = |t: u32| centroids[t as usize].distance_squared(at);
-                d(a).total_cmp(&d(b))
-            })
+            let on_part = |t: &u32| match (part_of, place.part) {
+                (Some(parts), Some(part)) => parts[*t as usize] as usize == part,
+                _ => true,
+            };
+            (0..centroids.len() as u32)
+                .filter(on_part)
+                .min_by(|&a, &b| {
+                    let d = |t: u32| centroids[t as usize].distance_squared(at);
+                    d(a).total_cmp(&d(b))
+                })
         };
         self.regions = overlaps
             .iter()
@@ -151,7 +181,7 @@ impl Arranger {
                 let at = (a + b + c) / 3.0;
                 Place {
                     at: [at.x, at.y],
-                    part: None,
+                    part: self.part_of.as_ref().map(|p| p[t as usize] as usize),
                 }
             })
         };

@@ -13,8 +13,9 @@
 //! displacement of its nearest vertex). A part that no handle binds and that overlaps
 //! no bound part beneath it stays where it is. Hidden layers are kept as they are.
 //!
-//! Not yet: parts in the editor, automatic depth between parts (the ARAP paper's §5.1),
-//! LBC cages over parts.
+//! The composite is drawn as one mesh ([`composite`]), so automatic depth (the ARAP
+//! paper's §5.1) orders overlaps between parts as within one. Not yet: parts in the
+//! editor, LBC cages over parts.
 
 use anyhow::{Context, Result, bail};
 use glam::{DVec2, Vec2};
@@ -51,6 +52,13 @@ pub struct PartSet {
 
 /// What [`warp_parts`] made.
 pub struct Parts {
+    /// The parts composited: every part's warped mesh drawn as one, back to front in
+    /// the layers' order, with automatic depth between and within parts where the
+    /// project has it on ([`composite`]).
+    pub composite: Picture,
+    /// The orders automatic depth gave the overlap regions (between parts and within
+    /// them), as a rig file keeps them.
+    pub overlaps: Vec<project::OverlapOrder>,
     /// The layers warped, each on the whole canvas at the origin (hidden layers as
     /// they were), in the artwork's order.
     pub warped: layers::Artwork,
@@ -95,7 +103,10 @@ pub fn warp_parts(
             pixels,
         });
     }
+    let (composite, overlaps) = composite(artwork, &set, project)?;
     Ok(Parts {
+        composite,
+        overlaps,
         warped: layers::Artwork {
             width: artwork.width,
             height: artwork.height,
@@ -219,6 +230,156 @@ pub fn set_up_parts(
         bindings,
         followed,
     })
+}
+
+/// The visible parts of `set` (meshed from `artwork`) drawn as one mesh onto the
+/// canvas: their layers' pixels packed side by side into one texture (each layer's
+/// opacity in its alpha), their meshes joined, their triangles back to front in the
+/// layers' order and each part's own order — and, where `project` has automatic depth
+/// on, the overlap regions of the joined mesh ordered by it (between parts as within
+/// one, starting from the `overlaps` the project saved), so that a part swung over
+/// another keeps its place while it lies there. Returns the picture, in 16 bits per
+/// channel where any visible layer has them, and the regions' orders.
+///
+/// # Errors
+/// Non-finite positions, or not enough memory for the texture or the canvas.
+pub fn composite(
+    artwork: &layers::Artwork,
+    set: &PartSet,
+    project: &Project,
+) -> Result<(Picture, Vec<project::OverlapOrder>)> {
+    /// Transparent pixels around each layer in the texture, so that sampling at a
+    /// part's edge sees what lies around it on the canvas: nothing.
+    const PAD: u32 = 2;
+    let shown: Vec<(usize, &layers::Layer, &PartMesh)> = artwork
+        .layers
+        .iter()
+        .zip(&set.meshes)
+        .enumerate()
+        .filter_map(|(k, (layer, mesh))| {
+            Some((k, layer, mesh.as_ref()?)).filter(|_| layer.visible && layer.opacity > 0.0)
+        })
+        .collect();
+    let deep = shown
+        .iter()
+        .any(|(_, l, _)| l.pixels.bits_per_channel() == 16);
+    // Shelves as wide as the widest layer or the square root of the area, whichever
+    // is more.
+    let area: u64 = shown
+        .iter()
+        .map(|(_, l, _)| {
+            let (w, h) = l.dimensions();
+            u64::from(w + 2 * PAD) * u64::from(h + 2 * PAD)
+        })
+        .sum();
+    let widest = shown
+        .iter()
+        .map(|(_, l, _)| l.dimensions().0 + 2 * PAD)
+        .max()
+        .unwrap_or(1);
+    let width = widest.max((area as f64).sqrt().ceil() as u32);
+    let (mut x, mut y, mut shelf) = (0u32, 0u32, 0u32);
+    let mut slots = Vec::with_capacity(shown.len());
+    for (_, layer, _) in &shown {
+        let (w, h) = layer.dimensions();
+        let (w, h) = (w + 2 * PAD, h + 2 * PAD);
+        if x + w > width {
+            (x, y, shelf) = (0, y + shelf, 0);
+        }
+        slots.push((x + PAD, y + PAD));
+        x += w;
+        shelf = shelf.max(h);
+    }
+    let height = (y + shelf).max(1);
+    let texture_frame = Frame {
+        origin: [0, 0],
+        width,
+        height,
+    };
+    let mut texture = blank(if deep { 16 } else { 8 }, texture_frame)?;
+    for ((_, layer, _), &(sx, sy)) in shown.iter().zip(&slots) {
+        put(&mut texture, layer, sx, sy);
+    }
+    // The joined mesh: texture positions, canvas positions at rest and warped.
+    let (mut uv, mut rest, mut deformed) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut triangles, mut part_of) = (Vec::new(), Vec::new());
+    for ((k, layer, mesh), &(sx, sy)) in shown.iter().zip(&slots) {
+        let base = rest.len() as u32;
+        let shift = DVec2::new(
+            f64::from(sx) - f64::from(layer.x),
+            f64::from(sy) - f64::from(layer.y),
+        );
+        uv.extend(mesh.rest.iter().map(|&p| (p + shift).as_vec2()));
+        rest.extend_from_slice(&mesh.rest);
+        deformed.extend_from_slice(&mesh.deformed);
+        triangles.extend(mesh.triangles.iter().map(|t| t.map(|v| v + base)));
+        part_of.extend(std::iter::repeat_n(*k as u32, mesh.triangles.len()));
+    }
+    if deformed.iter().any(|p| !p.is_finite()) {
+        bail!("the deformation produced non-finite positions");
+    }
+    let predefined: Vec<u32> = (0..triangles.len() as u32).collect();
+    let (order, overlaps) = if project.auto_depth {
+        let mut arranger = crate::order::Arranger::with_parts(
+            predefined,
+            &project.overlaps,
+            &rest,
+            &triangles,
+            part_of,
+        );
+        let order = arranger.arrange(&deformed, &triangles);
+        (order, arranger.overlaps(&rest, &triangles))
+    } else {
+        (predefined, Vec::new())
+    };
+    let drawn = crate::order::as_triangles(&order, &triangles);
+    let moved: Vec<Vec2> = deformed.iter().map(|p| p.as_vec2()).collect();
+    let mut canvas = blank(if deep { 16 } else { 8 }, canvas_of(artwork))?;
+    render::warp_picture_over(
+        &texture,
+        &render::WarpMesh {
+            rest: &uv,
+            deformed: &moved,
+            triangles: &drawn,
+        },
+        &mut canvas,
+    )?;
+    Ok((canvas, overlaps))
+}
+
+/// `layer`'s pixels written into `texture` at `(x, y)`, in the texture's depth, its
+/// opacity taken into their alpha (as flattening takes it).
+fn put(texture: &mut Picture, layer: &layers::Layer, x: u32, y: u32) {
+    let opacity = layer.opacity;
+    match (texture, &layer.pixels) {
+        (Picture::Rgba8(t), Picture::Rgba8(p)) => {
+            for (px, py, pixel) in p.enumerate_pixels() {
+                let mut c = pixel.0;
+                if opacity < 1.0 {
+                    c[3] = (f32::from(c[3]) * opacity).round() as u8;
+                }
+                t.put_pixel(x + px, y + py, image::Rgba(c));
+            }
+        }
+        (Picture::Rgba16(t), pixels) => {
+            let (w, h) = pixels.dimensions();
+            for py in 0..h {
+                for px in 0..w {
+                    let mut c = match pixels {
+                        Picture::Rgba8(p) => p.get_pixel(px, py).0.map(|v| u16::from(v) * 257),
+                        Picture::Rgba16(p) => p.get_pixel(px, py).0,
+                    };
+                    if opacity < 1.0 {
+                        c[3] = (f32::from(c[3]) * opacity).round() as u16;
+                    }
+                    t.put_pixel(x + px, y + py, image::Rgba(c));
+                }
+            }
+        }
+        (Picture::Rgba8(_), Picture::Rgba16(_)) => {
+            unreachable!("a texture with a 16-bit layer has 16 bits")
+        }
+    }
 }
 
 /// The artwork's canvas as a frame.

@@ -109,6 +109,15 @@ fn at_rest_the_parts_composite_to_the_layers_flattened() {
         worst <= 1,
         "differs from the layers flattened by {worst} levels"
     );
+    // Drawn as one mesh (their overlap at rest in the layers' order), the same.
+    let joined = parts.composite.clone().into_rgba8();
+    let worst = joined
+        .pixels()
+        .zip(b.pixels())
+        .flat_map(|(p, q)| (0..4).map(move |c| p[c].abs_diff(q[c])))
+        .max()
+        .unwrap_or(0);
+    assert!(worst <= 1, "the composite differs by {worst} levels");
     // Each part comes cut to the rectangle its mesh can touch, not the whole canvas.
     let right = &parts.warped.layers[1];
     let (w, h) = right.dimensions();
@@ -196,4 +205,76 @@ fn virtual_handles_of_the_whole_picture_do_not_reach_the_parts() {
     project.virtual_placed_for = vec![Some(1)];
     let parts = warp_parts(&two_parts(), &project, None, &()).expect("warps");
     assert_eq!(parts.bindings, vec![vec![0], vec![1]]);
+}
+
+/// An arm (the bottom layer, green) beside a body (blue) on the 200 × 120 canvas.
+fn arm_and_body() -> Artwork {
+    Artwork {
+        width: 200,
+        height: 120,
+        layers: vec![
+            block("arm", 10, 50, 40, 20, [40, 200, 40]),
+            block("body", 80, 20, 110, 80, [40, 40, 200]),
+        ],
+        notes: Vec::new(),
+    }
+}
+
+#[test]
+fn parts_are_composited_as_one_mesh_with_overlaps_ordered_between_them() {
+    // At rest: the layers flattened.
+    let still = rig(r#"{"type": "point", "rest": [20, 60]},
+           {"type": "point", "rest": [170, 60]}"#);
+    let artwork = arm_and_body();
+    let parts = warp_parts(&artwork, &still, None, &()).expect("warps");
+    let (a, b) = (
+        parts.composite.clone().into_rgba8(),
+        artwork.flatten().into_rgba8(),
+    );
+    let worst = a
+        .pixels()
+        .zip(b.pixels())
+        .flat_map(|(p, q)| (0..4).map(move |c| p[c].abs_diff(q[c])))
+        .max()
+        .unwrap_or(0);
+    assert!(
+        worst <= 1,
+        "differs from the layers flattened by {worst} levels"
+    );
+    assert!(parts.overlaps.is_empty());
+    // The arm laid over the body: the body's layer is above, so the new overlap puts
+    // the body in front.
+    let moved = rig(
+        r#"{"type": "point", "rest": [20, 60], "translate": [110, 0]},
+           {"type": "point", "rest": [170, 60]}"#,
+    );
+    let parts = warp_parts(&artwork, &moved, None, &()).expect("warps");
+    let at = |p: &Picture| p.to_rgba8().get_pixel(135, 60).0;
+    assert_eq!(
+        at(&parts.composite),
+        [40, 40, 200, 255],
+        "the body in front"
+    );
+    assert_eq!(parts.overlaps.len(), 1);
+    let order = &parts.overlaps[0];
+    assert_eq!((order.front.part, order.back.part), (Some(1), Some(0)));
+    // Kept the other way round (the arm swung in over the body earlier), it stays so.
+    let flipped = Project {
+        overlaps: vec![project::OverlapOrder {
+            front: order.back,
+            back: order.front,
+        }],
+        ..moved.clone()
+    };
+    let json = flipped.to_json();
+    let reopened = Project::from_json(&json).expect("reads");
+    let parts = warp_parts(&artwork, &reopened, None, &()).expect("warps");
+    assert_eq!(at(&parts.composite), [40, 200, 40, 255], "the arm in front");
+    // Without automatic depth, the layers' order alone.
+    let fixed = Project {
+        auto_depth: false,
+        ..reopened
+    };
+    let parts = warp_parts(&artwork, &fixed, None, &()).expect("warps");
+    assert_eq!(at(&parts.composite), [40, 40, 200, 255]);
 }
