@@ -1553,3 +1553,84 @@ fn render_takes_a_project_alone_or_a_picture_and_its_rig() {
     let line = fails(&[os("render"), pic.as_os_str(), os("-o"), alone.as_os_str()]);
     assert!(line.contains("--rig"), "{line}");
 }
+
+#[test]
+fn animate_parts_draws_each_frame_as_render_parts_draws_its_pose() {
+    use project::{Animation, HandlePose, Key, Pose, Project};
+    let dir = tempfile::tempdir().expect("temp dir");
+    let assets = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../assets");
+    let text = fs::read_to_string(assets.join("puppet-rig.json")).expect("the sample rig");
+    let mut posed = Project::from_json(&text).expect("a rig");
+    posed.image = Some(assets.join("puppet.ora"));
+    posed.density = Some(4_000);
+    let mut rest = posed.clone();
+    Pose {
+        handles: posed.handles.iter().map(HandlePose::rest).collect(),
+        cage: None,
+        overlaps: Vec::new(),
+    }
+    .apply(&mut rest);
+    let key = |time: f64, p: &Project| Key {
+        time,
+        hold: false,
+        pose: Pose::of(p),
+    };
+    let animated = Project {
+        animation: Some(Animation {
+            fps: 8.0,
+            keys: vec![key(0.0, &rest), key(0.25, &posed)],
+            ..Animation::default()
+        }),
+        ..posed.clone()
+    };
+    let write = |name: &str, p: &Project| {
+        let path = dir.path().join(name);
+        fs::write(&path, p.to_json()).expect("write");
+        path
+    };
+    let (anim, at_rest, at_end) = (
+        write("anim.json", &animated),
+        write("rest.json", &rest),
+        write("end.json", &posed),
+    );
+    let frames = dir.path().join("frames");
+    fs::create_dir(&frames).expect("a folder");
+    ok(&[
+        os("animate"),
+        anim.as_os_str(),
+        os("--parts"),
+        os("-o"),
+        frames.as_os_str(),
+    ]);
+    let drawn: Vec<PathBuf> = (0..3)
+        .map(|i| frames.join(format!("frame_{i:05}.png")))
+        .collect();
+    assert!(drawn.iter().all(|f| f.exists()));
+    assert!(!frames.join("frame_00003.png").exists());
+    for (frame, project) in [(&drawn[0], &at_rest), (&drawn[2], &at_end)] {
+        let png = dir.path().join("render.png");
+        ok(&[
+            os("render"),
+            project.as_os_str(),
+            os("--parts"),
+            os("-o"),
+            png.as_os_str(),
+        ]);
+        assert!(
+            load(frame) == load(&png),
+            "{} is render --parts of its pose",
+            frame.display()
+        );
+    }
+    // The middle frame lies between them.
+    assert!(load(&drawn[1]) != load(&drawn[0]) && load(&drawn[1]) != load(&drawn[2]));
+    let refused = fails(&[
+        os("animate"),
+        anim.as_os_str(),
+        os("--parts"),
+        os("--gpu"),
+        os("-o"),
+        frames.as_os_str(),
+    ]);
+    assert!(refused.contains("--gpu"), "{refused}");
+}

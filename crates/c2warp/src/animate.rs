@@ -21,6 +21,8 @@ pub struct Request<'a> {
     pub span: Span,
     /// Draw on the GPU.
     pub gpu: bool,
+    /// Animate a layered picture as parts.
+    pub parts: bool,
 }
 
 /// Runs `c2warp animate`: checks the output's form, the rate and the range before any
@@ -36,6 +38,24 @@ pub fn run(request: &Request) -> Result<()> {
         None => crate::named_picture(request.project, project.image.as_deref())?,
     };
     render::refuse_input_as_output(request.output, &[request.project, &image])?;
+    if request.parts {
+        anyhow::ensure!(!request.gpu, "--parts draws on the CPU: leave out --gpu");
+        let artwork = crate::load_artwork_noting(&image)?;
+        let progress = crate::progress::Steps::new(1);
+        progress.step("meshing every part, then drawing and writing frames");
+        let listener = &progress;
+        pipeline::animate_parts(
+            &artwork,
+            &project,
+            &frames,
+            request.output,
+            format,
+            &|done, total| progress.frames(done, total),
+            listener,
+        )?;
+        progress.finish();
+        return Ok(());
+    }
     let picture = crate::load_flattened(&image)?;
     let progress = crate::progress::Steps::new(2);
     progress.step("meshing and weighting");

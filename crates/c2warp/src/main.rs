@@ -120,6 +120,10 @@ enum Command {
         /// Draw with the GPU (8 bits per channel) instead of on the CPU.
         #[arg(long)]
         gpu: bool,
+        /// Animate a layered picture as parts (as `render --parts` draws each pose).
+        /// Not with a cage (LBC) or `--gpu`.
+        #[arg(long)]
+        parts: bool,
     },
     /// Write the deformed mesh as Wavefront OBJ: one `v x y 0` line per vertex (the
     /// input's order, inserted vertices after), then the faces.
@@ -394,12 +398,14 @@ fn run(command: Command) -> Result<()> {
             from,
             to,
             gpu,
+            parts,
         } => animate::run(&animate::Request {
             project: &project,
             image: image.as_deref(),
             output: &output,
             span: pipeline::animate::Span { fps, from, to },
             gpu,
+            parts,
         }),
         Command::Deform {
             source,
@@ -610,7 +616,7 @@ fn same_file_name(a: &Path, b: &Path) -> bool {
 
 /// Reads a picture as [`pipeline::load_artwork`] does, saying on standard error what of
 /// a layered file is drawn otherwise than it asks.
-fn load_artwork_noting(path: &Path) -> Result<pipeline::Artwork> {
+pub(crate) fn load_artwork_noting(path: &Path) -> Result<pipeline::Artwork> {
     let artwork = pipeline::load_artwork(path)?;
     for note in &artwork.notes {
         eprintln!("note: {}: {note}", path.display());

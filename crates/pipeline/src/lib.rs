@@ -30,7 +30,7 @@ pub use method::{
     SolveProgress, Source, WeightsListing, beside_rig, on_handles, setup,
 };
 pub use order::draw_order;
-pub use parts::{PartMesh, PartSet, Parts, set_up_parts, warp_parts};
+pub use parts::{PartMesh, PartRig, PartSet, Parts, animate_parts, set_up_parts, warp_parts};
 
 use weights_core::{
     Basis, Domain, Handle, Metric, MiddleControls, Placement, Rig, RigOptions, Similarity,

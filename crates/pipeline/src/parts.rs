@@ -123,113 +123,248 @@ pub fn warp_parts(
 /// default) is the total over the parts.
 ///
 /// # Errors
-/// An LBC project (its cage deforms the picture as a whole), a handle bound to no
-/// part (off every visible layer), or what setting up a part fails with, naming the
-/// layer.
+/// As [`PartRig::new`].
 pub fn set_up_parts(
     artwork: &layers::Artwork,
     project: &Project,
     density: Option<usize>,
     listener: &dyn Listener,
 ) -> Result<PartSet> {
-    if project.method.controls() == Controls::Cage {
-        bail!("a cage (LBC) deforms the picture as a whole: use it without parts");
-    }
-    let canvas = canvas_of(artwork);
-    let bindings: Vec<Vec<usize>> = artwork
-        .layers
-        .iter()
-        .map(|layer| {
-            if !layer.visible {
-                return Vec::new();
-            }
-            (0..project.handles.len())
-                .filter(|&h| {
-                    probes(&project.handles[h])
-                        .iter()
-                        .all(|p| covers(layer, *p))
-                })
-                .collect()
-        })
-        .collect();
-    if let Some(h) = (0..project.handles.len()).find(|h| !bindings.iter().any(|b| b.contains(h))) {
-        bail!(
-            "handle {} lies on no visible layer: place it on a part",
-            h + 1
-        );
-    }
-    let areas: Vec<u64> = artwork
-        .layers
-        .iter()
-        .map(|l| {
-            if l.visible {
-                visible_pixels(&l.pixels)
-            } else {
-                0
-            }
-        })
-        .collect();
-    let total_area = areas.iter().sum::<u64>().max(1);
-    let total = density.or(project.density).unwrap_or(DEFAULT_DENSITY);
-    let share = |area: u64| {
-        ((total as u128 * u128::from(area) / u128::from(total_area)) as usize).max(MIN_PART_DENSITY)
-    };
-    // The bound parts set up, each layer put on the canvas only while it is meshed.
-    let mut warpers: Vec<Option<Warper>> = Vec::with_capacity(artwork.layers.len());
-    for ((layer, bound), &area) in artwork.layers.iter().zip(&bindings).zip(&areas) {
-        if !layer.visible || bound.is_empty() {
-            warpers.push(None);
-            continue;
+    Ok(PartRig::new(artwork, project, density, listener)?.set())
+}
+
+/// The parts of a layered picture set up once — each bound part's method on its own
+/// layer, each unbound part's vertices tied to the part it follows — to be posed
+/// again and again ([`PartRig::pose`]: an animation's frames).
+#[derive(Clone)]
+pub struct PartRig {
+    /// For each layer, what moves it.
+    parts: Vec<Part>,
+    /// For each layer, the handles (indices into the project's) that bind it.
+    bindings: Vec<Vec<usize>>,
+    /// For each layer that no handle binds, the layer it follows (if any).
+    followed: Vec<Option<usize>>,
+}
+
+/// What moves one layer.
+#[derive(Clone)]
+enum Part {
+    /// A hidden layer: nothing.
+    Hidden,
+    /// Its own method, on its layer, with the handles that bind it.
+    Bound(Box<Warper>),
+    /// Its own mesh, each vertex where the part it follows takes it.
+    Follows {
+        mesh: PartMesh,
+        /// The part followed, and each vertex's place on it.
+        leader: Option<usize>,
+        ties: Vec<Tie>,
+    },
+}
+
+/// Where a follower's vertex lies on the mesh of the part it follows.
+#[derive(Clone, Copy)]
+enum Tie {
+    /// In a triangle (the leader's vertices), barycentrically.
+    In([u32; 3], [f64; 3]),
+    /// Outside the leader's mesh: moved as its nearest vertex moves.
+    Near(u32),
+    /// Nowhere (no leader): where it is.
+    Still,
+}
+
+impl PartRig {
+    /// Sets every visible layer of `artwork` up as a part for `project`'s handles (see
+    /// the module documentation), in `project`'s pose.
+    ///
+    /// # Errors
+    /// An LBC project (its cage deforms the picture as a whole), a handle bound to no
+    /// part (off every visible layer), or what setting up a part fails with, naming
+    /// the layer.
+    pub fn new(
+        artwork: &layers::Artwork,
+        project: &Project,
+        density: Option<usize>,
+        listener: &dyn Listener,
+    ) -> Result<Self> {
+        if project.method.controls() == Controls::Cage {
+            bail!("a cage (LBC) deforms the picture as a whole: use it without parts");
         }
-        let part = part_project(project, bound);
-        let placed_layer = on(layer, canvas)?;
-        let warper = prepare_warper(&placed_layer.to_rgba8(), &part, Some(share(area)), listener)
-            .with_context(|| format!("part \"{}\"", layer.name))?;
-        warpers.push(Some(warper));
-    }
-    let mut meshes: Vec<Option<PartMesh>> = warpers
-        .iter()
-        .map(|w| {
-            w.as_ref().map(|w| PartMesh {
-                rest: w.deformer.rest().to_vec(),
-                deformed: w.deformer.deformed(),
-                triangles: w.triangles.clone(),
+        let canvas = canvas_of(artwork);
+        let bindings: Vec<Vec<usize>> = artwork
+            .layers
+            .iter()
+            .map(|layer| {
+                if !layer.visible {
+                    return Vec::new();
+                }
+                (0..project.handles.len())
+                    .filter(|&h| {
+                        probes(&project.handles[h])
+                            .iter()
+                            .all(|p| covers(layer, *p))
+                    })
+                    .collect()
             })
-        })
-        .collect();
-    // The parts no handle binds follow the bound part beneath them they overlap most.
-    let mut followed = vec![None; artwork.layers.len()];
-    for (k, layer) in artwork.layers.iter().enumerate() {
-        if !layer.visible || warpers[k].is_some() {
-            continue;
+            .collect();
+        if let Some(h) =
+            (0..project.handles.len()).find(|h| !bindings.iter().any(|b| b.contains(h)))
+        {
+            bail!(
+                "handle {} lies on no visible layer: place it on a part",
+                h + 1
+            );
         }
-        let beneath = (0..k)
-            .rev()
-            .filter(|&j| warpers[j].is_some())
-            .map(|j| (j, overlap(layer, &artwork.layers[j])))
-            .filter(|&(_, n)| n > 0)
-            .fold(None, |best: Option<(usize, u64)>, (j, n)| match best {
-                Some((_, m)) if m >= n => best,
-                _ => Some((j, n)),
+        let areas: Vec<u64> = artwork
+            .layers
+            .iter()
+            .map(|l| {
+                if l.visible {
+                    visible_pixels(&l.pixels)
+                } else {
+                    0
+                }
+            })
+            .collect();
+        let total_area = areas.iter().sum::<u64>().max(1);
+        let total = density.or(project.density).unwrap_or(DEFAULT_DENSITY);
+        let share = |area: u64| {
+            ((total as u128 * u128::from(area) / u128::from(total_area)) as usize)
+                .max(MIN_PART_DENSITY)
+        };
+        // The bound parts set up, each layer put on the canvas only while it is meshed.
+        let mut parts: Vec<Part> = Vec::with_capacity(artwork.layers.len());
+        for ((layer, bound), &area) in artwork.layers.iter().zip(&bindings).zip(&areas) {
+            if !layer.visible || bound.is_empty() {
+                parts.push(Part::Hidden);
+                continue;
+            }
+            let part = part_project(project, bound);
+            let placed_layer = on(layer, canvas)?;
+            let warper =
+                prepare_warper(&placed_layer.to_rgba8(), &part, Some(share(area)), listener)
+                    .with_context(|| format!("part \"{}\"", layer.name))?;
+            parts.push(Part::Bound(Box::new(warper)));
+        }
+        // The parts no handle binds follow the bound part beneath them they overlap
+        // most.
+        let mut followed = vec![None; artwork.layers.len()];
+        for (k, layer) in artwork.layers.iter().enumerate() {
+            if !layer.visible || matches!(parts[k], Part::Bound(_)) {
+                continue;
+            }
+            let beneath = (0..k)
+                .rev()
+                .filter(|&j| matches!(parts[j], Part::Bound(_)))
+                .map(|j| (j, overlap(layer, &artwork.layers[j])))
+                .filter(|&(_, n)| n > 0)
+                .fold(None, |best: Option<(usize, u64)>, (j, n)| match best {
+                    Some((_, m)) if m >= n => best,
+                    _ => Some((j, n)),
+                });
+            followed[k] = beneath.map(|(j, _)| j);
+            let leader = beneath.and_then(|(j, _)| match &parts[j] {
+                Part::Bound(w) => Some(w.as_ref()),
+                _ => None,
             });
-        followed[k] = beneath.map(|(j, _)| j);
-        let leader = beneath.and_then(|(j, _)| warpers[j].as_ref());
-        meshes[k] = Some(
-            follow(
+            let (mesh, ties) = follow(
                 &on(layer, canvas)?,
                 leader,
                 project,
                 share(areas[k]),
                 listener,
             )
-            .with_context(|| format!("part \"{}\"", layer.name))?,
-        );
+            .with_context(|| format!("part \"{}\"", layer.name))?;
+            parts[k] = Part::Follows {
+                mesh,
+                leader: followed[k],
+                ties,
+            };
+        }
+        let mut rig = Self {
+            parts,
+            bindings,
+            followed,
+        };
+        rig.move_followers();
+        Ok(rig)
     }
-    Ok(PartSet {
-        meshes,
-        bindings,
-        followed,
-    })
+
+    /// Poses every part as `project` (the rig file set up, in another pose) has it.
+    ///
+    /// # Errors
+    /// What a part's method refuses of the pose, naming the part's layer index.
+    pub fn pose(&mut self, project: &Project) -> Result<()> {
+        for (k, part) in self.parts.iter_mut().enumerate() {
+            if let Part::Bound(warper) = part {
+                let own = part_project(project, &self.bindings[k]);
+                if warper.follow(&own).with_context(|| format!("part {k}"))?
+                    == crate::Follow::NeedsSetup
+                {
+                    bail!("part {k}: the pose asks for a new setup");
+                }
+            }
+        }
+        self.move_followers();
+        Ok(())
+    }
+
+    /// Moves each follower's vertices where its leader's mesh now takes them.
+    fn move_followers(&mut self) {
+        let leaders: Vec<Option<(Vec<DVec2>, Vec<DVec2>)>> = self
+            .parts
+            .iter()
+            .map(|p| match p {
+                Part::Bound(w) => Some((w.deformer.rest().to_vec(), w.deformer.deformed())),
+                _ => None,
+            })
+            .collect();
+        for part in &mut self.parts {
+            let Part::Follows { mesh, leader, ties } = part else {
+                continue;
+            };
+            let lead = leader.and_then(|j| leaders[j].as_ref());
+            mesh.deformed = mesh
+                .rest
+                .iter()
+                .zip(ties.iter())
+                .map(|(&p, tie)| match (tie, lead) {
+                    (Tie::In(tri, b), Some((_, moved))) => {
+                        (0..3).map(|i| moved[tri[i] as usize] * b[i]).sum()
+                    }
+                    (Tie::Near(v), Some((rest, moved))) => {
+                        p + moved[*v as usize] - rest[*v as usize]
+                    }
+                    _ => p,
+                })
+                .collect();
+        }
+    }
+
+    /// The parts' meshes in the current pose, and what binds them.
+    pub fn set(&self) -> PartSet {
+        PartSet {
+            meshes: self.meshes(),
+            bindings: self.bindings.clone(),
+            followed: self.followed.clone(),
+        }
+    }
+
+    /// For each layer, its part's mesh in the current pose; `None` for a hidden layer.
+    pub fn meshes(&self) -> Vec<Option<PartMesh>> {
+        self.parts
+            .iter()
+            .map(|p| match p {
+                Part::Hidden => None,
+                Part::Bound(w) => Some(PartMesh {
+                    rest: w.deformer.rest().to_vec(),
+                    deformed: w.deformer.deformed(),
+                    triangles: w.triangles.clone(),
+                }),
+                Part::Follows { mesh, .. } => Some(mesh.clone()),
+            })
+            .collect()
+    }
 }
 
 /// The visible parts of `set` (meshed from `artwork`) drawn as one mesh onto the
@@ -382,6 +517,47 @@ fn put(texture: &mut Picture, layer: &layers::Layer, x: u32, y: u32) {
     }
 }
 
+/// Draws `frames` of `project`'s animation of `artwork` as parts and writes them to
+/// `output` as `format` (atomically, as [`crate::animate::Animator::write`] does): the
+/// parts set up once (for the first frame's pose), each frame posed
+/// ([`PartRig::pose`]) and composited ([`composite`]) as `render --parts` draws that
+/// pose. `progress(done, total)` hears of each frame written.
+///
+/// # Errors
+/// What setting the parts up or posing them refuses; what the writer refuses.
+pub fn animate_parts(
+    artwork: &layers::Artwork,
+    project: &Project,
+    frames: &crate::animate::Frames,
+    output: &std::path::Path,
+    format: render::AnimationFormat,
+    progress: &dyn Fn(usize, usize),
+    listener: &dyn Listener,
+) -> Result<()> {
+    let first = animation::posed_at(project, frames.times.first().copied().unwrap_or(0.0));
+    let mut rig = PartRig::new(artwork, &first, None, listener)?;
+    let total = frames.times.len();
+    let mut writer = render::AnimationWriter::create(
+        output,
+        format,
+        artwork.width,
+        artwork.height,
+        total,
+        frames.fps,
+    )?;
+    progress(0, total);
+    for (i, &time) in frames.times.iter().enumerate() {
+        let posed = animation::posed_at(project, time);
+        rig.pose(&posed)
+            .with_context(|| format!("the pose at {time} s"))?;
+        let (picture, _) = composite(artwork, &rig.set(), &posed)?;
+        writer.push(&picture)?;
+        progress(i + 1, total);
+    }
+    writer.finish()?;
+    Ok(())
+}
+
 /// The artwork's canvas as a frame.
 fn canvas_of(artwork: &layers::Artwork) -> Frame {
     Frame {
@@ -458,22 +634,22 @@ fn draw(picture: &Picture, mesh: &PartMesh) -> Result<Picture> {
     Ok(out)
 }
 
-/// `part` (on the canvas) meshed on its own, its vertices where `leader`'s warped mesh
-/// takes them (where they are, without a leader).
+/// `part` (on the canvas) meshed on its own, each vertex tied to where it lies on
+/// `leader`'s rest mesh (still, without a leader).
 fn follow(
     part: &Picture,
     leader: Option<&Warper>,
     project: &Project,
     density: usize,
     listener: &dyn Listener,
-) -> Result<PartMesh> {
+) -> Result<(PartMesh, Vec<Tie>)> {
     // Its own mesh: the method's setup with no handle is the identity on it.
     let mut still = part_project(project, &[]);
     still.method = project::Method::C2;
     let own = prepare_warper(&part.to_rgba8(), &still, Some(density), listener)?;
     let rest = own.deformer.rest().to_vec();
-    let deformed = match leader {
-        None => rest.clone(),
+    let ties = match leader {
+        None => vec![Tie::Still; rest.len()],
         Some(leader) => {
             let lead = Domain::new(
                 leader.deformer.rest().to_vec(),
@@ -481,25 +657,22 @@ fn follow(
                 Metric::Euclidean,
             )
             .map_err(|e| anyhow::anyhow!("the part beneath: {e}"))?;
-            let (lead_rest, lead_deformed) = (leader.deformer.rest(), leader.deformer.deformed());
             rest.iter()
                 .map(|&p| match lead.locate(p) {
-                    Some((t, b)) => {
-                        let tri = lead.triangles()[t];
-                        (0..3).map(|i| lead_deformed[tri[i] as usize] * b[i]).sum()
-                    }
-                    None => lead
-                        .nearest_vertex(p)
-                        .map_or(p, |v| p + lead_deformed[v as usize] - lead_rest[v as usize]),
+                    Some((t, b)) => Tie::In(lead.triangles()[t], [b[0], b[1], b[2]]),
+                    None => lead.nearest_vertex(p).map_or(Tie::Still, Tie::Near),
                 })
                 .collect()
         }
     };
-    Ok(PartMesh {
-        rest,
-        deformed,
-        triangles: own.triangles.clone(),
-    })
+    Ok((
+        PartMesh {
+            deformed: rest.clone(),
+            rest,
+            triangles: own.triangles.clone(),
+        },
+        ties,
+    ))
 }
 
 /// The number of canvas pixels where both layers have a visible pixel.
