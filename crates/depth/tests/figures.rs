@@ -119,17 +119,26 @@ fn in_front(scene: &Scene, order: &[u32], p: usize, q: usize) -> Option<bool> {
     }
 }
 
+/// The paper's Fig. 8 set-up: a strip 20 × 2 whose predefined depth rises along it
+/// (its left half behind, its right half in front), and a bar 3 × 12 whose depth lies
+/// between, laid across the strip from `x` on. Returns the scene, the strip, the bar
+/// and the predefined order.
+fn figure_8(x: f64) -> (Scene, usize, usize, Vec<u32>) {
+    let mut scene = Scene::default();
+    let strip = scene.piece(20, 2, DVec2::new);
+    let bar = scene.piece(2, 12, |u, v| DVec2::new(x + u * 1.5, v - 5.0));
+    let mut predefined = scene.of(strip, |u| u < 10.0);
+    predefined.extend(scene.of(bar, |_| true));
+    predefined.extend(scene.of(strip, |u| u > 10.0));
+    (scene, strip, bar, predefined)
+}
+
 #[test]
 fn figure_8_a_region_brought_between_two_depths_is_drawn_wholly_on_one_side() {
     // A strip whose depth rises along it (its left half behind, its right half in
     // front), and a bar whose depth lies between, laid across the strip where the
     // two halves meet, mostly over the left half.
-    let mut scene = Scene::default();
-    let strip = scene.piece(20, 2, DVec2::new);
-    let bar = scene.piece(2, 12, |u, v| DVec2::new(7.5 + u * 1.5, v - 5.0));
-    let mut predefined = scene.of(strip, |u| u < 10.0);
-    predefined.extend(scene.of(bar, |_| true));
-    predefined.extend(scene.of(strip, |u| u > 10.0));
+    let (mut scene, strip, bar, predefined) = figure_8(7.5);
     assert_eq!(predefined.len(), scene.triangles.len());
     // Drawn in the predefined order, the bar is partly in front and partly behind.
     assert_eq!(in_front(&scene, &predefined, bar, strip), None);
@@ -244,12 +253,7 @@ fn a_limb_swung_across_the_body_and_back_keeps_its_order_while_it_overlaps() {
 fn a_saved_region_given_by_one_triangle_a_side_keeps_its_order() {
     // The Fig. 8 bar over the strip's front half: alone it goes behind; remembered in
     // front by one triangle of each sheet, it stays in front.
-    let mut scene = Scene::default();
-    let strip = scene.piece(20, 2, DVec2::new);
-    let bar = scene.piece(2, 12, |u, v| DVec2::new(9.5 + u * 1.5, v - 5.0));
-    let mut predefined = scene.of(strip, |u| u < 10.0);
-    predefined.extend(scene.of(bar, |_| true));
-    predefined.extend(scene.of(strip, |u| u > 10.0));
+    let (scene, strip, bar, predefined) = figure_8(9.5);
     let alone = arrange(&scene.positions, &scene.triangles, &predefined, &[]);
     assert_eq!(in_front(&scene, &alone.order, bar, strip), Some(false));
     let region = &alone.regions[0];

@@ -52,6 +52,15 @@ fn rgba8(layer: &Layer) -> RgbaImage {
     canvas
 }
 
+/// The largest difference of one channel of one pixel between two pictures.
+fn worst_level(a: &RgbaImage, b: &RgbaImage) -> u8 {
+    a.pixels()
+        .zip(b.pixels())
+        .flat_map(|(p, q)| (0..4).map(move |c| p[c].abs_diff(q[c])))
+        .max()
+        .unwrap_or(0)
+}
+
 #[test]
 fn a_handle_binds_the_layers_under_it_and_a_joint_binds_both() {
     let project = rig(r#"{"type": "point", "rest": [30, 60]},
@@ -99,24 +108,14 @@ fn at_rest_the_parts_composite_to_the_layers_flattened() {
         parts.warped.flatten().into_rgba8(),
         artwork.flatten().into_rgba8(),
     );
-    let worst = a
-        .pixels()
-        .zip(b.pixels())
-        .flat_map(|(p, q)| (0..4).map(move |c| p[c].abs_diff(q[c])))
-        .max()
-        .unwrap_or(0);
+    let worst = worst_level(&a, &b);
     assert!(
         worst <= 1,
         "differs from the layers flattened by {worst} levels"
     );
     // Drawn as one mesh (their overlap at rest in the layers' order), the same.
     let joined = parts.composite.clone().into_rgba8();
-    let worst = joined
-        .pixels()
-        .zip(b.pixels())
-        .flat_map(|(p, q)| (0..4).map(move |c| p[c].abs_diff(q[c])))
-        .max()
-        .unwrap_or(0);
+    let worst = worst_level(&joined, &b);
     assert!(worst <= 1, "the composite differs by {worst} levels");
     // Each part comes cut to the rectangle its mesh can touch, not the whole canvas.
     let right = &parts.warped.layers[1];
@@ -231,12 +230,7 @@ fn parts_are_composited_as_one_mesh_with_overlaps_ordered_between_them() {
         parts.composite.clone().into_rgba8(),
         artwork.flatten().into_rgba8(),
     );
-    let worst = a
-        .pixels()
-        .zip(b.pixels())
-        .flat_map(|(p, q)| (0..4).map(move |c| p[c].abs_diff(q[c])))
-        .max()
-        .unwrap_or(0);
+    let worst = worst_level(&a, &b);
     assert!(
         worst <= 1,
         "differs from the layers flattened by {worst} levels"
