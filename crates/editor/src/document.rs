@@ -658,9 +658,7 @@ impl Document {
     /// What the method refuses in the pose (as [`Document::restore`]).
     pub fn settle(&mut self) -> Result<()> {
         self.set_live(false)?;
-        if self.depth_deferred {
-            self.rearrange();
-        }
+        self.arrange_deferred();
         Ok(())
     }
 

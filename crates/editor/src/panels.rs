@@ -111,6 +111,11 @@ impl eframe::App for EditorApp {
         let clock = Instant::now();
         let ctx = ui.ctx().clone();
         self.poll_job();
+        // An edit of a large mesh is drawn with its overlaps arranged from the frame
+        // after it (automatic depth).
+        if let Some(doc) = &mut self.doc {
+            doc.arrange_deferred();
+        }
         self.sync_tool();
         self.tick(&ctx);
         self.dropped_files(&ctx);

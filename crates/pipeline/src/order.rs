@@ -114,6 +114,12 @@ impl Arranger {
         arranger
     }
 
+    /// Takes another predefined order for the same mesh (new handle depths), keeping
+    /// what it remembers.
+    pub fn set_predefined(&mut self, predefined: Vec<u32>) {
+        self.predefined = predefined;
+    }
+
     /// Forgets the last pose's regions and starts the next arrangement from the
     /// orders `overlaps` saved (each sheet by the triangle whose rest centroid is
     /// nearest its place).

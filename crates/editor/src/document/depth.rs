@@ -9,9 +9,11 @@ use project::{HandleSpec, OverlapOrder};
 
 use super::Document;
 
-/// The most triangles arranged on every frame of a live drag (a few milliseconds where
-/// the pose overlaps itself); a larger mesh keeps the drag's first order until the drag
-/// ends, and is arranged then.
+/// The most triangles arranged on every frame of a live drag and at once after every
+/// edit (a few milliseconds where the pose overlaps itself). A larger mesh keeps the
+/// drag's first order until the drag ends, and is arranged then; after another edit
+/// (an insertion, an undo) it is arranged on the next frame
+/// ([`Document::arrange_deferred`]). A mesh new to the document is arranged at once.
 const LIVE_TRIANGLES: usize = 12_000;
 
 /// The arrangement of the mesh shown, and what it was made for.
@@ -45,6 +47,23 @@ impl Document {
     /// documentation); bumps [`Document::order_version`] when the drawing order
     /// changed.
     pub(super) fn rearrange(&mut self) {
+        self.rearrange_now(false);
+    }
+
+    /// Arranges a pose whose arrangement waited (see [`LIVE_TRIANGLES`]): the app
+    /// calls it at the start of every frame, so an edit of a large mesh is drawn
+    /// arranged from the frame after it. Returns whether it arranged.
+    pub fn arrange_deferred(&mut self) -> bool {
+        if !self.depth_deferred || self.live {
+            return false;
+        }
+        self.rearrange_now(true);
+        true
+    }
+
+    /// [`Document::rearrange`]; on the mesh arranged last, a large one waits for the
+    /// drag's end or the next frame unless `now`.
+    pub(super) fn rearrange_now(&mut self, now: bool) {
         let cage = self.project.method.controls() == Controls::Cage;
         // (Compared by where the shown mesh's triangles lie, not element by element:
         // a pose keeps the mesh, and this runs on every frame of a drag.)
@@ -57,7 +76,7 @@ impl Document {
         let same_mesh = self.depth.as_ref().is_some_and(|d| {
             d.cage == cage && d.triangles.len() > LIVE_TRIANGLES && Some(d.mesh) == key
         });
-        if self.live && same_mesh && self.project.auto_depth {
+        if (self.live || !now) && same_mesh && self.project.auto_depth {
             self.depth_deferred = true;
             return;
         }
@@ -92,26 +111,36 @@ impl Document {
                 && d.depths != depths
                 && d.wrote == self.project.overlaps
         });
-        let kept = previous.filter(|d| {
-            d.cage == cage
-                && d.depths == depths
-                && d.triangles == triangles
-                && d.wrote == self.project.overlaps
-        });
+        let predefined = |rig| {
+            if cage {
+                (0..triangles.len() as u32).collect()
+            } else {
+                predefined_order(rig, &depths)
+            }
+        };
+        // The same mesh keeps its arranger (its topology, and what it remembers: a
+        // handle added or removed changes no overlap's order).
+        let kept = previous.filter(|d| d.cage == cage && d.triangles == triangles);
         let mut arranger = match kept {
-            Some(depth) => depth.arranger,
+            Some(depth) => {
+                let mut arranger = depth.arranger;
+                if depth.depths != depths {
+                    arranger.set_predefined(predefined(&self.rig));
+                }
+                if new_depths {
+                    arranger.restart(&[], deformer.rest(), triangles);
+                } else if depth.wrote != self.project.overlaps {
+                    arranger.restart(&self.project.overlaps, deformer.rest(), triangles);
+                }
+                arranger
+            }
             None => {
-                let predefined = if cage {
-                    (0..triangles.len() as u32).collect()
-                } else {
-                    predefined_order(&self.rig, &depths)
-                };
                 let saved: &[OverlapOrder] = if new_depths {
                     &[]
                 } else {
                     &self.project.overlaps
                 };
-                Arranger::new(predefined, saved, deformer.rest(), triangles)
+                Arranger::new(predefined(&self.rig), saved, deformer.rest(), triangles)
             }
         };
         let order = as_triangles(
