@@ -726,6 +726,9 @@ fn part_project(project: &Project, bound: &[usize]) -> Project {
     part.virtual_placed_for.clear();
     part.animation = None;
     part.canvas = Canvas::Keep;
+    // The saved overlap orders name places on the parts drawn together
+    // ([`composite`]), not on one part's own mesh.
+    part.overlaps.clear();
     part
 }
 
