@@ -383,103 +383,153 @@ pub fn composite(
     set: &PartSet,
     project: &Project,
 ) -> Result<(Picture, Vec<project::OverlapOrder>)> {
-    /// Transparent pixels around each layer in the texture, so that sampling at a
-    /// part's edge sees what lies around it on the canvas: nothing.
-    const PAD: u32 = 2;
-    let shown: Vec<(usize, &layers::Layer, &PartMesh)> = artwork
-        .layers
-        .iter()
-        .zip(&set.meshes)
-        .enumerate()
-        .filter_map(|(k, (layer, mesh))| {
-            Some((k, layer, mesh.as_ref()?)).filter(|_| layer.visible && layer.opacity > 0.0)
-        })
-        .collect();
-    let deep = shown
-        .iter()
-        .any(|(_, l, _)| l.pixels.bits_per_channel() == 16);
-    // Shelves as wide as the widest layer or the square root of the area, whichever
-    // is more.
-    let area: u64 = shown
-        .iter()
-        .map(|(_, l, _)| {
-            let (w, h) = l.dimensions();
-            u64::from(w + 2 * PAD) * u64::from(h + 2 * PAD)
-        })
-        .sum();
-    let widest = shown
-        .iter()
-        .map(|(_, l, _)| l.dimensions().0 + 2 * PAD)
-        .max()
-        .unwrap_or(1);
-    let width = widest.max((area as f64).sqrt().ceil() as u32);
-    let (mut x, mut y, mut shelf) = (0u32, 0u32, 0u32);
-    let mut slots = Vec::with_capacity(shown.len());
-    for (_, layer, _) in &shown {
-        let (w, h) = layer.dimensions();
-        let (w, h) = (w + 2 * PAD, h + 2 * PAD);
-        if x + w > width {
-            (x, y, shelf) = (0, y + shelf, 0);
+    Composer::new(artwork, set)?.draw(&set.meshes, project)
+}
+
+/// What [`composite`] draws with that does not change with the pose: the texture of
+/// the visible parts and where each part's vertices sample it, made once for an
+/// animation's frames.
+pub struct Composer {
+    /// The layers drawn (indices), in order.
+    shown: Vec<usize>,
+    /// Each drawn layer's pixels, packed.
+    texture: Picture,
+    /// Each drawn layer's vertices' places in the texture, in order.
+    uv: Vec<Vec2>,
+    /// The canvas.
+    canvas: Frame,
+}
+
+impl Composer {
+    /// Packs the visible parts of `set` (their layers' pixels, meshed from `artwork`).
+    ///
+    /// # Errors
+    /// Not enough memory for the texture.
+    pub fn new(artwork: &layers::Artwork, set: &PartSet) -> Result<Self> {
+        /// Transparent pixels around each layer in the texture, so that sampling at a
+        /// part's edge sees what lies around it on the canvas: nothing.
+        const PAD: u32 = 2;
+        let shown: Vec<(usize, &layers::Layer, &PartMesh)> = artwork
+            .layers
+            .iter()
+            .zip(&set.meshes)
+            .enumerate()
+            .filter_map(|(k, (layer, mesh))| {
+                Some((k, layer, mesh.as_ref()?)).filter(|_| layer.visible && layer.opacity > 0.0)
+            })
+            .collect();
+        let deep = shown
+            .iter()
+            .any(|(_, l, _)| l.pixels.bits_per_channel() == 16);
+        // Shelves as wide as the widest layer or the square root of the area,
+        // whichever is more.
+        let area: u64 = shown
+            .iter()
+            .map(|(_, l, _)| {
+                let (w, h) = l.dimensions();
+                u64::from(w + 2 * PAD) * u64::from(h + 2 * PAD)
+            })
+            .sum();
+        let widest = shown
+            .iter()
+            .map(|(_, l, _)| l.dimensions().0 + 2 * PAD)
+            .max()
+            .unwrap_or(1);
+        let width = widest.max((area as f64).sqrt().ceil() as u32);
+        let (mut x, mut y, mut shelf) = (0u32, 0u32, 0u32);
+        let mut slots = Vec::with_capacity(shown.len());
+        for (_, layer, _) in &shown {
+            let (w, h) = layer.dimensions();
+            let (w, h) = (w + 2 * PAD, h + 2 * PAD);
+            if x + w > width {
+                (x, y, shelf) = (0, y + shelf, 0);
+            }
+            slots.push((x + PAD, y + PAD));
+            x += w;
+            shelf = shelf.max(h);
         }
-        slots.push((x + PAD, y + PAD));
-        x += w;
-        shelf = shelf.max(h);
+        let height = (y + shelf).max(1);
+        let texture_frame = Frame {
+            origin: [0, 0],
+            width,
+            height,
+        };
+        let mut texture = blank(if deep { 16 } else { 8 }, texture_frame)?;
+        let mut uv = Vec::new();
+        for ((_, layer, mesh), &(sx, sy)) in shown.iter().zip(&slots) {
+            put(&mut texture, layer, sx, sy);
+            let shift = DVec2::new(
+                f64::from(sx) - f64::from(layer.x),
+                f64::from(sy) - f64::from(layer.y),
+            );
+            uv.extend(mesh.rest.iter().map(|&p| (p + shift).as_vec2()));
+        }
+        Ok(Self {
+            shown: shown.iter().map(|&(k, _, _)| k).collect(),
+            texture,
+            uv,
+            canvas: canvas_of(artwork),
+        })
     }
-    let height = (y + shelf).max(1);
-    let texture_frame = Frame {
-        origin: [0, 0],
-        width,
-        height,
-    };
-    let mut texture = blank(if deep { 16 } else { 8 }, texture_frame)?;
-    for ((_, layer, _), &(sx, sy)) in shown.iter().zip(&slots) {
-        put(&mut texture, layer, sx, sy);
+
+    /// Draws the parts' `meshes` (the same parts and meshes, in any pose), as
+    /// [`composite`] does.
+    ///
+    /// # Errors
+    /// Non-finite positions, meshes not the ones packed, or not enough memory for
+    /// the canvas.
+    pub fn draw(
+        &self,
+        meshes: &[Option<PartMesh>],
+        project: &Project,
+    ) -> Result<(Picture, Vec<project::OverlapOrder>)> {
+        // The joined mesh: canvas positions at rest and warped.
+        let (mut rest, mut deformed) = (Vec::new(), Vec::new());
+        let (mut triangles, mut part_of) = (Vec::new(), Vec::new());
+        for &k in &self.shown {
+            let Some(mesh) = meshes.get(k).and_then(Option::as_ref) else {
+                bail!("part {k} has no mesh to draw");
+            };
+            let base = rest.len() as u32;
+            rest.extend_from_slice(&mesh.rest);
+            deformed.extend_from_slice(&mesh.deformed);
+            triangles.extend(mesh.triangles.iter().map(|t| t.map(|v| v + base)));
+            part_of.extend(std::iter::repeat_n(k as u32, mesh.triangles.len()));
+        }
+        if rest.len() != self.uv.len() {
+            bail!("the parts' meshes are not the ones their texture was packed for");
+        }
+        if deformed.iter().any(|p| !p.is_finite()) {
+            bail!("the deformation produced non-finite positions");
+        }
+        let predefined: Vec<u32> = (0..triangles.len() as u32).collect();
+        let (order, overlaps) = if project.auto_depth {
+            let mut arranger = crate::order::Arranger::with_parts(
+                predefined,
+                &project.overlaps,
+                &rest,
+                &triangles,
+                part_of,
+            );
+            let order = arranger.arrange(&deformed, &triangles);
+            (order, arranger.overlaps(&rest, &triangles))
+        } else {
+            (predefined, Vec::new())
+        };
+        let drawn = crate::order::as_triangles(&order, &triangles);
+        let moved: Vec<Vec2> = deformed.iter().map(|p| p.as_vec2()).collect();
+        let mut canvas = blank(self.texture.bits_per_channel(), self.canvas)?;
+        render::warp_picture_over(
+            &self.texture,
+            &render::WarpMesh {
+                rest: &self.uv,
+                deformed: &moved,
+                triangles: &drawn,
+            },
+            &mut canvas,
+        )?;
+        Ok((canvas, overlaps))
     }
-    // The joined mesh: texture positions, canvas positions at rest and warped.
-    let (mut uv, mut rest, mut deformed) = (Vec::new(), Vec::new(), Vec::new());
-    let (mut triangles, mut part_of) = (Vec::new(), Vec::new());
-    for ((k, layer, mesh), &(sx, sy)) in shown.iter().zip(&slots) {
-        let base = rest.len() as u32;
-        let shift = DVec2::new(
-            f64::from(sx) - f64::from(layer.x),
-            f64::from(sy) - f64::from(layer.y),
-        );
-        uv.extend(mesh.rest.iter().map(|&p| (p + shift).as_vec2()));
-        rest.extend_from_slice(&mesh.rest);
-        deformed.extend_from_slice(&mesh.deformed);
-        triangles.extend(mesh.triangles.iter().map(|t| t.map(|v| v + base)));
-        part_of.extend(std::iter::repeat_n(*k as u32, mesh.triangles.len()));
-    }
-    if deformed.iter().any(|p| !p.is_finite()) {
-        bail!("the deformation produced non-finite positions");
-    }
-    let predefined: Vec<u32> = (0..triangles.len() as u32).collect();
-    let (order, overlaps) = if project.auto_depth {
-        let mut arranger = crate::order::Arranger::with_parts(
-            predefined,
-            &project.overlaps,
-            &rest,
-            &triangles,
-            part_of,
-        );
-        let order = arranger.arrange(&deformed, &triangles);
-        (order, arranger.overlaps(&rest, &triangles))
-    } else {
-        (predefined, Vec::new())
-    };
-    let drawn = crate::order::as_triangles(&order, &triangles);
-    let moved: Vec<Vec2> = deformed.iter().map(|p| p.as_vec2()).collect();
-    let mut canvas = blank(if deep { 16 } else { 8 }, canvas_of(artwork))?;
-    render::warp_picture_over(
-        &texture,
-        &render::WarpMesh {
-            rest: &uv,
-            deformed: &moved,
-            triangles: &drawn,
-        },
-        &mut canvas,
-    )?;
-    Ok((canvas, overlaps))
 }
 
 /// `layer`'s pixels written into `texture` at `(x, y)`, in the texture's depth, its
@@ -536,6 +586,7 @@ pub fn animate_parts(
 ) -> Result<()> {
     let first = animation::posed_at(project, frames.times.first().copied().unwrap_or(0.0));
     let mut rig = PartRig::new(artwork, &first, None, listener)?;
+    let composer = Composer::new(artwork, &rig.set())?;
     let total = frames.times.len();
     let mut writer = render::AnimationWriter::create(
         output,
@@ -550,7 +601,7 @@ pub fn animate_parts(
         let posed = animation::posed_at(project, time);
         rig.pose(&posed)
             .with_context(|| format!("the pose at {time} s"))?;
-        let (picture, _) = composite(artwork, &rig.set(), &posed)?;
+        let (picture, _) = composer.draw(&rig.meshes(), &posed)?;
         writer.push(&picture)?;
         progress(i + 1, total);
     }
