@@ -1634,3 +1634,61 @@ fn animate_parts_draws_each_frame_as_render_parts_draws_its_pose() {
     ]);
     assert!(refused.contains("--gpu"), "{refused}");
 }
+
+#[test]
+fn a_project_of_several_pictures_with_parts_renders_them_in_its_order() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let block = |name: &str, x0: u32, colour: [u8; 4]| {
+        let picture = image::RgbaImage::from_fn(200, 120, |x, y| {
+            let inside = (x0..x0 + 100).contains(&x) && (20..100).contains(&y);
+            image::Rgba(if inside { colour } else { [0; 4] })
+        });
+        picture
+            .save(dir.path().join(name))
+            .expect("write a picture");
+    };
+    block("left.png", 10, [200, 40, 40, 255]);
+    block("right.png", 80, [40, 40, 200, 255]);
+    let project = dir.path().join("pair.json");
+    let rig = |parts: &str| {
+        format!(
+            r#"{{"version": 1, "images": ["left.png", "right.png"], "density": 800,
+                "handles": [{{"type": "point", "rest": [30, 60]}},
+                            {{"type": "point", "rest": [170, 60]}}]{parts}}}"#
+        )
+    };
+    let (png, obj) = (dir.path().join("out.png"), dir.path().join("out.obj"));
+    // With "parts" in the rig file, no --parts is needed, and its order holds: the
+    // left picture sent to the front covers the right one where they overlap.
+    fs::write(&project, rig(r#", "parts": {"order": [1, 0]}"#)).expect("write the rig");
+    ok(&[os("render"), project.as_os_str(), os("-o"), png.as_os_str()]);
+    assert_eq!(load(&png).get_pixel(85, 60).0, [200, 40, 40, 255]);
+    ok(&[
+        os("deform"),
+        os("--rig"),
+        project.as_os_str(),
+        os("-o"),
+        obj.as_os_str(),
+    ]);
+    let objects: Vec<String> = (fs::read_to_string(&obj).expect("the OBJ").lines())
+        .filter_map(|l| l.strip_prefix("o ").map(str::to_owned))
+        .collect();
+    assert_eq!(
+        objects,
+        ["right", "left"],
+        "one object a part, in the draw order"
+    );
+    // Without "parts" the pictures are one picture, the later on top.
+    fs::write(&project, rig("")).expect("write the rig");
+    ok(&[os("render"), project.as_os_str(), os("-o"), png.as_os_str()]);
+    assert_eq!(load(&png).get_pixel(85, 60).0, [40, 40, 200, 255]);
+    // Every picture named is an input no output may replace.
+    let left = dir.path().join("left.png");
+    let line = fails(&[
+        os("render"),
+        project.as_os_str(),
+        os("-o"),
+        left.as_os_str(),
+    ]);
+    assert!(line.contains("one of the inputs"), "{line}");
+}

@@ -33,14 +33,14 @@ pub fn run(request: &Request) -> Result<()> {
     let project = load_project(request.project)?;
     let frames = plan(&project, request.span, format)
         .with_context(|| format!("cannot animate {}", request.project.display()))?;
-    let image = match request.image {
-        Some(image) => image.to_path_buf(),
-        None => crate::named_picture(request.project, project.image.as_deref())?,
+    let pictures = match request.image {
+        Some(image) => vec![image.to_path_buf()],
+        None => crate::named_pictures(request.project, &project)?,
     };
-    render::refuse_input_as_output(request.output, &[request.project, &image])?;
-    if request.parts {
-        anyhow::ensure!(!request.gpu, "--parts draws on the CPU: leave out --gpu");
-        let artwork = crate::load_artwork_noting(&image)?;
+    render::refuse_input_as_output(request.output, &crate::inputs(request.project, &pictures))?;
+    if request.parts || project.parts.is_some() {
+        anyhow::ensure!(!request.gpu, "parts are drawn on the CPU: leave out --gpu");
+        let artwork = crate::load_artwork_noting(&pictures)?;
         let progress = crate::progress::Steps::new(1);
         progress.step("meshing every part, then drawing and writing frames");
         let listener = &progress;
@@ -56,7 +56,7 @@ pub fn run(request: &Request) -> Result<()> {
         progress.finish();
         return Ok(());
     }
-    let picture = crate::load_flattened(&image)?;
+    let picture = crate::load_flattened(&pictures)?;
     let progress = crate::progress::Steps::new(2);
     progress.step("meshing and weighting");
     let animator = Animator::new(&picture, &project, &frames, request.gpu, &progress)?;

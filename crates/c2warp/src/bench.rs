@@ -20,8 +20,8 @@ pub fn run(
     if let Some(method) = method {
         project.method = method;
     }
-    let file = source.file(rig_path, &project)?;
-    let input = Input::load(source, &file)?;
+    let files = source.files(rig_path, &project)?;
+    let input = Input::load(source, &files)?;
     let mut warper = pipeline::setup(input.source(), &project, &())?;
     crate::warn(&*warper.deformer);
     let report = warper.deformer.bench(&project, positions)?;

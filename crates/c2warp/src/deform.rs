@@ -1,7 +1,7 @@
 //! `c2warp deform`: the deformed mesh as Wavefront OBJ, by any method.
 
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
 use glam::DVec2;
@@ -25,15 +25,15 @@ pub fn run(
     if let Some(method) = method {
         project.method = method;
     }
-    let file = source.file(rig_path, &project)?;
-    render::refuse_input_as_output(output, &[rig_path, &file])?;
-    if parts {
+    let files = source.files(rig_path, &project)?;
+    render::refuse_input_as_output(output, &crate::inputs(rig_path, &files))?;
+    if parts || (project.parts.is_some() && source.mesh.is_none()) {
         if source.mesh.is_some() {
             bail!("--parts meshes each layer of a picture: give --image, not --mesh");
         }
-        return run_parts(&file, source.density, &project, output);
+        return run_parts(&files, source.density, &project, output);
     }
-    let input = Input::load(source, &file)?;
+    let input = Input::load(source, &files)?;
     let progress = crate::progress::Steps::new(3);
     progress.step("meshing and weighting");
     // With --mesh, the given mesh is the method's own (ARAP solves on it, LBC takes it
@@ -51,18 +51,20 @@ pub fn run(
 
 /// `deform --parts`: every visible layer of the picture `file` set up as a part
 /// ([`pipeline::set_up_parts`]), each written as an OBJ object (`o` and the layer's
-/// name) of its deformed vertices and triangles, in the layers' order.
-fn run_parts(file: &Path, density: Option<usize>, project: &Project, output: &Path) -> Result<()> {
-    let artwork = crate::load_artwork_noting(file)?;
+/// name) of its deformed vertices and triangles, in the draw order.
+fn run_parts(
+    files: &[PathBuf],
+    density: Option<usize>,
+    project: &Project,
+    output: &Path,
+) -> Result<()> {
+    let artwork = crate::load_artwork_noting(files)?;
     let progress = crate::progress::Steps::new(2);
     progress.step("meshing, weighting and posing every part");
     let set = pipeline::set_up_parts(&artwork, project, density, &progress)?;
     progress.step("writing");
-    let parts: Vec<(&str, &pipeline::PartMesh)> = artwork
-        .layers
-        .iter()
-        .zip(&set.meshes)
-        .filter_map(|(layer, mesh)| Some((layer.name.as_str(), mesh.as_ref()?)))
+    let parts: Vec<(&str, &pipeline::PartMesh)> = (set.order.iter())
+        .filter_map(|&k| Some((artwork.layers[k].name.as_str(), set.meshes[k].as_ref()?)))
         .collect();
     let vertices: usize = parts.iter().map(|(_, m)| m.deformed.len()).sum();
     let triangles: usize = parts.iter().map(|(_, m)| m.triangles.len()).sum();

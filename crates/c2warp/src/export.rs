@@ -12,9 +12,9 @@ use crate::{Input, Source};
 /// [`pipeline::Deformer::weights`] lists.
 pub fn weights(source: &Source, rig_path: &Path, output: &Path) -> Result<()> {
     let project = load_project(rig_path)?;
-    let file = source.file(rig_path, &project)?;
-    render::refuse_input_as_output(output, &[rig_path, &file])?;
-    let input = Input::load(source, &file)?;
+    let files = source.files(rig_path, &project)?;
+    render::refuse_input_as_output(output, &crate::inputs(rig_path, &files))?;
+    let input = Input::load(source, &files)?;
     let progress = crate::progress::Steps::new(2);
     progress.step("meshing and weighting");
     let warper = pipeline::setup(input.source(), &project, &progress)?;

@@ -244,14 +244,13 @@ enum Input {
 }
 
 impl Source {
-    /// The file the samples come from: the mesh or the image given, else the picture
-    /// the rig file at `rig` names.
-    fn file(&self, rig: &Path, project: &Project) -> Result<PathBuf> {
+    /// The files the samples come from: the mesh or the image given, else the
+    /// pictures the rig file at `rig` names (its `"image"`, or its `"images"` drawn
+    /// as layers).
+    fn files(&self, rig: &Path, project: &Project) -> Result<Vec<PathBuf>> {
         match (&self.mesh, &self.image) {
-            (Some(path), _) | (None, Some(path)) => Ok(path.clone()),
-            (None, None) => {
-                named_picture(rig, project.image.as_deref()).context("give --mesh or --image")
-            }
+            (Some(path), _) | (None, Some(path)) => Ok(vec![path.clone()]),
+            (None, None) => named_pictures(rig, project).context("give --mesh or --image"),
         }
     }
 }
@@ -261,26 +260,31 @@ impl Source {
 ///
 /// # Errors
 /// A project that names none.
-pub(crate) fn named_picture(project: &Path, named: Option<&Path>) -> Result<PathBuf> {
-    let Some(named) = named else {
+pub(crate) fn named_pictures(path: &Path, project: &Project) -> Result<Vec<PathBuf>> {
+    let folder = path.parent().unwrap_or(Path::new(""));
+    let named: Vec<PathBuf> = (project.image.iter().chain(&project.images))
+        .map(|p| folder.join(p))
+        .collect();
+    if named.is_empty() {
         bail!(
             "{} names no picture (\"image\"): give one with --image PATH",
-            project.display()
+            path.display()
         );
-    };
-    Ok(project.parent().unwrap_or(Path::new("")).join(named))
+    }
+    Ok(named)
 }
 
 impl Input {
-    /// Reads `file`, the OBJ mesh or the picture `source` stands for (a mesh is
-    /// checked).
-    fn load(source: &Source, file: &Path) -> Result<Self> {
+    /// Reads `files`, the OBJ mesh or the pictures `source` stands for (a mesh is
+    /// checked; pictures are flattened).
+    fn load(source: &Source, files: &[PathBuf]) -> Result<Self> {
         if source.mesh.is_none() {
             return Ok(Self::Picture {
-                image: pipeline::load_image(file)?,
+                image: load_flattened(files)?.to_rgba8().into_owned(),
                 density: source.density,
             });
         }
+        let file = &files[0];
         let mesh = pipeline::load_obj(file)?;
         mesh.sanity_check()
             .with_context(|| format!("mesh {}", file.display()))?;
@@ -478,12 +482,19 @@ fn cage(
     write_text(output, project.to_json().as_bytes())
 }
 
-/// The rig file, the project it holds and the picture a command warps: `first` is
+/// The rig file, the project it holds and the pictures a command warps: `first` is
 /// the picture and `rig` the rig file, or, without `rig`, `first` is the project and
-/// names its picture.
-fn project_and_picture(first: &Path, rig: Option<&Path>) -> Result<(PathBuf, Project, PathBuf)> {
+/// names its pictures.
+fn project_and_picture(
+    first: &Path,
+    rig: Option<&Path>,
+) -> Result<(PathBuf, Project, Vec<PathBuf>)> {
     if let Some(rig) = rig {
-        return Ok((rig.to_path_buf(), load_project(rig)?, first.to_path_buf()));
+        return Ok((
+            rig.to_path_buf(),
+            load_project(rig)?,
+            vec![first.to_path_buf()],
+        ));
     }
     let is_json = first
         .extension()
@@ -495,8 +506,8 @@ fn project_and_picture(first: &Path, rig: Option<&Path>) -> Result<(PathBuf, Pro
         );
     }
     let project = load_project(first)?;
-    let picture = named_picture(first, project.image.as_deref())?;
-    Ok((first.to_path_buf(), project, picture))
+    let pictures = named_pictures(first, &project)?;
+    Ok((first.to_path_buf(), project, pictures))
 }
 
 /// What `render` writes: the warped picture, its layers, or both.
@@ -519,9 +530,9 @@ fn render(
     method: Option<Method>,
     canvas: Option<project::Canvas>,
 ) -> Result<()> {
-    let (rig, mut project, image) = project_and_picture(input, rig)?;
+    let (rig, mut project, pictures) = project_and_picture(input, rig)?;
     for output in [outputs.png, outputs.layers].into_iter().flatten() {
-        render::refuse_input_as_output(output, &[&image, &rig])?;
+        render::refuse_input_as_output(output, &inputs(&rig, &pictures))?;
     }
     if let Some(layers) = outputs.layers {
         let is_ora = layers
@@ -546,8 +557,8 @@ fn render(
     if let Some(canvas) = canvas {
         project.canvas = canvas;
     }
-    let artwork = load_artwork_noting(&image)?;
-    if outputs.parts {
+    let artwork = load_artwork_noting(&pictures)?;
+    if outputs.parts || project.parts.is_some() {
         if gpu {
             bail!("--parts draws on the CPU: leave out --gpu");
         }
@@ -614,20 +625,26 @@ fn same_file_name(a: &Path, b: &Path) -> bool {
     absolute(a) == absolute(b)
 }
 
-/// Reads a picture as [`pipeline::load_artwork`] does, saying on standard error what of
-/// a layered file is drawn otherwise than it asks.
-pub(crate) fn load_artwork_noting(path: &Path) -> Result<pipeline::Artwork> {
-    let artwork = pipeline::load_artwork(path)?;
+/// Reads pictures as [`pipeline::load_artworks`] does (several: the layers of one),
+/// saying on standard error what of a layered file is drawn otherwise than it asks.
+pub(crate) fn load_artwork_noting(paths: &[PathBuf]) -> Result<pipeline::Artwork> {
+    let artwork = pipeline::load_artworks(paths)?;
     for note in &artwork.notes {
-        eprintln!("note: {}: {note}", path.display());
+        eprintln!("note: {}: {note}", paths[0].display());
     }
     Ok(artwork)
 }
 
-/// Reads a picture as [`pipeline::load_picture`] does, saying on standard error what of a
-/// layered file is drawn otherwise than it asks.
-pub(crate) fn load_flattened(path: &Path) -> Result<render::Picture> {
-    Ok(load_artwork_noting(path)?.flatten())
+/// Reads pictures as [`load_artwork_noting`] does, flattened.
+pub(crate) fn load_flattened(paths: &[PathBuf]) -> Result<render::Picture> {
+    Ok(load_artwork_noting(paths)?.flatten())
+}
+
+/// A command's inputs: its rig file and its pictures.
+pub(crate) fn inputs<'a>(rig: &'a Path, pictures: &'a [PathBuf]) -> Vec<&'a Path> {
+    std::iter::once(rig)
+        .chain(pictures.iter().map(PathBuf::as_path))
+        .collect()
 }
 
 /// Meshes, weights, warps and writes `picture` by `project` (with its method), with a

@@ -140,8 +140,11 @@ pub struct Document {
     /// The picture's layers, as its file has them (one for a flat picture; `None`
     /// for the built-in picture): *Export layers…* warps each on its own.
     pub layers: Option<Arc<pipeline::Artwork>>,
-    /// Where the picture came from (`None`: the built-in picture).
+    /// Where the picture came from (`None`: the built-in picture, or several pictures).
     pub image_path: Option<PathBuf>,
+    /// The pictures drawn as the layers of one (a rig file's `"images"`), bottom first;
+    /// empty unless the picture came from several files.
+    pub image_paths: Vec<PathBuf>,
     /// Where the project was last saved or loaded from.
     pub project_path: Option<PathBuf>,
     /// What the picture file holds that is drawn otherwise than it asks (layers whose
@@ -216,6 +219,7 @@ impl Document {
             deep: None,
             layers: None,
             image_path,
+            image_paths: Vec::new(),
             project_path: None,
             picture_notes: Vec::new(),
             rig: prepared.rig,
@@ -357,14 +361,21 @@ impl Document {
     /// or bad picture, each naming the file.
     pub fn open_project(path: &Path) -> Result<Self> {
         let project = pipeline::load_project(path)?;
-        let Some(image) = &project.image else {
+        let folder = path.parent().unwrap_or(Path::new(""));
+        let named: Vec<PathBuf> = (project.image.iter().chain(&project.images))
+            .map(|p| folder.join(p))
+            .collect();
+        if named.is_empty() {
             bail!("{} names no image", path.display());
-        };
-        let image_path = path.parent().unwrap_or(Path::new("")).join(image);
-        let artwork = pipeline::load_artwork(&image_path)
+        }
+        let artwork = pipeline::load_artworks(&named)
             .with_context(|| format!("the image of project {}", path.display()))?;
-        let mut document = Self::from_picture(artwork.flatten(), Some(image_path), project)
+        let image_path = project.image.is_some().then(|| named[0].clone());
+        let mut document = Self::from_picture(artwork.flatten(), image_path, project)
             .with_context(|| format!("project {}", path.display()))?;
+        if document.image_path.is_none() {
+            document.image_paths = named;
+        }
         document.project_path = Some(path.to_path_buf());
         document.take_layers(artwork);
         Ok(document)
@@ -415,15 +426,22 @@ impl Document {
                     .any(|(a, b)| !same_rest(a, b)))
     }
 
+    /// The files the picture came from (none for the built-in picture).
+    pub fn pictures(&self) -> impl Iterator<Item = &Path> {
+        (self.image_path.iter().chain(&self.image_paths)).map(PathBuf::as_path)
+    }
+
     /// The rig file to save next to `path`: the picture's path relative to the file's
     /// folder where possible, and the virtual handles, so it reloads with the same
     /// weights.
     pub fn project_for_saving(&self, path: Option<&Path>) -> Project {
         let mut project = self.snapshot();
-        project.image = self.image_path.as_ref().map(|image| {
-            let folder = path.and_then(Path::parent).unwrap_or(Path::new(""));
-            pipeline::relative_path(image, folder)
-        });
+        let folder = path.and_then(Path::parent).unwrap_or(Path::new(""));
+        project.image =
+            (self.image_path.as_ref()).map(|image| pipeline::relative_path(image, folder));
+        project.images = (self.image_paths.iter())
+            .map(|image| pipeline::relative_path(image, folder))
+            .collect();
         project
     }
 

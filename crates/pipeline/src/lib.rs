@@ -13,7 +13,7 @@ pub mod order;
 pub mod parts;
 
 use std::io::{BufReader, Read};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, anyhow, bail};
 use glam::{DVec2, Vec2};
@@ -130,6 +130,54 @@ pub fn load_artwork(path: &Path) -> Result<layers::Artwork> {
         |s| s.to_string_lossy().into_owned(),
     );
     Ok(layers::Artwork::from_picture(&name, picture))
+}
+
+/// Reads several pictures as the layers of one, bottom first ([`load_artwork`] each:
+/// a flat picture is one layer at the origin, a layered file brings its layers at
+/// their offsets); the canvas is the largest width and height among them. One path
+/// is [`load_artwork`] of it.
+///
+/// # Errors
+/// No path, what reading one refuses (naming it), more than [`layers::MAX_LAYERS`]
+/// layers together, or a canvas past the picture limits.
+pub fn load_artworks(paths: &[PathBuf]) -> Result<layers::Artwork> {
+    let [first, rest @ ..] = paths else {
+        bail!("no picture to read");
+    };
+    let mut artwork = load_artwork(first)?;
+    let limit = render::ImageLimits::default();
+    for path in rest {
+        let more = load_artwork(path)?;
+        artwork.width = artwork.width.max(more.width);
+        artwork.height = artwork.height.max(more.height);
+        artwork.layers.extend(more.layers);
+        artwork.notes.extend(
+            more.notes
+                .into_iter()
+                .map(|n| format!("{}: {n}", path.display())),
+        );
+        if artwork.layers.len() > layers::MAX_LAYERS {
+            bail!(
+                "the pictures have more than {} layers together",
+                layers::MAX_LAYERS
+            );
+        }
+    }
+    let bytes: u64 = (artwork.layers.iter())
+        .map(|l| {
+            let (w, h) = l.dimensions();
+            // Four channels a pixel.
+            u64::from(w) * u64::from(h) * 4 * u64::from(l.pixels.bits_per_channel() / 8)
+        })
+        .sum();
+    if bytes > limit.max_alloc_bytes {
+        bail!(
+            "the pictures need {} MiB together; the limit is {} MiB",
+            bytes >> 20,
+            limit.max_alloc_bytes >> 20
+        );
+    }
+    Ok(artwork)
 }
 
 /// Meshes a picture at `options` (its outline traced from the alpha channel, or its

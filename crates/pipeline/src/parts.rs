@@ -1,6 +1,6 @@
 //! Layered artwork warped as parts: every visible layer meshed along its own outline
-//! and deformed by the handles that bind it, then composited in the layers' order
-//! (`c2warp render --parts`).
+//! and deformed by the handles that bind it, then composited in the draw order
+//! (`c2warp render --parts`, or a rig file with `"parts"`).
 //!
 //! A handle binds every visible layer with a visible pixel under it (for a bar: under
 //! both ends and its middle), so a handle placed where two layers overlap — a shoulder,
@@ -12,6 +12,11 @@
 //! part's warped mesh takes them (barycentrically inside it; outside it, by the
 //! displacement of its nearest vertex). A part that no handle binds and that overlaps
 //! no bound part beneath it stays where it is. Hidden layers are kept as they are.
+//!
+//! The rig file's `"parts"` ([`project::PartsSpec`]) changes three things: the draw
+//! order (`order`, bottom first; "beneath" is in that order), which layers are shown
+//! (`hidden`, `shown`, against the file's visibility) and which parts a handle binds
+//! (`bindings`: the parts named, whatever lies under the handle).
 //!
 //! The composite is drawn as one mesh ([`composite`]), so automatic depth (the ARAP
 //! paper's §5.1) orders overlaps between parts as within one. Not yet: parts in the
@@ -41,6 +46,9 @@ pub struct PartMesh {
 
 /// The parts of a layered picture, set up and posed ([`set_up_parts`]).
 pub struct PartSet {
+    /// The layers' draw order (indices, bottom first): the rig file's `parts.order`,
+    /// else the file's.
+    pub order: Vec<usize>,
     /// For each layer, its part's mesh; `None` for a hidden layer.
     pub meshes: Vec<Option<PartMesh>>,
     /// For each layer, the handles (indices into the project's) that bind it; empty
@@ -59,8 +67,8 @@ pub struct Parts {
     /// The orders automatic depth gave the overlap regions (between parts and within
     /// them), as a rig file keeps them.
     pub overlaps: Vec<project::OverlapOrder>,
-    /// The layers warped, each on the whole canvas at the origin (hidden layers as
-    /// they were), in the artwork's order.
+    /// The layers warped, each cut to what its warped mesh covers (hidden layers as
+    /// they were), in the draw order.
     pub warped: layers::Artwork,
     /// For each layer, the handles (indices into the project's) that bind it; empty
     /// for a hidden layer.
@@ -84,7 +92,8 @@ pub fn warp_parts(
     let set = set_up_parts(artwork, project, density, listener)?;
     let canvas = canvas_of(artwork);
     let mut warped = Vec::with_capacity(artwork.layers.len());
-    for (layer, mesh) in artwork.layers.iter().zip(&set.meshes) {
+    for &k in &set.order {
+        let (layer, mesh) = (&artwork.layers[k], &set.meshes[k]);
         let (x, y, pixels) = match mesh {
             None => (layer.x, layer.y, layer.pixels.clone()),
             Some(mesh) => {
@@ -99,7 +108,7 @@ pub fn warp_parts(
             x,
             y,
             opacity: layer.opacity,
-            visible: layer.visible,
+            visible: mesh.is_some(),
             pixels,
         });
     }
@@ -138,6 +147,8 @@ pub fn set_up_parts(
 /// again and again ([`PartRig::pose`]: an animation's frames).
 #[derive(Clone)]
 pub struct PartRig {
+    /// The layers' draw order (indices, bottom first).
+    order: Vec<usize>,
     /// For each layer, what moves it.
     parts: Vec<Part>,
     /// For each layer, the handles (indices into the project's) that bind it.
@@ -191,18 +202,23 @@ impl PartRig {
             bail!("a cage (LBC) deforms the picture as a whole: use it without parts");
         }
         let canvas = canvas_of(artwork);
-        let bindings: Vec<Vec<usize>> = artwork
-            .layers
-            .iter()
-            .map(|layer| {
-                if !layer.visible {
+        let spec = project.parts.clone().unwrap_or_default();
+        spec.check_layers(artwork.layers.len())?;
+        let order = spec.order_of(artwork.layers.len());
+        let shown: Vec<bool> = (artwork.layers.iter().enumerate())
+            .map(|(k, layer)| spec.shows(k, layer.visible))
+            .collect();
+        let bindings: Vec<Vec<usize>> = (artwork.layers.iter().enumerate())
+            .map(|(k, layer)| {
+                if !shown[k] {
                     return Vec::new();
                 }
                 (0..project.handles.len())
-                    .filter(|&h| {
-                        probes(&project.handles[h])
+                    .filter(|&h| match spec.binding(h) {
+                        Some(parts) => parts.contains(&k),
+                        None => probes(&project.handles[h])
                             .iter()
-                            .all(|p| covers(layer, *p))
+                            .all(|p| covers(layer, *p)),
                     })
                     .collect()
             })
@@ -215,11 +231,9 @@ impl PartRig {
                 h + 1
             );
         }
-        let areas: Vec<u64> = artwork
-            .layers
-            .iter()
-            .map(|l| {
-                if l.visible {
+        let areas: Vec<u64> = (artwork.layers.iter().enumerate())
+            .map(|(k, l)| {
+                if shown[k] {
                     visible_pixels(&l.pixels)
                 } else {
                     0
@@ -234,8 +248,10 @@ impl PartRig {
         };
         // The bound parts set up, each layer put on the canvas only while it is meshed.
         let mut parts: Vec<Part> = Vec::with_capacity(artwork.layers.len());
-        for ((layer, bound), &area) in artwork.layers.iter().zip(&bindings).zip(&areas) {
-            if !layer.visible || bound.is_empty() {
+        for (k, ((layer, bound), &area)) in
+            (artwork.layers.iter().zip(&bindings).zip(&areas)).enumerate()
+        {
+            if !shown[k] || bound.is_empty() {
                 parts.push(Part::Hidden);
                 continue;
             }
@@ -246,15 +262,15 @@ impl PartRig {
                     .with_context(|| format!("part \"{}\"", layer.name))?;
             parts.push(Part::Bound(Box::new(warper)));
         }
-        // The parts no handle binds follow the bound part beneath them they overlap
-        // most.
+        // The parts no handle binds follow the bound part beneath them (in the draw
+        // order) they overlap most.
         let mut followed = vec![None; artwork.layers.len()];
-        for (k, layer) in artwork.layers.iter().enumerate() {
-            if !layer.visible || matches!(parts[k], Part::Bound(_)) {
+        for (at, &k) in order.iter().enumerate() {
+            let layer = &artwork.layers[k];
+            if !shown[k] || matches!(parts[k], Part::Bound(_)) {
                 continue;
             }
-            let beneath = (0..k)
-                .rev()
+            let beneath = (order[..at].iter().rev().copied())
                 .filter(|&j| matches!(parts[j], Part::Bound(_)))
                 .map(|j| (j, overlap(layer, &artwork.layers[j])))
                 .filter(|&(_, n)| n > 0)
@@ -282,6 +298,7 @@ impl PartRig {
             };
         }
         let mut rig = Self {
+            order,
             parts,
             bindings,
             followed,
@@ -344,6 +361,7 @@ impl PartRig {
     /// The parts' meshes in the current pose, and what binds them.
     pub fn set(&self) -> PartSet {
         PartSet {
+            order: self.order.clone(),
             meshes: self.meshes(),
             bindings: self.bindings.clone(),
             followed: self.followed.clone(),
@@ -409,13 +427,10 @@ impl Composer {
         /// Transparent pixels around each layer in the texture, so that sampling at a
         /// part's edge sees what lies around it on the canvas: nothing.
         const PAD: u32 = 2;
-        let shown: Vec<(usize, &layers::Layer, &PartMesh)> = artwork
-            .layers
-            .iter()
-            .zip(&set.meshes)
-            .enumerate()
-            .filter_map(|(k, (layer, mesh))| {
-                Some((k, layer, mesh.as_ref()?)).filter(|_| layer.visible && layer.opacity > 0.0)
+        let shown: Vec<(usize, &layers::Layer, &PartMesh)> = (set.order.iter())
+            .filter_map(|&k| {
+                let (layer, mesh) = (artwork.layers.get(k)?, set.meshes.get(k)?.as_ref()?);
+                Some((k, layer, mesh)).filter(|_| layer.opacity > 0.0)
             })
             .collect();
         let deep = shown
@@ -780,6 +795,8 @@ fn part_project(project: &Project, bound: &[usize]) -> Project {
     // The saved overlap orders name places on the parts drawn together
     // ([`composite`]), not on one part's own mesh.
     part.overlaps.clear();
+    // A part is one picture: the parts' order, visibility and bindings are the whole's.
+    part.parts = None;
     part
 }
 

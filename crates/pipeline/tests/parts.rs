@@ -272,3 +272,73 @@ fn parts_are_composited_as_one_mesh_with_overlaps_ordered_between_them() {
     let parts = warp_parts(&artwork, &fixed, None, &()).expect("warps");
     assert_eq!(at(&parts.composite), [40, 40, 200, 255]);
 }
+
+#[test]
+fn the_rig_files_parts_reorder_hide_and_bind() {
+    let handles = r#"{"type": "point", "rest": [30, 60]},
+           {"type": "point", "rest": [85, 60], "translate": [0, 30]},
+           {"type": "point", "rest": [170, 60]}"#;
+    let artwork = two_parts();
+    let at = |p: &Picture, x, y| p.clone().into_rgba8().get_pixel(x, y).0;
+    // As the file has it, the right part is drawn over the left where they overlap.
+    let mut project = rig(handles.replace(r#", "translate": [0, 30]"#, "").as_str());
+    let plain = warp_parts(&artwork, &project, None, &()).expect("warps");
+    assert_eq!(at(&plain.composite, 85, 60), [40, 40, 200, 255]);
+    // Sent backward: the left part is in front, and the layers come in that order.
+    project.parts = Some(project::PartsSpec {
+        order: vec![1, 0],
+        ..Default::default()
+    });
+    let reordered = warp_parts(&artwork, &project, None, &()).expect("warps");
+    assert_eq!(at(&reordered.composite, 85, 60), [200, 40, 40, 255]);
+    let names: Vec<&str> = (reordered.warped.layers.iter())
+        .map(|l| l.name.as_str())
+        .collect();
+    assert_eq!(names, ["right", "left"]);
+    // Hidden: the right part is not drawn, and its layer is kept hidden as it was.
+    project.parts = Some(project::PartsSpec {
+        hidden: vec![1],
+        ..Default::default()
+    });
+    project.handles.pop();
+    let hidden = warp_parts(&artwork, &project, None, &()).expect("warps");
+    assert_eq!(at(&hidden.composite, 150, 60), [0; 4]);
+    assert_eq!(at(&hidden.composite, 85, 60), [200, 40, 40, 255]);
+    let kept = &hidden.warped.layers[1];
+    assert!(!kept.visible && kept.x == 80 && kept.dimensions() == (110, 80));
+    // The middle handle (over both) moved down: a joint pulls both parts; bound to
+    // the left part alone, the right part stays where it was, pixel for pixel.
+    let mut project = rig(handles);
+    let joint = warp_parts(&artwork, &project, None, &()).expect("warps");
+    assert_eq!(joint.bindings, vec![vec![0, 1], vec![1, 2]]);
+    let moved = rgba8(&joint.warped.layers[1]);
+    assert!(
+        (0..200).any(|x| moved.get_pixel(x, 105)[3] > 0),
+        "the joint took the right part down"
+    );
+    project.parts = Some(project::PartsSpec {
+        bindings: vec![project::Binding {
+            handle: 1,
+            parts: vec![0],
+        }],
+        ..Default::default()
+    });
+    let bound = warp_parts(&artwork, &project, None, &()).expect("warps");
+    assert_eq!(bound.bindings, vec![vec![0, 1], vec![2]]);
+    let right = rgba8(&bound.warped.layers[1]);
+    for (x, y, p) in right.enumerate_pixels() {
+        let inside = (80..190).contains(&x) && (20..100).contains(&y);
+        let expected = if inside { [40, 40, 200, 255] } else { [0; 4] };
+        assert_eq!(p.0, expected, "the right part at ({x}, {y})");
+    }
+    // An order for other layers than the picture has is refused, naming it.
+    project.parts = Some(project::PartsSpec {
+        order: vec![0, 1, 2],
+        ..Default::default()
+    });
+    let error = warp_parts(&artwork, &project, None, &())
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(error.contains("parts.order lists 3 layers"), "{error}");
+}

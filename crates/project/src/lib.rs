@@ -511,9 +511,14 @@ fn default_degree() -> u32 {
 pub struct Project {
     /// Format version; must be [`VERSION`].
     pub version: u32,
-    /// The image, relative to the project file (optional for a bare rig).
+    /// The image, relative to the project file (optional for a bare rig): a picture,
+    /// or layered artwork (PSD, OpenRaster).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub image: Option<PathBuf>,
+    /// Several pictures drawn as the layers of one (bottom first, each at the origin),
+    /// relative to the project file; instead of `image`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub images: Vec<PathBuf>,
     /// Shape factor α ∈ [0, 1].
     #[serde(default = "default_alpha")]
     pub alpha: f64,
@@ -596,6 +601,170 @@ pub struct Project {
     /// depth decided, so that a reopened file draws what was shown).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub overlaps: Vec<OverlapOrder>,
+    /// A layered picture drawn as parts (each layer meshed and moved on its own): the
+    /// parts' draw order, visibility and bindings. Absent: the picture is drawn as one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub parts: Option<PartsSpec>,
+}
+
+/// How a layered picture is drawn as parts (`"parts"`). Parts are named by their
+/// layer's index in the file, bottom first.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PartsSpec {
+    /// The draw order, bottom first: every layer's index once. Empty: the file's order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub order: Vec<usize>,
+    /// The layers shown as hidden here whatever the file says (the file's hidden
+    /// layers stay hidden unless listed in `shown`), ascending.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub hidden: Vec<usize>,
+    /// The layers the file hides that are shown here, ascending.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub shown: Vec<usize>,
+    /// Handles bound to the parts named rather than to every visible part under them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub bindings: Vec<Binding>,
+}
+
+/// A handle bound to chosen parts only (`{"handle": 3, "parts": [2]}`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Binding {
+    /// The handle (an index into [`Project::handles`]).
+    pub handle: usize,
+    /// The parts it binds (layer indices), ascending, at least one.
+    pub parts: Vec<usize>,
+}
+
+/// The most layers a layered picture may have, and so the highest part index + 1.
+pub const MAX_PARTS: usize = 1_000;
+
+impl PartsSpec {
+    /// Whether layer `layer` is shown, given whether the file shows it.
+    pub fn shows(&self, layer: usize, in_file: bool) -> bool {
+        if in_file {
+            self.hidden.binary_search(&layer).is_err()
+        } else {
+            self.shown.binary_search(&layer).is_ok()
+        }
+    }
+
+    /// The draw order of `layers` layers, bottom first (the file's when none is kept).
+    pub fn order_of(&self, layers: usize) -> Vec<usize> {
+        if self.order.is_empty() {
+            (0..layers).collect()
+        } else {
+            self.order.clone()
+        }
+    }
+
+    /// The parts handle `handle` is bound to, where it is bound to chosen ones.
+    pub fn binding(&self, handle: usize) -> Option<&[usize]> {
+        self.bindings
+            .iter()
+            .find(|b| b.handle == handle)
+            .map(|b| b.parts.as_slice())
+    }
+
+    /// Checks the indices against a picture of `layers` layers.
+    ///
+    /// # Errors
+    /// An order that is not every layer once, or an index past the layers.
+    pub fn check_layers(&self, layers: usize) -> Result<(), ProjectError> {
+        let bad = |m: String| Err(ProjectError::Invalid(m));
+        if !self.order.is_empty() && self.order.len() != layers {
+            return bad(format!(
+                "parts.order lists {} layers; the picture has {layers}",
+                self.order.len()
+            ));
+        }
+        let past = |list: &[usize]| list.iter().copied().find(|&k| k >= layers);
+        for (name, list) in [
+            ("order", &self.order),
+            ("hidden", &self.hidden),
+            ("shown", &self.shown),
+        ] {
+            if let Some(k) = past(list) {
+                return bad(format!(
+                    "parts.{name} names layer {k}; the picture has {layers} (0 to {})",
+                    layers.saturating_sub(1)
+                ));
+            }
+        }
+        for b in &self.bindings {
+            if let Some(k) = past(&b.parts) {
+                return bad(format!(
+                    "parts.bindings binds handle {} to layer {k}; the picture has {layers}",
+                    b.handle
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks what needs no picture: `order` a permutation, the lists ascending and
+    /// in range, each binding naming a handle of `handles` once, with parts.
+    fn validate(&self, handles: usize) -> Result<(), ProjectError> {
+        let bad = |m: String| Err(ProjectError::Invalid(m));
+        if self.order.len() > MAX_PARTS {
+            return bad(format!(
+                "parts.order lists {} layers; at most {MAX_PARTS}",
+                self.order.len()
+            ));
+        }
+        let mut seen = vec![false; self.order.len()];
+        for &k in &self.order {
+            if k >= self.order.len() || std::mem::replace(&mut seen[k], true) {
+                return bad(format!(
+                    "parts.order must list each layer index from 0 to {} once",
+                    self.order.len().saturating_sub(1)
+                ));
+            }
+        }
+        let ascending = |list: &[usize]| {
+            list.len() <= MAX_PARTS
+                && list.windows(2).all(|w| w[0] < w[1])
+                && list.iter().all(|&k| k < MAX_PARTS)
+        };
+        for (name, list) in [("hidden", &self.hidden), ("shown", &self.shown)] {
+            if !ascending(list) {
+                return bad(format!(
+                    "parts.{name} must be layer indices below {MAX_PARTS}, ascending, each once"
+                ));
+            }
+        }
+        if let Some(k) = self.hidden.iter().find(|k| self.shown.contains(k)) {
+            return bad(format!("parts: layer {k} is both hidden and shown"));
+        }
+        if self.bindings.len() > MAX_HANDLES {
+            return bad(format!(
+                "parts.bindings has {} entries; at most one a handle",
+                self.bindings.len()
+            ));
+        }
+        for (i, b) in self.bindings.iter().enumerate() {
+            if b.handle >= handles {
+                return bad(format!(
+                    "parts.bindings[{i}] names handle {}; there are {handles}",
+                    b.handle
+                ));
+            }
+            if self.bindings[..i].iter().any(|o| o.handle == b.handle) {
+                return bad(format!(
+                    "parts.bindings[{i}]: handle {} is bound twice",
+                    b.handle
+                ));
+            }
+            if b.parts.is_empty() || !ascending(&b.parts) {
+                return bad(format!(
+                    "parts.bindings[{i}].parts must be at least one layer index below \
+                     {MAX_PARTS}, ascending, each once"
+                ));
+            }
+        }
+        Ok(())
+    }
 }
 
 fn yes() -> bool {
@@ -700,6 +869,8 @@ impl Default for Project {
             cuts: Vec::new(),
             auto_depth: true,
             overlaps: Vec::new(),
+            parts: None,
+            images: Vec::new(),
         }
     }
 }
@@ -788,6 +959,14 @@ impl Project {
         for h in &mut self.overlaid {
             if *h > index {
                 *h -= 1;
+            }
+        }
+        if let Some(parts) = &mut self.parts {
+            parts.bindings.retain(|b| b.handle != index);
+            for b in &mut parts.bindings {
+                if b.handle > index {
+                    b.handle -= 1;
+                }
             }
         }
     }
@@ -944,6 +1123,18 @@ impl Project {
                     ));
                 }
             }
+        }
+        if let Some(parts) = &self.parts {
+            parts.validate(self.handles.len())?;
+        }
+        if self.image.is_some() && !self.images.is_empty() {
+            return bad("a rig file names its picture by \"image\" or \"images\", not both".into());
+        }
+        if self.images.len() > MAX_PARTS {
+            return bad(format!(
+                "{} images; at most {MAX_PARTS} are drawn as layers",
+                self.images.len()
+            ));
         }
         if self.cuts.len() > MAX_CUTS {
             return bad(format!(
@@ -1210,6 +1401,78 @@ mod tests {
         }
         let at_rest = text.replace(r#","translate":[2,0]"#, "");
         assert!(!Project::from_json(&at_rest).expect("at rest").is_posed());
+    }
+
+    #[test]
+    fn parts_are_checked_kept_and_follow_their_handles() {
+        let text = r#"{"version":1,"image":"cat.ora","handles":[
+            {"type":"point","rest":[10,10]},{"type":"point","rest":[30,10]},
+            {"type":"point","rest":[50,10]}],
+            "parts":{"order":[2,0,1],"hidden":[1],"shown":[3],
+                     "bindings":[{"handle":0,"parts":[0]},{"handle":2,"parts":[1,2]}]}}"#;
+        let mut project = Project::from_json(text).expect("a rig with parts");
+        assert_eq!(
+            Project::from_json(&project.to_json()).expect("round trip"),
+            project
+        );
+        let parts = project.parts.clone().expect("parts");
+        assert_eq!(parts.order_of(3), [2, 0, 1]);
+        assert_eq!(PartsSpec::default().order_of(3), [0, 1, 2]);
+        assert!(!parts.shows(1, true) && parts.shows(0, true));
+        assert!(parts.shows(3, false) && !parts.shows(4, false));
+        assert_eq!(parts.binding(2), Some(&[1, 2][..]));
+        assert_eq!(parts.binding(1), None);
+        // The order is checked against the picture's layers when it is read.
+        let error = parts.check_layers(4).expect_err("4 layers").to_string();
+        assert!(error.contains("parts.order lists 3 layers"), "{error}");
+        let error = PartsSpec {
+            shown: vec![3],
+            ..PartsSpec::default()
+        }
+        .check_layers(3)
+        .expect_err("no layer 3")
+        .to_string();
+        assert!(error.contains("parts.shown names layer 3"), "{error}");
+        project.remove_handle(0);
+        let parts = project.parts.as_ref().expect("parts");
+        assert_eq!(parts.bindings.len(), 1, "the removed handle's binding gone");
+        assert_eq!(parts.bindings[0].handle, 1, "renumbered");
+        for (bad, says) in [
+            (r#""order":[2,0,1]"#, r#""order":[0,0,1]"#),
+            (r#""order":[2,0,1]"#, r#""order":[3,0,1]"#),
+            (r#""hidden":[1]"#, r#""hidden":[1,1]"#),
+            (r#""hidden":[1]"#, r#""hidden":[3]"#),
+            (
+                r#"{"handle":2,"parts":[1,2]}"#,
+                r#"{"handle":3,"parts":[1]}"#,
+            ),
+            (
+                r#"{"handle":2,"parts":[1,2]}"#,
+                r#"{"handle":0,"parts":[1]}"#,
+            ),
+            (
+                r#"{"handle":2,"parts":[1,2]}"#,
+                r#"{"handle":2,"parts":[]}"#,
+            ),
+            (
+                r#""image":"cat.ora""#,
+                r#""image":"cat.ora","images":["a.png"]"#,
+            ),
+        ] {
+            let text = text.replace(bad, says);
+            let error = Project::from_json(&text).expect_err(says).to_string();
+            assert!(
+                error.contains("parts") || error.contains("images"),
+                "{says}: {error}"
+            );
+        }
+        let listed = text.replace(r#""image":"cat.ora""#, r#""images":["a.png","b.png"]"#);
+        let listed = Project::from_json(&listed).expect("a list of pictures");
+        assert_eq!(listed.images.len(), 2);
+        assert!(
+            !Project::default().to_json().contains("parts"),
+            "absent by default"
+        );
     }
 
     #[test]

@@ -105,7 +105,7 @@ impl EditorApp {
     pub fn save_to(&mut self, path: &Path) {
         let Some(doc) = &mut self.doc else { return };
         // Saving over the project itself is what Save does; over the picture, never.
-        let picture: Vec<&Path> = doc.image_path.as_deref().into_iter().collect();
+        let picture: Vec<&Path> = doc.pictures().collect();
         if let Err(e) = render::refuse_input_as_output(path, &picture) {
             return self.error(&anyhow::Error::from(e));
         }
@@ -225,10 +225,7 @@ impl EditorApp {
     /// project file (through links and `..` too).
     pub(super) fn refuse_sources(&self, path: &Path) -> Result<()> {
         let Some(doc) = &self.doc else { return Ok(()) };
-        let sources: Vec<&Path> = [doc.image_path.as_deref(), doc.project_path.as_deref()]
-            .into_iter()
-            .flatten()
-            .collect();
+        let sources: Vec<&Path> = doc.pictures().chain(doc.project_path.as_deref()).collect();
         render::refuse_input_as_output(path, &sources)?;
         Ok(())
     }

@@ -346,11 +346,18 @@ fn remesh(
 ) -> impl FnOnce() -> Outcome + Send + 'static {
     let image = doc.image.clone();
     let deep = doc.deep.clone();
+    let layers = doc.layers.clone();
+    let notes = doc.picture_notes.clone();
     let image_path = doc.image_path.clone();
+    let image_paths = doc.image_paths.clone();
     move || Outcome::Rebuilt {
         cause,
+        // The same picture: its depth, its layers and the files it came from kept.
         document: Document::with_image(image, image_path, project).map(|mut d| {
             d.deep = deep;
+            d.layers = layers;
+            d.picture_notes = notes;
+            d.image_paths = image_paths;
             d
         }),
     }

@@ -130,6 +130,7 @@ impl Document {
         let saved = Project::from_json(&text).context("the saved rig file does not load")?;
         let mut fresh = Document::with_image(self.image.clone(), self.image_path.clone(), saved)
             .context("the saved rig file does not build")?;
+        fresh.image_paths.clone_from(&self.image_paths);
         // Solved cages are not saved (`c2warp render` solves again, to the same
         // coordinates): the reopened document finds this one's for its cage, if the
         // saved cage, τ and density are the same.

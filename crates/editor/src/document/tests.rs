@@ -491,6 +491,40 @@ fn saved_projects_name_the_picture_relative_to_the_file() {
 }
 
 #[test]
+fn a_project_of_several_pictures_opens_as_their_layers_and_saves_them_all() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    for (name, x0) in [("body.png", 10), ("arm.png", 60)] {
+        let picture = RgbaImage::from_fn(120, 90, |x, y| {
+            let inside = (x0..x0 + 50).contains(&x) && (20..70).contains(&y);
+            image::Rgba(if inside { [90, 60, 30, 255] } else { [0; 4] })
+        });
+        picture.save(dir.path().join(name)).expect("a picture");
+    }
+    let path = dir.path().join("pair.json");
+    std::fs::write(
+        &path,
+        r#"{"version": 1, "images": ["body.png", "arm.png"], "handles": []}"#,
+    )
+    .expect("the project");
+    let doc = Document::open_project(&path).expect("opens");
+    assert_eq!(doc.layers.as_ref().map(|l| l.layers.len()), Some(2));
+    assert_eq!(doc.pictures().count(), 2);
+    // Opaque where either picture is.
+    assert_eq!(doc.image.get_pixel(15, 30)[3], 255);
+    assert_eq!(doc.image.get_pixel(105, 30)[3], 255);
+    let elsewhere = dir.path().join("sub").join("pair.json");
+    let saved = doc.project_for_saving(Some(&elsewhere));
+    assert_eq!(saved.image, None);
+    assert_eq!(
+        saved.images,
+        [Path::new("../body.png"), Path::new("../arm.png")]
+            .map(Path::to_path_buf)
+            .to_vec()
+    );
+    doc.check_reopens().expect("reopens");
+}
+
+#[test]
 fn handles_half_a_pixel_apart_are_placed_and_reopen_the_same() {
     let mut doc = Document::built_in().expect("the lizard");
     let before = doc.rig().domain().len();
