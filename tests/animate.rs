@@ -2,7 +2,7 @@
 //! the rig posed at its time, for every method; the animated files hold the same
 //! frames as the PNG sequence; bad requests fail at once and leave files alone.
 
-mod support;
+use crate::support;
 
 use std::fs;
 use std::path::{Path, PathBuf};

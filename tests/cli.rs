@@ -1,7 +1,7 @@
 //! End-to-end tests of the `c2warp` command: golden images, identity, weights export,
 //! benchmarks, and clear errors on bad input.
 
-mod support;
+use crate::support;
 
 use std::ffi::OsStr;
 use std::fs;

@@ -1,7 +1,7 @@
 //! End-to-end tests of the method switch: `c2warp deform` for every method, `render
 //! --method`, and the bad-input bank of the method's fields.
 
-mod support;
+use crate::support;
 
 use std::ffi::OsStr;
 use std::fs;

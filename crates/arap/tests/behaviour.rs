@@ -3,7 +3,7 @@
 //! (Fig. 15, squash and stretch), and painted rigidity keeps a region from distorting
 //! (§5.2, Fig. 9).
 
-mod support;
+use crate::support;
 
 use arap::Registration;
 use glam::DVec2;

@@ -3,7 +3,7 @@
 //! border and neighbouring handles, collapsed poses, zero-area triangles, isolated
 //! vertices, empty meshes, and every input error.
 
-mod support;
+use crate::support;
 
 use arap::{ArapError, Registration, Similarity, ring_constraints, similarity_constraints};
 use glam::DVec2;

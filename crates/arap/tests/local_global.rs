@@ -3,7 +3,7 @@
 //! plain reference finds — local and global steps written from their definitions,
 //! the global one by the dense solver of `support::dense`.
 
-mod support;
+use crate::support;
 
 use arap::{Minimise, Registration};
 use glam::DVec2;

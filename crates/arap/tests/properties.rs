@@ -3,7 +3,7 @@
 //! exactly, constraints are met exactly, mirror symmetry is kept, and nothing is ever
 //! NaN.
 
-mod support;
+use crate::support;
 
 use arap::{Deformation, Registration};
 use glam::DVec2;

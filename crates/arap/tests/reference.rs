@@ -1,7 +1,7 @@
 //! The compiled solver against a from-scratch dense minimisation of the paper's
 //! energies (tests/support/dense.rs), pose after pose.
 
-mod support;
+use crate::support;
 
 use arap::Registration;
 use glam::DVec2;

@@ -3,7 +3,7 @@
 //! spatial keys blended by the control cursor, a recorded performance, and the
 //! animation saved and reopened — on the built-in lizard, for every method.
 
-mod support;
+use crate::support;
 
 use egui::{Key, Modifiers};
 use egui_kittest::Harness;

@@ -4,7 +4,7 @@
 //! cancelled solve. The canvas is drawn by the real wgpu paint callback on the software
 //! adapter.
 
-mod support;
+use crate::support;
 
 use egui::{Key, Modifiers, Pos2, Vec2};
 use egui_kittest::Harness;

@@ -1,7 +1,7 @@
 //! The editor in its empty and edge states, and gestures that the document changes
 //! under: each test here reproduces something a user ran into.
 
-mod support;
+use crate::support;
 
 use egui::{Key, Modifiers, Pos2, Vec2};
 use egui_kittest::Harness;

@@ -2,7 +2,7 @@
 //! built-in picture with its posed sample rig; the canvas drawn by the real wgpu paint
 //! callback on the software adapter.
 
-mod support;
+use crate::support;
 
 use egui::{Key, Modifiers};
 use egui_kittest::Harness;

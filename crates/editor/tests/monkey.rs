@@ -12,10 +12,10 @@
 //!
 //! CI runs a short walk. A long one:
 //! `MONKEY_ACTIONS=5000 MONKEY_SEEDS=1,2,3,4,5,6,7,8 cargo test --release -p editor
-//! --test monkey -- --nocapture` (a failing walk prints its seed and last actions;
+//! --test integration monkey -- --nocapture` (a failing walk prints its seed and last actions;
 //! `MONKEY_SEEDS=<seed>` replays it).
 
-mod support;
+use crate::support;
 
 use std::panic::AssertUnwindSafe;
 use std::path::{Path, PathBuf};

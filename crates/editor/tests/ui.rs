@@ -4,7 +4,7 @@
 //!
 //! File dialogs are answered by `support::Scripted` with paths in a temporary folder.
 
-mod support;
+use crate::support;
 
 use std::path::Path;
 

@@ -4,7 +4,7 @@
 
 #![allow(clippy::unwrap_used)] // Tests unwrap freely.
 
-mod support;
+use crate::support;
 
 use glam::DVec2;
 use image::{Rgba, RgbaImage};

@@ -2,7 +2,7 @@
 
 #![allow(clippy::unwrap_used)] // Tests unwrap freely.
 
-mod support;
+use crate::support;
 
 use glam::DVec2;
 use mesh::{Constraints, DomainOptions, MeshError, MeshOptions, domain_from_image, mesh_image};

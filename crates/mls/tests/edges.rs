@@ -1,7 +1,7 @@
 //! Bars against their halves, the degenerate scenes an editor produces (no handles,
 //! one handle, coincident handles, a vertex on a handle), and refused input.
 
-mod support;
+use crate::support;
 
 use glam::DVec2;
 use mls::{Control, Mls, MlsError, MlsOptions, Variant, deform_point};

@@ -1,7 +1,7 @@
 //! What any moving least squares deformation must do: interpolate the handles, keep
 //! the rest pose, and reproduce the transformations of its class.
 
-mod support;
+use crate::support;
 
 use glam::{DMat2, DVec2};
 use mls::{Control, Mls, MlsOptions, Variant};

@@ -3,7 +3,7 @@
 //! similarity, a search over the angle for rigid, and bars sampled by adaptive
 //! quadrature along their length.
 
-mod support;
+use crate::support;
 
 use glam::DVec2;
 use mls::{Control, Mls, MlsOptions, Variant, deform_point};

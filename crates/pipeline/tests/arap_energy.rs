@@ -4,7 +4,7 @@
 //! pins placed), with no more triangles turned over; the paper's two steps alone
 //! stay reachable and fall well short of it.
 
-mod support;
+use crate::support;
 
 use pipeline::ArapRig;
 use support::energy::{self, ControlMesh, jacobian_energy, local_global};

@@ -2,7 +2,7 @@
 //! near a moved pin goes with it, what lies near a fixed pin stays, and the warp does
 //! not depend on how fine the picture is meshed (see `support/pins.rs`).
 
-mod support;
+use crate::support;
 
 use support::pins;
 

@@ -1,6 +1,6 @@
 //! Animations: each format written frame by frame, decoded back and compared.
 
-mod support;
+use crate::support;
 
 use std::fs::{self, File};
 use std::io::BufReader;

@@ -1,7 +1,7 @@
 //! The GPU path (wgpu, on a software adapter where there is no GPU) draws what the CPU
 //! path draws. Needs a wgpu adapter: `scripts/setup.sh` installs Mesa's lavapipe.
 
-mod support;
+use crate::support;
 
 use glam::Vec2;
 use render::{GpuContext, RasterOptions, WarpMesh, warp_cpu};

@@ -1,6 +1,6 @@
 //! Image loading under limits, and atomic writes.
 
-mod support;
+use crate::support;
 
 use std::fs;
 use std::path::Path;

@@ -1,6 +1,6 @@
 //! Behaviour of `warp_cpu` and `coverage_counts` on whole meshes.
 
-mod support;
+use crate::support;
 
 use glam::Vec2;
 use image::{Rgba, RgbaImage};

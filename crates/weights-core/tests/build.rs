@@ -1,7 +1,7 @@
 //! Building a rig: progress reports, the virtual handles saved with the handle they were
 //! placed for, and the limits refused up front.
 
-mod support;
+use crate::support;
 
 use std::sync::Mutex;
 

@@ -2,7 +2,7 @@
 //! invariants, placing one moves nothing, it moves the picture when it moves, its
 //! point stays under it, and a rebuild equals the incremental update.
 
-mod support;
+use crate::support;
 
 use glam::DVec2;
 use support::{Shape, grid_domain};

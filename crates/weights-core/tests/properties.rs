@@ -1,7 +1,7 @@
 //! The invariants of the weights on random rigs, incremental updates against rebuilds,
 //! consistency, symmetry and a bank of degenerate rigs.
 
-mod support;
+use crate::support;
 
 use glam::DVec2;
 use proptest::prelude::*;

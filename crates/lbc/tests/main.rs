@@ -1,0 +1,4 @@
+//! The integration tests, built as one binary: each file is a module.
+
+mod optimality;
+mod properties;
