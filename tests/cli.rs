@@ -1678,6 +1678,32 @@ fn a_project_of_several_pictures_with_parts_renders_them_in_its_order() {
         ["right", "left"],
         "one object a part, in the draw order"
     );
+    // Weights and timings by part.
+    let weights = dir.path().join("weights.json");
+    ok(&[
+        os("weights"),
+        os("--rig"),
+        project.as_os_str(),
+        os("-o"),
+        weights.as_os_str(),
+    ]);
+    let listed: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(&weights).expect("weights")).expect("JSON");
+    let parts = listed["parts"].as_array().expect("by part");
+    let names: Vec<_> = parts.iter().map(|p| p["name"].as_str()).collect();
+    assert_eq!(names, [Some("right"), Some("left")]);
+    let out = ok(&[
+        os("bench"),
+        os("--rig"),
+        project.as_os_str(),
+        os("--positions"),
+        os("2"),
+    ]);
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    assert_eq!(
+        (report["parts"].as_u64(), report["poses"].as_u64()),
+        (Some(2), Some(2))
+    );
     // Without "parts" the pictures are one picture, the later on top.
     fs::write(&project, rig("")).expect("write the rig");
     ok(&[os("render"), project.as_os_str(), os("-o"), png.as_os_str()]);

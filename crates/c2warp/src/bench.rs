@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use anyhow::Result;
-use pipeline::{Method, load_project};
+use pipeline::{Deformer as _, Method, load_project};
 
 use crate::{Input, Source};
 
@@ -21,10 +21,17 @@ pub fn run(
         project.method = method;
     }
     let files = source.files(rig_path, &project)?;
-    let input = Input::load(source, &files)?;
-    let mut warper = pipeline::setup(input.source(), &project, &())?;
-    crate::warn(&*warper.deformer);
-    let report = warper.deformer.bench(&project, positions)?;
+    let report = if project.parts.is_some() && source.mesh.is_none() {
+        // A picture drawn as parts: every part set up, each pose posing them all.
+        let artwork = crate::load_artwork_noting(&files)?;
+        let mut parts = pipeline::PartsDeformer::new(&artwork, &project, source.density, &())?;
+        parts.bench(&project, positions)?
+    } else {
+        let input = Input::load(source, &files)?;
+        let mut warper = pipeline::setup(input.source(), &project, &())?;
+        crate::warn(&*warper.deformer);
+        warper.deformer.bench(&project, positions)?
+    };
     println!("{}", serde_json::to_string_pretty(&report)?);
     Ok(())
 }

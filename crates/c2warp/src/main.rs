@@ -31,16 +31,18 @@ use weights_core::Rig;
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
-    /// A picture (PNG, JPEG, WebP, TIFF, BMP, GIF) or a project (.json) to open in the editor.
-    file: Option<PathBuf>,
+    /// A picture (PNG, JPEG, WebP, TIFF, BMP, GIF, PSD, OpenRaster) or a project (.json)
+    /// to open in the editor; several pictures open as the layers of one, bottom first.
+    files: Vec<PathBuf>,
 }
 
 #[derive(Subcommand)]
 enum Command {
     /// Open the editor on a picture (PNG, JPEG, WebP, TIFF, BMP, GIF) or a project (.json).
     Open {
-        /// The file to open.
-        file: PathBuf,
+        /// The file to open (several pictures: the layers of one, bottom first).
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
     },
     /// Warp an image by a rig and write a PNG of the same size (alpha kept; 16 bits
     /// per channel for a 16-bit source).
@@ -356,7 +358,7 @@ fn main() -> ExitCode {
         );
     }
     let result = match cli.command {
-        None => editor::run(cli.file),
+        None => editor::run(cli.files),
         Some(command) => run(command),
     };
     match result {
@@ -370,7 +372,7 @@ fn main() -> ExitCode {
 
 fn run(command: Command) -> Result<()> {
     match command {
-        Command::Open { file } => editor::run(Some(file)),
+        Command::Open { files } => editor::run(files),
         Command::Render {
             input,
             rig,

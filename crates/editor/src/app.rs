@@ -40,8 +40,8 @@ pub struct Message {
 /// Something that would discard unsaved changes, waiting for the user's answer.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Pending {
-    /// Open this picture or project.
-    Open(PathBuf),
+    /// Open this picture or project, or these pictures as the layers of one.
+    Open(Vec<PathBuf>),
     /// Close the window.
     Close,
     /// Write over this existing file (chosen in the built-in dialog).
@@ -149,7 +149,7 @@ mod work;
 impl EditorApp {
     /// The editor on `path` (a picture, or a `.json` project), or on the built-in
     /// picture. Sets up the GPU resources when eframe runs on wgpu.
-    pub fn new(cc: &eframe::CreationContext<'_>, path: Option<&Path>) -> Self {
+    pub fn new(cc: &eframe::CreationContext<'_>, paths: &[PathBuf]) -> Self {
         let has_gpu = if let Some(state) = &cc.wgpu_render_state {
             let resources = SceneResources::new(&state.device, &state.queue, state.target_format);
             state.renderer.write().callback_resources.insert(resources);
@@ -159,8 +159,8 @@ impl EditorApp {
         };
         let mut app = Self::headless(has_gpu);
         app.wake = Some(cc.egui_ctx.clone());
-        if let Some(path) = path {
-            app.open_in_background(path.to_path_buf());
+        if !paths.is_empty() {
+            app.open_all_in_background(paths.to_vec());
         }
         app
     }

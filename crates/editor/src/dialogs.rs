@@ -68,6 +68,8 @@ pub const IMAGES: &[&str] = &[
 pub enum Answer {
     /// The user chose this file.
     Chosen(PathBuf),
+    /// The user chose several pictures to open (as the layers of one).
+    Several(Vec<PathBuf>),
     /// The user cancelled.
     Cancelled,
     /// No dialog can be shown here: the editor shows its built-in one instead.
@@ -118,6 +120,13 @@ impl Dialogs for NativeDialogs {
         };
         let chosen = if action.writes() {
             dialog.set_file_name(suggested).save_file()
+        } else if action == FileAction::OpenImage {
+            // Several pictures open as the layers of one.
+            match dialog.pick_files() {
+                Some(several) if several.len() > 1 => return Answer::Several(several),
+                Some(mut one) => one.pop(),
+                None => None,
+            }
         } else {
             dialog.pick_file()
         };

@@ -334,6 +334,26 @@ impl Document {
         Ok(document)
     }
 
+    /// Pictures drawn as the layers of one, bottom first, with no handles (one: as
+    /// [`Document::open_image`]); the project names them all (`"images"`).
+    ///
+    /// # Errors
+    /// What [`pipeline::load_artworks`] refuses, or a picture that cannot be meshed.
+    pub fn open_pictures(paths: &[PathBuf]) -> Result<Self> {
+        if let [one] = paths {
+            return Self::open_image(one);
+        }
+        let artwork = pipeline::load_artworks(paths)?;
+        let project = Project {
+            images: paths.to_vec(),
+            ..Project::default()
+        };
+        let mut document = Self::from_picture(artwork.flatten(), None, project)?;
+        document.image_paths = paths.to_vec();
+        document.take_layers(artwork);
+        Ok(document)
+    }
+
     /// As [`Document::new`] for a decoded picture of either depth (a 16-bit one is
     /// kept for exports).
     ///

@@ -19,7 +19,8 @@ use crate::document::{CageKey, Document};
 pub(crate) enum Outcome {
     /// A picture or project was opened.
     Opened {
-        path: PathBuf,
+        /// The files opened: one picture or project, or several pictures.
+        paths: Vec<PathBuf>,
         is_project: bool,
         document: Result<Document>,
     },

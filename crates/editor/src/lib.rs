@@ -43,12 +43,13 @@ pub use show::Show;
 pub use timeline::Timeline;
 pub use viewport::Viewport;
 
-/// Opens the editor window on `path` (a picture, or a `.json` project) or on the
+/// Opens the editor window on `paths` (a picture, several pictures as the layers of
+/// one, or a `.json` project) or, with none, on the
 /// built-in picture, and returns when the window closes.
 ///
 /// # Errors
 /// No window or no GPU adapter could be had.
-pub fn run(path: Option<PathBuf>) -> anyhow::Result<()> {
+pub fn run(paths: Vec<PathBuf>) -> anyhow::Result<()> {
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
             .with_title("C2Warp")
@@ -64,7 +65,7 @@ pub fn run(path: Option<PathBuf>) -> anyhow::Result<()> {
     eframe::run_native(
         "C2Warp",
         options,
-        Box::new(move |cc| Ok(Box::new(EditorApp::new(cc, path.as_deref())))),
+        Box::new(move |cc| Ok(Box::new(EditorApp::new(cc, &paths)))),
     )
     .map_err(|e| {
         anyhow::anyhow!(

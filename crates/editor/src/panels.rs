@@ -200,9 +200,14 @@ impl EditorApp {
         let Some(path) = dropped.first().cloned() else {
             return;
         };
-        if dropped.len() > 1 {
+        let is_json = |p: &std::path::PathBuf| {
+            p.extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+        };
+        let several_pictures = dropped.len() > 1 && !dropped.iter().any(is_json);
+        if dropped.len() > 1 && !several_pictures {
             self.info(format!(
-                "{} files dropped: opening the first, {}",
+                "{} files dropped, a project among them: opening the first, {}",
                 dropped.len(),
                 path.display()
             ));
@@ -219,6 +224,9 @@ impl EditorApp {
                 "{} was not opened: answer the open question or dialog first",
                 path.display()
             ));
+        } else if several_pictures {
+            // Several pictures: the layers of one, in the order dropped.
+            self.request_open_all(dropped);
         } else {
             self.request_open(path);
         }

@@ -345,6 +345,47 @@ fn dropping_a_picture_opens_it() {
 }
 
 #[test]
+fn dropping_several_pictures_opens_them_as_the_layers_of_one_and_saves_them_all() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let lizard = write_lizard(dir.path());
+    // A second picture: a small opaque square, on top.
+    let square = dir.path().join("square.png");
+    image::RgbaImage::from_pixel(40, 40, image::Rgba([250, 200, 0, 255]))
+        .save(&square)
+        .expect("write the square");
+    let mut h = editor(dir.path());
+    for path in [&lizard, &square] {
+        h.input_mut()
+            .dropped_files
+            .push(std::sync::Arc::new(Dropped(path.clone())));
+    }
+    h.step();
+    settle(&mut h);
+    let message = h.state().message.clone().expect("a message");
+    assert!(
+        message.text.contains("2 pictures as layers"),
+        "{}",
+        message.text
+    );
+    let doc = h.state().document().expect("a document");
+    assert_eq!(doc.layers.as_ref().map(|l| l.layers.len()), Some(2));
+    assert_eq!(doc.image.get_pixel(10, 10).0, [250, 200, 0, 255], "on top");
+    // Saved, the project names both pictures, bottom first, and reopens so.
+    h.state_mut().save_to(&dir.path().join("project.json"));
+    let saved = std::fs::read_to_string(dir.path().join("project.json")).expect("saved");
+    let project = Project::from_json(&saved).expect("a project");
+    assert_eq!(
+        project.images,
+        [std::path::PathBuf::from("lizard.png"), "square.png".into()]
+    );
+    h.state_mut().request_open(dir.path().join("project.json"));
+    settle(&mut h);
+    let doc = h.state().document().expect("reopened");
+    assert_eq!(doc.pictures().count(), 2);
+    assert_eq!(doc.image.get_pixel(10, 10).0, [250, 200, 0, 255]);
+}
+
+#[test]
 fn the_help_window_lists_the_shortcuts() {
     let dir = tempfile::tempdir().expect("temp dir");
     let mut h = editor(dir.path());

@@ -30,7 +30,10 @@ pub use method::{
     SolveProgress, Source, WeightsListing, beside_rig, on_handles, setup,
 };
 pub use order::draw_order;
-pub use parts::{PartMesh, PartRig, PartSet, Parts, animate_parts, set_up_parts, warp_parts};
+pub use parts::{
+    Composer, Joined, PartMesh, PartRig, PartSet, Parts, PartsDeformer, animate_parts,
+    set_up_parts, warp_parts,
+};
 
 use weights_core::{
     Basis, Domain, Handle, Metric, MiddleControls, Placement, Rig, RigOptions, Similarity,

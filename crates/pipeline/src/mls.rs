@@ -229,7 +229,7 @@ fn precompute(
 }
 
 /// The mean edge length of a mesh (each triangle's three edges), pixels.
-fn mean_edge(positions: &[DVec2], triangles: &[[u32; 3]]) -> f64 {
+pub(crate) fn mean_edge(positions: &[DVec2], triangles: &[[u32; 3]]) -> f64 {
     let (sum, count) = triangles.iter().fold((0.0, 0usize), |(sum, count), t| {
         let [a, b, c] = t.map(|v| positions[v as usize]);
         (

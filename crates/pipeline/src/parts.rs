@@ -28,6 +28,7 @@ use project::{Canvas, Controls, HandleSpec, Hold, Project};
 use render::Picture;
 use weights_core::{Domain, Metric};
 
+use crate::deformer::{Deformer, Follow, Method, Output, WeightsListing, json, median, quantile};
 use crate::{DEFAULT_DENSITY, Frame, Listener, Warper, blank, placed, prepare_warper};
 
 /// The fewest vertices a part is meshed with, whatever its share of the density.
@@ -312,18 +313,31 @@ impl PartRig {
     /// # Errors
     /// What a part's method refuses of the pose, naming the part's layer index.
     pub fn pose(&mut self, project: &Project) -> Result<()> {
-        for (k, part) in self.parts.iter_mut().enumerate() {
+        if self.follow(project)? == Follow::NeedsSetup {
+            bail!("the pose asks for a new setup of the parts");
+        }
+        Ok(())
+    }
+
+    /// Poses every part as `project` has it, or says that a part needs setting up
+    /// again for it (its handles' rests or its method's settings changed): then
+    /// nothing is posed.
+    ///
+    /// # Errors
+    /// What a part's method refuses of the pose, naming the part's layer index.
+    pub fn follow(&mut self, project: &Project) -> Result<Follow> {
+        let mut posed = self.parts.clone();
+        for (k, part) in posed.iter_mut().enumerate() {
             if let Part::Bound(warper) = part {
                 let own = part_project(project, &self.bindings[k]);
-                if warper.follow(&own).with_context(|| format!("part {k}"))?
-                    == crate::Follow::NeedsSetup
-                {
-                    bail!("part {k}: the pose asks for a new setup");
+                if warper.follow(&own).with_context(|| format!("part {k}"))? == Follow::NeedsSetup {
+                    return Ok(Follow::NeedsSetup);
                 }
             }
         }
+        self.parts = posed;
         self.move_followers();
-        Ok(())
+        Ok(Follow::Followed)
     }
 
     /// Moves each follower's vertices where its leader's mesh now takes them.
@@ -487,6 +501,39 @@ impl Composer {
         })
     }
 
+    /// The drawn parts' `meshes` (the same parts and meshes, in any pose) joined into
+    /// one, in the draw order.
+    ///
+    /// # Errors
+    /// Meshes not the ones packed.
+    pub fn join(&self, meshes: &[Option<PartMesh>]) -> Result<Joined> {
+        let mut joined = Joined::default();
+        for &k in &self.shown {
+            let Some(mesh) = meshes.get(k).and_then(Option::as_ref) else {
+                bail!("part {k} has no mesh to draw");
+            };
+            let base = joined.rest.len() as u32;
+            joined.rest.extend_from_slice(&mesh.rest);
+            joined.deformed.extend_from_slice(&mesh.deformed);
+            (joined.triangles).extend(mesh.triangles.iter().map(|t| t.map(|v| v + base)));
+            (joined.part_of).extend(std::iter::repeat_n(k as u32, mesh.triangles.len()));
+        }
+        if joined.rest.len() != self.uv.len() {
+            bail!("the parts' meshes are not the ones their texture was packed for");
+        }
+        Ok(joined)
+    }
+
+    /// The texture the joined mesh samples: every drawn layer's pixels, packed.
+    pub fn texture(&self) -> &Picture {
+        &self.texture
+    }
+
+    /// Where each vertex of the joined mesh samples [`Composer::texture`] (pixels).
+    pub fn uv(&self) -> &[Vec2] {
+        &self.uv
+    }
+
     /// Draws the parts' `meshes` (the same parts and meshes, in any pose), as
     /// [`composite`] does.
     ///
@@ -498,22 +545,12 @@ impl Composer {
         meshes: &[Option<PartMesh>],
         project: &Project,
     ) -> Result<(Picture, Vec<project::OverlapOrder>)> {
-        // The joined mesh: canvas positions at rest and warped.
-        let (mut rest, mut deformed) = (Vec::new(), Vec::new());
-        let (mut triangles, mut part_of) = (Vec::new(), Vec::new());
-        for &k in &self.shown {
-            let Some(mesh) = meshes.get(k).and_then(Option::as_ref) else {
-                bail!("part {k} has no mesh to draw");
-            };
-            let base = rest.len() as u32;
-            rest.extend_from_slice(&mesh.rest);
-            deformed.extend_from_slice(&mesh.deformed);
-            triangles.extend(mesh.triangles.iter().map(|t| t.map(|v| v + base)));
-            part_of.extend(std::iter::repeat_n(k as u32, mesh.triangles.len()));
-        }
-        if rest.len() != self.uv.len() {
-            bail!("the parts' meshes are not the ones their texture was packed for");
-        }
+        let Joined {
+            rest,
+            deformed,
+            triangles,
+            part_of,
+        } = self.join(meshes)?;
         if deformed.iter().any(|p| !p.is_finite()) {
             bail!("the deformation produced non-finite positions");
         }
@@ -545,6 +582,221 @@ impl Composer {
         )?;
         Ok((canvas, overlaps))
     }
+}
+
+/// The drawn parts' meshes joined into one ([`Composer::join`]).
+#[derive(Clone, Debug, Default)]
+pub struct Joined {
+    /// Every vertex at rest (canvas pixels).
+    pub rest: Vec<DVec2>,
+    /// Where the warp takes it.
+    pub deformed: Vec<DVec2>,
+    /// The triangles, the parts back to front in the draw order, each in its own order.
+    pub triangles: Vec<[u32; 3]>,
+    /// For each triangle, its part (the layer's index).
+    pub part_of: Vec<u32>,
+}
+
+/// Layered artwork's parts behind the method seam: one mesh, the parts' meshes joined
+/// in the draw order ([`Composer::join`]), each part posed by the handles that bind
+/// it ([`PartRig`]), its positions the joined mesh's. The joined mesh samples
+/// [`PartsDeformer::composer`]'s texture, not the flattened picture: where parts
+/// overlap at rest, each keeps its own pixels.
+#[derive(Clone)]
+pub struct PartsDeformer {
+    rig: PartRig,
+    composer: std::sync::Arc<Composer>,
+    joined: Joined,
+    /// The layers' names, for what is listed by part.
+    names: Vec<String>,
+    /// What the parts were set up for: the method, the parts' spec and each handle's
+    /// rest, so that [`Deformer::follow`] tells a pose from a new setup.
+    setup: (Method, Option<project::PartsSpec>, Vec<HandleSpec>),
+}
+
+impl PartsDeformer {
+    /// Sets every visible layer of `artwork` up as a part for `project` ([`PartRig`])
+    /// and joins them.
+    ///
+    /// # Errors
+    /// As [`PartRig::new`]; not enough memory for the texture.
+    pub fn new(
+        artwork: &layers::Artwork,
+        project: &Project,
+        density: Option<usize>,
+        listener: &dyn Listener,
+    ) -> Result<Self> {
+        let rig = PartRig::new(artwork, project, density, listener)?;
+        let composer = Composer::new(artwork, &rig.set())?;
+        let joined = composer.join(&rig.meshes())?;
+        Ok(Self {
+            rig,
+            composer: std::sync::Arc::new(composer),
+            joined,
+            names: artwork.layers.iter().map(|l| l.name.clone()).collect(),
+            setup: setup_of(project),
+        })
+    }
+
+    /// The packed texture and where the joined mesh samples it.
+    pub fn composer(&self) -> &Composer {
+        &self.composer
+    }
+
+    /// The parts set up.
+    pub fn rig(&self) -> &PartRig {
+        &self.rig
+    }
+
+    /// For each triangle, its part (the layer's index).
+    pub fn part_of(&self) -> &[u32] {
+        &self.joined.part_of
+    }
+}
+
+/// What a part setup depends on beyond the pose: the method, the parts' spec, the
+/// handles at rest.
+fn setup_of(project: &Project) -> (Method, Option<project::PartsSpec>, Vec<HandleSpec>) {
+    let at_rest = project.handles.iter().map(|h| match *h {
+        HandleSpec::Point { rest, depth, .. } => HandleSpec::Point {
+            rest,
+            translate: [0.0; 2],
+            rotate: 0.0,
+            scale: 1.0,
+            depth,
+        },
+        HandleSpec::Bar { rest, depth, .. } => HandleSpec::Bar {
+            rest,
+            pose: None,
+            depth,
+        },
+    });
+    (project.method, project.parts.clone(), at_rest.collect())
+}
+
+impl Deformer for PartsDeformer {
+    fn method(&self) -> Method {
+        self.setup.0
+    }
+
+    fn rest(&self) -> &[DVec2] {
+        &self.joined.rest
+    }
+
+    fn triangles(&self) -> &[[u32; 3]] {
+        &self.joined.triangles
+    }
+
+    fn follow(&mut self, project: &Project) -> Result<Follow> {
+        if setup_of(project) != self.setup || self.rig.follow(project)? == Follow::NeedsSetup {
+            return Ok(Follow::NeedsSetup);
+        }
+        self.joined = self.composer.join(&self.rig.meshes())?;
+        Ok(Follow::Followed)
+    }
+
+    fn deformed(&self) -> Vec<DVec2> {
+        self.joined.deformed.clone()
+    }
+
+    fn output(&self) -> Output<'_> {
+        Output::Positions(&self.joined.deformed)
+    }
+
+    fn weights(&self, listing: WeightsListing) -> Result<serde_json::Value> {
+        let mut parts = Vec::new();
+        for &k in &self.rig.order {
+            let name = &self.names[k];
+            let entry = match &self.rig.parts[k] {
+                Part::Hidden => continue,
+                Part::Bound(warper) => {
+                    let own = WeightsListing {
+                        file_vertices: warper.deformer.rest().len(),
+                        ..listing
+                    };
+                    serde_json::json!({
+                        "layer": k,
+                        "name": name,
+                        "handles": self.rig.bindings[k],
+                        "weights": warper.deformer.weights(own).with_context(|| format!("part \"{name}\""))?,
+                    })
+                }
+                Part::Follows { leader, .. } => serde_json::json!({
+                    "layer": k,
+                    "name": name,
+                    "follows": leader,
+                }),
+            };
+            parts.push(entry);
+        }
+        Ok(serde_json::json!({ "parts": parts }))
+    }
+
+    fn bench(&mut self, project: &Project, poses: usize) -> Result<serde_json::Value> {
+        let mut sequence = crate::deformer::Sequence::new();
+        let scale = crate::mls::mean_edge(&self.joined.rest, &self.joined.triangles) * 10.0;
+        let mut times = Vec::new();
+        for _ in 0..poses.max(1) {
+            let mut posed = project.clone();
+            for h in &mut posed.handles {
+                let d = [sequence.next() * scale, sequence.next() * scale];
+                match h {
+                    HandleSpec::Point { translate, .. } => {
+                        *translate = [translate[0] + d[0], translate[1] + d[1]];
+                    }
+                    HandleSpec::Bar { rest, pose, .. } => {
+                        let p = pose.unwrap_or(*rest);
+                        *pose = Some(p.map(|e| [e[0] + d[0], e[1] + d[1]]));
+                    }
+                }
+            }
+            let clock = std::time::Instant::now();
+            if self.follow(&posed)? == Follow::NeedsSetup {
+                bail!("a pose asked for a new setup of the parts");
+            }
+            times.push(clock.elapsed().as_secs_f64() * 1e3);
+        }
+        self.follow(project)?;
+        json(&PartsReport {
+            method: self.setup.0.name(),
+            parts: self
+                .rig
+                .order
+                .iter()
+                .filter(|&&k| !matches!(self.rig.parts[k], Part::Hidden))
+                .count(),
+            samples: self.joined.rest.len(),
+            triangles: self.joined.triangles.len(),
+            real_handles: project.handles.len(),
+            pose_ms_median: median(times.clone()),
+            pose_ms_p90: quantile(times.clone(), 0.9),
+            poses: times.len(),
+        })
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+
+    fn clone_box(&self) -> Box<dyn Deformer> {
+        Box::new(self.clone())
+    }
+}
+
+/// `c2warp bench` of a picture drawn as parts.
+#[derive(serde::Serialize)]
+struct PartsReport {
+    method: &'static str,
+    /// The parts drawn (visible layers).
+    parts: usize,
+    /// Vertices of the parts' meshes together.
+    samples: usize,
+    triangles: usize,
+    real_handles: usize,
+    /// One pose of every part (and every follower moved), ms.
+    pose_ms_median: f64,
+    pose_ms_p90: f64,
+    poses: usize,
 }
 
 /// `layer`'s pixels written into `texture` at `(x, y)`, in the texture's depth, its

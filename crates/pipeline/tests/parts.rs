@@ -4,7 +4,7 @@
 
 use image::{Rgba, RgbaImage};
 use pipeline::{Artwork, Layer, warp_parts};
-use project::Project;
+use project::{HandleSpec, Project};
 use render::Picture;
 
 /// A layer of `w × h` opaque pixels of `colour` at (`x`, `y`).
@@ -341,4 +341,110 @@ fn the_rig_files_parts_reorder_hide_and_bind() {
         .expect("refused")
         .to_string();
     assert!(error.contains("parts.order lists 3 layers"), "{error}");
+}
+
+#[test]
+fn the_parts_deformer_poses_the_joined_mesh_and_knows_a_new_setup() {
+    use pipeline::{Deformer, Follow, PartsDeformer, WeightsListing};
+    let handles = r#"{"type": "point", "rest": [30, 60]},
+           {"type": "point", "rest": [85, 60]},
+           {"type": "point", "rest": [170, 60]}"#;
+    let artwork = two_parts();
+    let mut project = rig(handles);
+    project.parts = Some(project::PartsSpec::default());
+    let mut parts = PartsDeformer::new(&artwork, &project, None, &()).expect("set up");
+    // At rest: the joined mesh is the parts' meshes, bottom first, where they lie.
+    let set = pipeline::set_up_parts(&artwork, &project, None, &()).expect("parts");
+    let joined: Vec<_> = set
+        .meshes
+        .iter()
+        .flatten()
+        .flat_map(|m| m.rest.clone())
+        .collect();
+    assert!(parts.rest() == joined.as_slice(), "the joined rest mesh");
+    let far = |a: &[glam::DVec2], b: &[glam::DVec2]| {
+        assert_eq!(a.len(), b.len());
+        (a.iter().zip(b))
+            .map(|(p, q)| p.distance(*q))
+            .fold(0.0, f64::max)
+    };
+    assert!(
+        far(&parts.deformed(), &joined) < 1e-6,
+        "at rest where it lies"
+    );
+    assert_eq!(parts.rest().len(), parts.composer().uv().len());
+    // A pose moves the left part's vertices near its handle, the right part's stay.
+    let HandleSpec::Point { translate, .. } = &mut project.handles[0] else {
+        unreachable!()
+    };
+    *translate = [0.0, 20.0];
+    assert_eq!(parts.follow(&project).expect("posed"), Follow::Followed);
+    let left = set.meshes[0].as_ref().expect("left").rest.len();
+    let moved = parts.deformed();
+    assert!(
+        moved[..left]
+            .iter()
+            .zip(&joined)
+            .any(|(a, b)| a.distance(*b) > 5.0)
+    );
+    let right_still = moved[left..].iter().zip(&joined[left..]);
+    let worst = right_still.map(|(a, b)| a.distance(*b)).fold(0.0, f64::max);
+    assert!(worst < 1e-9, "the right part moved {worst} px");
+    // Its posed positions are what render --parts draws: the same as the parts posed.
+    let posed = pipeline::set_up_parts(&artwork, &project, None, &()).expect("parts");
+    let expected: Vec<_> = posed
+        .meshes
+        .iter()
+        .flatten()
+        .flat_map(|m| m.deformed.clone())
+        .collect();
+    assert!(moved == expected, "the parts posed");
+    // A handle moved at rest, another order or another method: a new setup.
+    for change in 0..3 {
+        let mut other = project.clone();
+        match change {
+            0 => {
+                let HandleSpec::Point { rest, .. } = &mut other.handles[2] else {
+                    unreachable!()
+                };
+                rest[0] += 3.0;
+            }
+            1 => {
+                other.parts = Some(project::PartsSpec {
+                    order: vec![1, 0],
+                    ..Default::default()
+                })
+            }
+            _ => other.method = project::Method::Mls,
+        }
+        assert_eq!(
+            parts.follow(&other).expect("asks"),
+            Follow::NeedsSetup,
+            "{change}"
+        );
+    }
+    assert_eq!(
+        parts.deformed(),
+        expected,
+        "a new setup asked for moves nothing"
+    );
+    // Weights are listed by part, in the draw order, with the handles that bind each.
+    let listing = WeightsListing {
+        file_vertices: 0,
+        positions: true,
+    };
+    let weights = parts.weights(listing).expect("C² weights");
+    let listed = weights["parts"].as_array().expect("parts");
+    assert_eq!(listed.len(), 2);
+    assert_eq!(listed[0]["name"], "left");
+    assert_eq!(listed[0]["handles"], serde_json::json!([0, 1]));
+    assert_eq!(listed[1]["handles"], serde_json::json!([1, 2]));
+    let report = parts.bench(&project, 3).expect("timed");
+    assert_eq!(report["parts"], 2);
+    assert_eq!(report["poses"], 3);
+    assert_eq!(
+        parts.deformed(),
+        expected,
+        "the bench leaves the pose as it was"
+    );
 }

@@ -24,6 +24,7 @@ impl EditorApp {
         if !self.builtin_dialogs {
             match self.dialogs.ask(action, &suggested) {
                 Answer::Chosen(path) => return self.file_chosen(action, path),
+                Answer::Several(paths) => return self.request_open_all(paths),
                 Answer::Cancelled => return,
                 Answer::Unavailable => {
                     self.builtin_dialogs = true;

@@ -9,10 +9,16 @@ impl EditorApp {
     /// Opens a picture or (for `.json`) a project, asking first if there are unsaved
     /// changes.
     pub fn request_open(&mut self, path: PathBuf) {
+        self.request_open_all(vec![path]);
+    }
+
+    /// Opens pictures (several: as the layers of one, bottom first) or one project,
+    /// asking first if there are unsaved changes.
+    pub fn request_open_all(&mut self, paths: Vec<PathBuf>) {
         if self.dirty {
-            self.pending = Some(Pending::Open(path));
+            self.pending = Some(Pending::Open(paths));
         } else {
-            self.open_in_background(path);
+            self.open_all_in_background(paths);
         }
     }
 
@@ -20,7 +26,7 @@ impl EditorApp {
     /// current document stays and the status line says why.
     pub fn open(&mut self, path: &Path) {
         let outcome = open_outcome(
-            path.to_path_buf(),
+            vec![path.to_path_buf()],
             &CancelFlag::default(),
             &SolveProgress::default(),
         );
@@ -30,10 +36,19 @@ impl EditorApp {
     /// Opens a picture or project on a worker thread (an LBC project's cage is solved
     /// there too); the editor shows progress and takes no edits until it is in.
     pub fn open_in_background(&mut self, path: PathBuf) {
-        let label = format!("Opening {}", file_name(&path));
+        self.open_all_in_background(vec![path]);
+    }
+
+    /// Opens pictures (several: as the layers of one, bottom first) or one project on
+    /// a worker thread, as [`EditorApp::open_in_background`] opens one.
+    pub fn open_all_in_background(&mut self, paths: Vec<PathBuf>) {
+        let label = match paths.as_slice() {
+            [one] => format!("Opening {}", file_name(one)),
+            several => format!("Opening {} pictures", several.len()),
+        };
         let (cancel, progress) = (CancelFlag::default(), SolveProgress::default());
         let (flag, steps) = (cancel.clone(), progress.clone());
-        let work = move || open_outcome(path, &flag, &steps);
+        let work = move || open_outcome(paths, &flag, &steps);
         self.start_job(label, cancel, work);
         if let Some(job) = &mut self.job {
             job.progress = Some(progress);
@@ -172,12 +187,16 @@ impl EditorApp {
     pub(super) fn finish_outcome(&mut self, outcome: Outcome) {
         match outcome {
             Outcome::Opened {
-                path,
+                paths,
                 is_project,
                 document: Ok(doc),
             } => {
                 let stats = doc.rig().stats();
-                let what = if is_project { "project" } else { "image" };
+                let what = match (is_project, paths.len()) {
+                    (true, _) => "project".to_owned(),
+                    (false, 1) => "image".to_owned(),
+                    (false, n) => format!("{n} pictures as layers:"),
+                };
                 self.end_gesture();
                 let lbc = doc.method().controls() == Controls::Cage;
                 let unsolved = lbc && doc.cage_solution().is_none();
@@ -204,7 +223,7 @@ impl EditorApp {
                     .map_or_else(String::new, |n| format!("; {n}"));
                 self.info(format!(
                     "opened {what} {} ({} mesh vertices){notes}",
-                    path.display(),
+                    named(&paths),
                     stats.samples
                 ));
                 if unsolved {
@@ -215,10 +234,10 @@ impl EditorApp {
                 }
             }
             Outcome::Opened {
-                path,
+                paths,
                 document: Err(e),
                 ..
-            } => self.error(&e.context(format!("cannot open {}", path.display()))),
+            } => self.error(&e.context(format!("cannot open {}", named(&paths)))),
             Outcome::Rebuilt {
                 cause,
                 document: Ok(doc),
@@ -363,14 +382,27 @@ fn remesh(
     }
 }
 
-/// Opens a picture or (for `.json`) a project; an LBC project's cage is solved (a cage
-/// that cannot be is left unsolved, for the user to fix).
-fn open_outcome(path: PathBuf, cancel: &CancelFlag, progress: &SolveProgress) -> Outcome {
-    let is_project = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("json"));
-    let document = if is_project {
-        Document::open_project(&path).map(|mut doc| {
+/// The files `paths` names, for a message: their paths, comma-separated.
+fn named(paths: &[PathBuf]) -> String {
+    let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+    names.join(", ")
+}
+
+/// Opens pictures (several: as the layers of one) or (for `.json`) a project; an LBC
+/// project's cage is solved (a cage that cannot be is left unsolved, for the user to
+/// fix).
+fn open_outcome(paths: Vec<PathBuf>, cancel: &CancelFlag, progress: &SolveProgress) -> Outcome {
+    let is_json = |p: &PathBuf| {
+        p.extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+    };
+    let is_project = paths.len() == 1 && is_json(&paths[0]);
+    let document = if paths.len() > 1 && paths.iter().any(is_json) {
+        Err(anyhow::anyhow!(
+            "a project opens alone: open several pictures, or one project"
+        ))
+    } else if is_project {
+        Document::open_project(&paths[0]).map(|mut doc| {
             let solvable = CageKey::of(doc.project()).is_some_and(|k| k.problem().is_none());
             if doc.method().controls() == Controls::Cage && solvable {
                 // Failing (cancelled) leaves the cage unsolved.
@@ -382,10 +414,10 @@ fn open_outcome(path: PathBuf, cancel: &CancelFlag, progress: &SolveProgress) ->
             doc
         })
     } else {
-        Document::open_image(&path)
+        Document::open_pictures(&paths)
     };
     Outcome::Opened {
-        path,
+        paths,
         is_project,
         document,
     }

@@ -212,7 +212,7 @@ impl EditorApp {
     /// Does what a question was asked for, now that it is answered.
     pub(crate) fn go_on(&mut self, pending: Pending, ctx: &egui::Context) {
         match pending {
-            Pending::Open(path) => self.open_in_background(path),
+            Pending::Open(paths) => self.open_all_in_background(paths),
             Pending::Replace(action, path) => self.file_chosen(action, path),
             Pending::Close => {
                 self.allow_close = true;

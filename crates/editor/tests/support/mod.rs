@@ -68,7 +68,7 @@ pub fn build(
     let builder = builder.with_size(Vec2::new(1200.0, 800.0));
     let builder = if gpu { builder.wgpu() } else { builder };
     let mut harness = builder.build_eframe(move |cc| {
-        let mut app = EditorApp::new(cc, None);
+        let mut app = EditorApp::new(cc, &[]);
         // What the built-in dialog saves lands in a scratch folder, not in the crate.
         app.default_folder = Some(scratch_folder());
         if let Some(dialogs) = dialogs.take() {
