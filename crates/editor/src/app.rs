@@ -378,8 +378,8 @@ impl EditorApp {
         // mesh: on the worker too.
         let heavy = match &edit {
             Edit::Method(method) => method.sets_up_on_the_mesh(),
-            // A cut re-meshes the picture.
-            Edit::Cuts(_) => true,
+            // A cut re-meshes the picture; parts are meshed and set up each on its own.
+            Edit::Cuts(_) | Edit::Parts(_) => true,
             Edit::Rigidity(_) => self
                 .doc
                 .as_ref()

@@ -17,7 +17,7 @@ use anyhow::{Context, Result, bail};
 use glam::DVec2;
 use image::RgbaImage;
 use pipeline::cage::CageCoordinates;
-use pipeline::{ArapRig, Controls, Deformer, Follow, Method};
+use pipeline::{ArapRig, Controls, Deformer, Follow, Method, PartsDeformer};
 use project::{
     CageSpec, HandleSpec, LbcSettings, MetricChoice, Middle, Placement, Project, RigidityStroke,
 };
@@ -124,6 +124,9 @@ pub enum Edit {
     Animation(Option<Box<project::Animation>>),
     /// Automatic depth (the ARAP paper's §5.1) on or off.
     AutoDepth(bool),
+    /// A layered picture drawn as parts (their order, visibility and bindings), or
+    /// as one picture (`None`).
+    Parts(Option<project::PartsSpec>),
 }
 
 /// An open picture with its rig. Cloning copies the rig (tens of megabytes at a
@@ -196,6 +199,20 @@ impl Document {
     pub fn with_image(
         image: Arc<RgbaImage>,
         image_path: Option<PathBuf>,
+        project: Project,
+    ) -> Result<Self> {
+        Self::with_layers(image, None, image_path, project)
+    }
+
+    /// As [`Document::with_image`], with the layers the picture was flattened from
+    /// (a rig file drawing them as parts is set up as parts).
+    ///
+    /// # Errors
+    /// As [`Document::new`], and what setting the parts up refuses.
+    pub fn with_layers(
+        image: Arc<RgbaImage>,
+        layers: Option<Arc<pipeline::Artwork>>,
+        image_path: Option<PathBuf>,
         mut project: Project,
     ) -> Result<Self> {
         let clock = Instant::now();
@@ -217,7 +234,7 @@ impl Document {
             project,
             image,
             deep: None,
-            layers: None,
+            layers,
             image_path,
             image_paths: Vec::new(),
             project_path: None,
@@ -260,9 +277,24 @@ impl Document {
         if self.project.method.controls() == Controls::Cage {
             return self.sync_cage();
         }
+        if let Some(layers) = self.layers.clone().filter(|_| self.project.parts.is_some()) {
+            // Drawn as parts: each part set up by the method with its own handles,
+            // the parts joined into the mesh shown.
+            if let Some((mesh, deformer)) = &mut self.method
+                && *mesh == self.mesh_version
+                && deformer.as_any().is::<PartsDeformer>()
+                && deformer.follow(&self.project)? == Follow::Followed
+            {
+                return Ok(());
+            }
+            let parts = PartsDeformer::new(&layers, &self.project, None, &())?;
+            self.method = Some((self.mesh_version, Box::new(parts)));
+            return Ok(());
+        }
         if let Some((mesh, deformer)) = &mut self.method
             && *mesh == self.mesh_version
             && deformer.method() == self.project.method
+            && !deformer.as_any().is::<PartsDeformer>()
             && deformer.follow(&self.project)? == Follow::Followed
         {
             return Ok(());
@@ -283,6 +315,10 @@ impl Document {
         if let Some(depth) = self.depth.as_ref().filter(|d| !d.is_cage()) {
             return depth.order.clone();
         }
+        if let Some(parts) = self.parts() {
+            // The parts back to front in the draw order, each in its own order.
+            return parts.triangles().to_vec();
+        }
         let depths: Vec<i32> = self.project.handles.iter().map(HandleSpec::depth).collect();
         pipeline::draw_order(&self.rig, &depths)
     }
@@ -298,6 +334,13 @@ impl Document {
             Some((_, deformer)) => deformer.as_ref(),
             None => &self.rig,
         }
+    }
+
+    /// The parts, when the picture is drawn as parts (the rig file's `"parts"`).
+    pub fn parts(&self) -> Option<&PartsDeformer> {
+        self.method
+            .as_ref()
+            .and_then(|(_, deformer)| deformer.as_any().downcast_ref::<PartsDeformer>())
     }
 
     /// The ARAP rig, when ARAP is in use (its step times, its rigidity per triangle).
@@ -328,10 +371,7 @@ impl Document {
             image: Some(path.to_path_buf()),
             ..Project::default()
         };
-        let mut document =
-            Self::from_picture(artwork.flatten(), Some(path.to_path_buf()), project)?;
-        document.take_layers(artwork);
-        Ok(document)
+        Self::from_artwork(artwork, Some(path.to_path_buf()), project)
     }
 
     /// Pictures drawn as the layers of one, bottom first, with no handles (one: as
@@ -348,9 +388,8 @@ impl Document {
             images: paths.to_vec(),
             ..Project::default()
         };
-        let mut document = Self::from_picture(artwork.flatten(), None, project)?;
+        let mut document = Self::from_artwork(artwork, None, project)?;
         document.image_paths = paths.to_vec();
-        document.take_layers(artwork);
         Ok(document)
     }
 
@@ -364,14 +403,44 @@ impl Document {
         image_path: Option<PathBuf>,
         project: Project,
     ) -> Result<Self> {
-        match picture {
-            render::Picture::Rgba8(image) => Self::new(image, image_path, project),
+        Self::from_layers(picture, None, image_path, project)
+    }
+
+    /// As [`Document::from_picture`] for `artwork` flattened, its layers kept (what
+    /// its reading noted too): a rig file drawing them as parts is set up as parts.
+    ///
+    /// # Errors
+    /// As [`Document::new`], and what setting the parts up refuses.
+    pub fn from_artwork(
+        mut artwork: pipeline::Artwork,
+        image_path: Option<PathBuf>,
+        project: Project,
+    ) -> Result<Self> {
+        let notes = std::mem::take(&mut artwork.notes);
+        let picture = artwork.flatten();
+        let mut document =
+            Self::from_layers(picture, Some(Arc::new(artwork)), image_path, project)?;
+        document.picture_notes = notes;
+        Ok(document)
+    }
+
+    /// [`Document::from_picture`] with the layers it was flattened from, set before
+    /// the method is set up (so that parts are set up once, from the saved orders).
+    fn from_layers(
+        picture: render::Picture,
+        layers: Option<Arc<pipeline::Artwork>>,
+        image_path: Option<PathBuf>,
+        project: Project,
+    ) -> Result<Self> {
+        let (image, deep) = match picture {
+            render::Picture::Rgba8(image) => (image, None),
             deep @ render::Picture::Rgba16(_) => {
-                let mut document = Self::new(deep.to_rgba8().into_owned(), image_path, project)?;
-                document.deep = Some(Arc::new(deep));
-                Ok(document)
+                (deep.to_rgba8().into_owned(), Some(Arc::new(deep)))
             }
-        }
+        };
+        let mut document = Self::with_layers(Arc::new(image), layers, image_path, project)?;
+        document.deep = deep;
+        Ok(document)
     }
 
     /// A project file and the picture it names (relative to the project file).
@@ -391,21 +460,13 @@ impl Document {
         let artwork = pipeline::load_artworks(&named)
             .with_context(|| format!("the image of project {}", path.display()))?;
         let image_path = project.image.is_some().then(|| named[0].clone());
-        let mut document = Self::from_picture(artwork.flatten(), image_path, project)
+        let mut document = Self::from_artwork(artwork, image_path, project)
             .with_context(|| format!("project {}", path.display()))?;
         if document.image_path.is_none() {
             document.image_paths = named;
         }
         document.project_path = Some(path.to_path_buf());
-        document.take_layers(artwork);
         Ok(document)
-    }
-
-    /// Keeps `artwork`, the layers the document's picture was flattened from, and
-    /// what its reading noted.
-    fn take_layers(&mut self, mut artwork: pipeline::Artwork) {
-        self.picture_notes = std::mem::take(&mut artwork.notes);
-        self.layers = Some(Arc::new(artwork));
     }
 
     /// The rig file as it stands (without virtual handles).
@@ -605,6 +666,22 @@ impl Document {
             Edit::AutoDepth(on) => {
                 project.auto_depth = on;
                 project.overlaps.clear();
+            }
+            Edit::Parts(parts) => {
+                if let (Some(spec), Some(layers)) = (&parts, &self.layers) {
+                    spec.check_layers(layers.layers.len())?;
+                } else if parts.is_some() {
+                    bail!("the built-in picture has no layers to draw as parts");
+                }
+                // The orders automatic depth kept name places on the mesh drawn
+                // before: the parts' mesh is another.
+                if parts.is_some() != project.parts.is_some() {
+                    project.overlaps.clear();
+                }
+                project.parts = parts;
+                project
+                    .validate(Some(self.image.dimensions()))
+                    .context("the parts")?;
             }
             Edit::Mls(settings) => {
                 project.mls = Some(settings);

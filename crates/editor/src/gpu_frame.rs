@@ -58,6 +58,8 @@ struct Seen {
     warping: bool,
     /// The picture and rest mesh the backdrop was made for.
     backdrop: Option<(Arc<image::RgbaImage>, Vec<DVec2>)>,
+    /// Drawn as parts: the packed texture shown (keyed by the parts' composer).
+    parts: Option<(usize, Arc<image::RgbaImage>)>,
 }
 
 impl FrameBuilder {
@@ -76,16 +78,33 @@ impl FrameBuilder {
             .filter(|_| view.cage_view && view.warping)
             .map(|cage| cage as &dyn Deformer);
         let weights = doc.weights_version;
+        // Drawn as parts: the joined mesh samples the layers' pixels packed together.
+        let parts = doc.parts().filter(|_| !view.cage_view);
+        let parts_key = parts.map(|p| std::ptr::from_ref(p.composer()) as usize);
+        let parts_changed = parts_key != self.seen.parts.as_ref().map(|(key, _)| *key);
+        if parts_changed {
+            self.seen.parts = parts.zip(parts_key).map(|(p, key)| {
+                (
+                    key,
+                    Arc::new(p.composer().texture().to_rgba8().into_owned()),
+                )
+            });
+        }
+        let picture = match &self.seen.parts {
+            Some((_, texture)) => texture.clone(),
+            None => doc.image.clone(),
+        };
         let image_is_new =
-            self.frame.image.version == 0 || !Arc::ptr_eq(&self.frame.image.value, &doc.image);
+            self.frame.image.version == 0 || !Arc::ptr_eq(&self.frame.image.value, &picture);
         if image_is_new {
             let version = self.bump();
             self.frame.image = Versioned {
                 version,
-                value: doc.image.clone(),
+                value: picture,
             };
         }
         let mesh_changed = image_is_new
+            || parts_changed
             || weights != self.seen.weights
             || doc.order_version != self.seen.order
             || view.cage_view != self.seen.cage_view
@@ -121,7 +140,20 @@ impl FrameBuilder {
                 source_size: size,
                 ..MeshData::default()
             },
-            (false, _) => skinned_mesh(doc.rig(), doc.draw_order(), size),
+            (false, _) => match doc.parts() {
+                // The joined mesh at the texture's places, moved by positions alone.
+                Some(parts) => {
+                    let texture = parts.composer().texture().dimensions();
+                    MeshData {
+                        rest: parts.composer().uv().to_vec(),
+                        rows: vec![0; parts.rest().len() + 1],
+                        triangles: doc.draw_order(),
+                        source_size: [texture.0, texture.1],
+                        ..MeshData::default()
+                    }
+                }
+                None => skinned_mesh(doc.rig(), doc.draw_order(), size),
+            },
         };
         let version = self.bump();
         self.frame.mesh = Versioned {
@@ -130,6 +162,11 @@ impl FrameBuilder {
         };
         self.seen.heat = None;
         self.seen.cells = 0;
+        if doc.parts().is_some() && !cage_view {
+            // No overlay values for the parts' mesh (see `update_overlays`).
+            self.frame.heat.value = Arc::new(Vec::new());
+            self.frame.cells.value = Arc::new(Vec::new());
+        }
         if !cage_view {
             self.frame.backdrop = None;
             self.seen.backdrop = None;
@@ -165,7 +202,12 @@ impl FrameBuilder {
                     Output::Skinned(_) => Vec::new(),
                     Output::Positions(p) => p.iter().map(|p| p.as_vec2()).collect(),
                 };
-                (doc.rig().node_affines(), positions)
+                let affines = if doc.parts().is_some() {
+                    Vec::new()
+                } else {
+                    doc.rig().node_affines()
+                };
+                (affines, positions)
             }
         };
         let version = self.bump();
@@ -183,6 +225,11 @@ impl FrameBuilder {
     /// The heat map of the shown handle or cage vertex, the cells, the dual graph: each
     /// when on and out of date.
     fn update_overlays(&mut self, doc: &Document, view: &View) {
+        if doc.parts().is_some() && !view.cage_view {
+            // The heat map, cells and dual graph are the whole picture's C² rig's, on
+            // another mesh than the parts'.
+            return;
+        }
         let weights = doc.weights_version;
         let heat_key = view.shown.filter(|_| view.show.heat).map(|s| (s, weights));
         if let Some((shown, _)) = heat_key
@@ -235,7 +282,9 @@ impl FrameBuilder {
             return Ok(());
         }
         let mesh = &self.frame.mesh.value;
-        let (samples, what) = if !self.seen.cage_view {
+        let (samples, what) = if let Some(parts) = doc.parts().filter(|_| !self.seen.cage_view) {
+            (parts.rest().len(), "the parts")
+        } else if !self.seen.cage_view {
             (doc.rig().domain().len(), "the rig")
         } else if self.seen.warping {
             let solved = doc.cage_deformer().map(|c| c.rest().len());

@@ -639,6 +639,16 @@ impl EditorApp {
         ui.heading("Method");
         self.method_choice(ui);
         ui.separator();
+        if self
+            .doc
+            .as_ref()
+            .and_then(|d| d.layers.as_ref())
+            .is_some_and(|l| l.layers.len() > 1)
+        {
+            ui.heading("Layers");
+            self.layers_panel(ui);
+            ui.separator();
+        }
         let lbc = self
             .doc
             .as_ref()
@@ -665,6 +675,67 @@ impl EditorApp {
         }
         ui.heading("Show");
         self.overlay_toggles(ui);
+    }
+
+    /// A layered picture's layers: drawn as one picture or as parts; as parts, each
+    /// part's visibility and place in the draw order (each change one undo step, saved
+    /// in the rig file's `"parts"`).
+    fn layers_panel(&mut self, ui: &mut Ui) {
+        let Some(doc) = &self.doc else { return };
+        let Some(layers) = doc.layers.clone() else {
+            return;
+        };
+        let spec = doc.project().parts.clone();
+        let mut as_parts = spec.is_some();
+        let mut chosen = None;
+        if ui
+            .checkbox(&mut as_parts, "Draw as parts")
+            .on_hover_text(
+                "Each layer meshed along its own outline and moved by the handles on it; \
+                 a handle where two layers overlap binds both",
+            )
+            .changed()
+        {
+            chosen = Some(as_parts.then(project::PartsSpec::default));
+        }
+        if let Some(spec) = &spec {
+            let order = spec.order_of(layers.layers.len());
+            // Top first, as layer panels list them.
+            for (at, &k) in order.iter().enumerate().rev() {
+                let layer = &layers.layers[k];
+                ui.horizontal(|ui| {
+                    let mut shown = spec.shows(k, layer.visible);
+                    if ui
+                        .checkbox(&mut shown, "")
+                        .on_hover_text(format!("Show {}", layer.name))
+                        .changed()
+                    {
+                        chosen = Some(Some(with_shown(spec, k, layer.visible, shown)));
+                    }
+                    // Named for what they do to which part (hover text, and the
+                    // name a screen reader says).
+                    let step = |ui: &mut Ui, enabled: bool, arrow: &str, what: String| {
+                        let button = ui.add_enabled(enabled, egui::Button::new(arrow));
+                        button.widget_info(|| {
+                            egui::WidgetInfo::labeled(egui::Role::Button, enabled, &what)
+                        });
+                        button.on_hover_text(what).clicked()
+                    };
+                    let (top, bottom) = (at + 1 == order.len(), at == 0);
+                    if step(ui, !top, "⏶", format!("Bring {} forward", layer.name)) {
+                        chosen = Some(Some(with_order(spec, &order, at, at + 1)));
+                    }
+                    if step(ui, !bottom, "⏷", format!("Send {} backward", layer.name)) {
+                        chosen = Some(Some(with_order(spec, &order, at, at - 1)));
+                    }
+                    ui.label(&layer.name);
+                });
+            }
+        }
+        if let Some(parts) = chosen {
+            // Refused, the status line says why.
+            let _ = self.edit(Edit::Parts(parts));
+        }
     }
 
     /// The method the method selector shows: the document's, or LBC while the cage
@@ -815,4 +886,44 @@ fn middle_name(m: Middle) -> &'static str {
 /// 41000 must not re-mesh at 4, 41 and 410 on the way.
 fn released(r: &egui::Response) -> bool {
     r.drag_stopped() || r.lost_focus() || (r.changed() && !r.dragged() && !r.has_focus())
+}
+
+/// `spec` with layer `k` (which the file shows or not: `in_file`) shown or hidden.
+fn with_shown(
+    spec: &project::PartsSpec,
+    k: usize,
+    in_file: bool,
+    shown: bool,
+) -> project::PartsSpec {
+    let mut spec = spec.clone();
+    spec.hidden.retain(|&h| h != k);
+    spec.shown.retain(|&h| h != k);
+    match (in_file, shown) {
+        (true, false) => spec.hidden.push(k),
+        (false, true) => spec.shown.push(k),
+        _ => {}
+    }
+    spec.hidden.sort_unstable();
+    spec.shown.sort_unstable();
+    spec
+}
+
+/// `spec` with the layer at place `from` of the draw order `order` swapped with the
+/// one at place `to`.
+fn with_order(
+    spec: &project::PartsSpec,
+    order: &[usize],
+    from: usize,
+    to: usize,
+) -> project::PartsSpec {
+    let mut order = order.to_vec();
+    order.swap(from, to);
+    let mut spec = spec.clone();
+    // The file's own order is kept as no order at all.
+    spec.order = if order.iter().enumerate().all(|(i, &k)| i == k) {
+        Vec::new()
+    } else {
+        order
+    };
+    spec
 }

@@ -5,5 +5,6 @@ mod cage;
 mod edge_states;
 mod methods;
 mod monkey;
+mod parts;
 mod support;
 mod ui;

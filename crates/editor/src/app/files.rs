@@ -194,9 +194,20 @@ impl EditorApp {
             })),
         };
         let cage = ExportSetup::of(doc, &project);
+        // Drawn as parts: the export is `c2warp render` of the saved project, parts
+        // and all.
+        let parts = doc.layers.clone().filter(|_| doc.parts().is_some());
         Some(move || {
             let clock = Instant::now();
             let result = (|| -> Result<()> {
+                if let Some(artwork) = parts {
+                    let parts = pipeline::warp_parts(&artwork, &project, None, &())?;
+                    anyhow::ensure!(!cancel.is_set(), "cancelled");
+                    return match what {
+                        Export::Layers => Ok(pipeline::write_ora(&path, &parts.warped)?),
+                        Export::Picture => Ok(render::save_png_atomic(&path, &parts.composite)?),
+                    };
+                }
                 let warper = cage.warper(&image, &project, &cancel)?;
                 if let Some(layers) = layers {
                     let warped = pipeline::warp_layers(&layers, &warper)?;

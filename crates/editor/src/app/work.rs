@@ -372,9 +372,8 @@ fn remesh(
     move || Outcome::Rebuilt {
         cause,
         // The same picture: its depth, its layers and the files it came from kept.
-        document: Document::with_image(image, image_path, project).map(|mut d| {
+        document: Document::with_layers(image, layers, image_path, project).map(|mut d| {
             d.deep = deep;
-            d.layers = layers;
             d.picture_notes = notes;
             d.image_paths = image_paths;
             d

@@ -87,6 +87,15 @@ impl Document {
             );
         }
         match method.controls() {
+            Controls::Handles if self.project.parts.is_some() => {
+                let parts = self.parts().context("drawn as parts without the parts")?;
+                if *mesh != self.mesh_version || self.layers.is_none() {
+                    bail!("the parts were set up for another picture");
+                }
+                if parts.rest().len() != parts.composer().uv().len() {
+                    bail!("the parts' mesh and texture disagree");
+                }
+            }
             Controls::Handles => {
                 if *mesh != self.mesh_version || deformer.rest() != self.rig.domain().positions() {
                     bail!("the {} deformer was set up on another mesh", method.name());
@@ -128,8 +137,13 @@ impl Document {
     pub fn check_reopens(&self) -> Result<()> {
         let text = self.project_for_saving(None).to_json();
         let saved = Project::from_json(&text).context("the saved rig file does not load")?;
-        let mut fresh = Document::with_image(self.image.clone(), self.image_path.clone(), saved)
-            .context("the saved rig file does not build")?;
+        let mut fresh = Document::with_layers(
+            self.image.clone(),
+            self.layers.clone(),
+            self.image_path.clone(),
+            saved,
+        )
+        .context("the saved rig file does not build")?;
         fresh.image_paths.clone_from(&self.image_paths);
         // Solved cages are not saved (`c2warp render` solves again, to the same
         // coordinates): the reopened document finds this one's for its cage, if the

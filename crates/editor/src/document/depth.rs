@@ -97,7 +97,12 @@ impl Document {
             }
             return;
         };
-        let depths: Vec<i32> = if cage {
+        // Parts: each triangle's part, the joined mesh already in the predefined order
+        // (the parts' draw order, each part's own by its handles' depths).
+        let part_of = (self.parts())
+            .filter(|_| !cage)
+            .map(|p| p.part_of().to_vec());
+        let depths: Vec<i32> = if cage || part_of.is_some() {
             Vec::new()
         } else {
             self.project.handles.iter().map(HandleSpec::depth).collect()
@@ -111,8 +116,9 @@ impl Document {
                 && d.depths != depths
                 && d.wrote == self.project.overlaps
         });
+        let joined = part_of.is_some();
         let predefined = |rig| {
-            if cage {
+            if cage || joined {
                 (0..triangles.len() as u32).collect()
             } else {
                 predefined_order(rig, &depths)
@@ -140,7 +146,16 @@ impl Document {
                 } else {
                     &self.project.overlaps
                 };
-                Arranger::new(predefined(&self.rig), saved, deformer.rest(), triangles)
+                match part_of {
+                    Some(part_of) => Arranger::with_parts(
+                        predefined(&self.rig),
+                        saved,
+                        deformer.rest(),
+                        triangles,
+                        part_of,
+                    ),
+                    None => Arranger::new(predefined(&self.rig), saved, deformer.rest(), triangles),
+                }
             }
         };
         let order = as_triangles(

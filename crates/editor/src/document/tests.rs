@@ -699,3 +699,87 @@ fn layered_files_open_flattened_and_say_what_is_drawn_as_normal() {
     assert_eq!(doc.image.dimensions(), (64, 40));
     assert!(doc.picture_notes.is_empty());
 }
+
+/// The sample character (`assets/puppet.ora`) with its rig, at a low density, in a
+/// folder of its own.
+fn puppet(dir: &Path) -> Document {
+    let assets = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets");
+    std::fs::copy(assets.join("puppet.ora"), dir.join("puppet.ora")).expect("the sample");
+    let mut rig: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(assets.join("puppet-rig.json")).expect("its rig"),
+    )
+    .expect("JSON");
+    rig["density"] = 2_000.into();
+    let path = dir.join("puppet.json");
+    std::fs::write(&path, rig.to_string()).expect("write the rig");
+    Document::open_project(&path).expect("opens")
+}
+
+/// The positions of the parts `project` draws (`c2warp render --parts`), joined.
+fn parts_drawn(doc: &Document, project: &Project) -> Vec<DVec2> {
+    let layers = doc.layers.as_ref().expect("layers");
+    let set = pipeline::set_up_parts(layers, project, None, &()).expect("parts");
+    (set.order.iter())
+        .filter_map(|&k| set.meshes[k].as_ref())
+        .flat_map(|m| m.deformed.clone())
+        .collect()
+}
+
+#[test]
+fn a_layered_picture_drawn_as_parts_shows_what_render_draws_of_it() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut doc = puppet(dir.path());
+    assert!(doc.parts().is_none(), "one picture until asked");
+    doc.apply(Edit::Parts(Some(project::PartsSpec::default())))
+        .expect("drawn as parts");
+    let parts = doc.parts().expect("parts");
+    assert_eq!(parts.rest().len(), parts.composer().uv().len());
+    let saved = doc.project_for_saving(None);
+    assert!(doc.deformer().deformed() == parts_drawn(&doc, &saved));
+    doc.sanity_check().expect("consistent");
+    doc.check_reopens().expect("reopens as parts");
+    // A pose moves the parts as render draws that pose, without setting them up again.
+    let before = std::ptr::from_ref(doc.parts().expect("parts").composer());
+    let HandleSpec::Point { rest, .. } = doc.project().handles[4].clone() else {
+        panic!("the back arm's point");
+    };
+    let moved = HandleSpec::Point {
+        rest,
+        translate: [-60.0, -120.0],
+        rotate: 1.0,
+        scale: 1.0,
+        depth: 0,
+    };
+    doc.apply(Edit::Pose(4, moved)).expect("posed");
+    let after = std::ptr::from_ref(doc.parts().expect("parts").composer());
+    assert_eq!(before, after, "posed, not set up again");
+    let saved = doc.project_for_saving(None);
+    assert!(doc.deformer().deformed() == parts_drawn(&doc, &saved));
+    doc.check_reopens().expect("reopens posed");
+    // Sending the tail (bottom) forward puts it on top: saved, reopened the same.
+    let order = vec![1, 2, 3, 4, 5, 6, 0];
+    doc.apply(Edit::Parts(Some(project::PartsSpec {
+        order: order.clone(),
+        ..Default::default()
+    })))
+    .expect("reordered");
+    let saved = doc.project_for_saving(None);
+    assert_eq!(saved.parts.as_ref().map(|p| p.order.clone()), Some(order));
+    let parts = doc.parts().expect("parts");
+    let last = *parts.part_of().last().expect("triangles");
+    assert_eq!(last, 0, "the tail's triangles are drawn last");
+    doc.check_reopens().expect("reopens reordered");
+    // An order for other layers is refused, and nothing changes.
+    let error = doc
+        .apply(Edit::Parts(Some(project::PartsSpec {
+            order: vec![0, 1],
+            ..Default::default()
+        })))
+        .expect_err("two layers of seven");
+    assert!(error.to_string().contains("parts.order"), "{error}");
+    assert_eq!(doc.project().parts, saved.parts);
+    // Back to one picture.
+    doc.apply(Edit::Parts(None)).expect("one picture");
+    assert!(doc.parts().is_none());
+    doc.sanity_check().expect("consistent");
+}

@@ -61,7 +61,9 @@ fn paint_overlays(host: &dyn Host, painter: &Painter, turning: Option<usize>) {
     let v = host.viewport();
     let show = host.shows();
     let selected = host.selected();
-    let c2 = doc.method().uses_virtual_handles();
+    // (Drawn as parts, each part places virtual handles of its own: the whole
+    // picture's are not what warps it.)
+    let c2 = doc.method().uses_virtual_handles() && doc.parts().is_none();
     if show.dual_graph && c2 {
         for &(a, b) in host.dual_graph() {
             let (a, b) = (a as usize, b as usize);
