@@ -83,6 +83,9 @@ impl Settings {
 pub enum Edit {
     /// Appends a handle.
     Add(HandleSpec),
+    /// Appends a handle bound to one part alone (a layer's index), not to every part
+    /// under it (the layers drawn as parts).
+    AddBound(HandleSpec, usize),
     /// Removes handle `index`.
     Remove(usize),
     /// Replaces handle `index` with the same rest geometry and a new pose.
@@ -343,6 +346,18 @@ impl Document {
             .and_then(|(_, deformer)| deformer.as_any().downcast_ref::<PartsDeformer>())
     }
 
+    /// Drawn as parts: the part (a layer's index) shown at `p` in the current pose,
+    /// the topmost there.
+    pub fn part_at(&mut self, p: DVec2) -> Option<usize> {
+        self.deformed();
+        let deformed = self.deformed.as_ref().map(|(_, d)| d.as_slice())?;
+        let parts = self.parts()?;
+        let mut order = self.draw_order();
+        order.reverse();
+        let ([a, ..], _) = locate(deformed, &order, p)?;
+        parts.part_of_vertex(a).map(|k| k as usize)
+    }
+
     /// The ARAP rig, when ARAP is in use (its step times, its rigidity per triangle).
     pub fn arap(&self) -> Option<&ArapRig> {
         self.method
@@ -534,24 +549,22 @@ impl Document {
     pub fn apply(&mut self, edit: Edit) -> Result<()> {
         let mut project = self.project.clone();
         match edit {
-            Edit::Add(handle) => {
-                // Every key gets the new handle where its pose takes it.
-                let fitted = self.fit_into_keys(&handle)?;
-                if let Some(animation) = &mut project.animation {
-                    for (pose, fit) in animation.poses_mut().zip(fitted) {
-                        pose.handles.push(fit);
-                    }
+            Edit::Add(handle) => self.push_handle(&mut project, handle)?,
+            Edit::AddBound(handle, part) => {
+                let Some(parts) = &project.parts else {
+                    bail!("a handle is bound to one part when the layers are drawn as parts");
+                };
+                parts.check_layers(self.layers.as_ref().map_or(0, |l| l.layers.len()))?;
+                if self.layers.as_ref().is_none_or(|l| part >= l.layers.len()) {
+                    bail!("there is no part {part}");
                 }
-                // Placed in a posed state, it holds the picture where it is: C² lays
-                // it over the weights it is placed on, ARAP pins what is under it.
-                let posed = project.is_posed();
-                project.handles.push(handle);
-                let index = project.handles.len() - 1;
-                if posed {
-                    project.overlaid.push(index);
-                }
-                if let Some(hold) = self.deformer().hold(&project, index) {
-                    project.holds.push(hold);
+                self.push_handle(&mut project, handle)?;
+                let handle = project.handles.len() - 1;
+                if let Some(parts) = &mut project.parts {
+                    parts.bindings.push(project::Binding {
+                        handle,
+                        parts: vec![part],
+                    });
                 }
             }
             Edit::Remove(index) => {
@@ -697,6 +710,29 @@ impl Document {
             }
         }
         self.restore(project)
+    }
+
+    /// Appends `handle` to `project` (the document's, being edited) with what goes with
+    /// it: its place in every key, and in a posed state what holds the picture where
+    /// it is (C² lays it over the weights it is placed on, ARAP pins what is under it).
+    fn push_handle(&mut self, project: &mut Project, handle: HandleSpec) -> Result<()> {
+        // Every key gets the new handle where its pose takes it.
+        let fitted = self.fit_into_keys(&handle)?;
+        if let Some(animation) = &mut project.animation {
+            for (pose, fit) in animation.poses_mut().zip(fitted) {
+                pose.handles.push(fit);
+            }
+        }
+        let posed = project.is_posed();
+        project.handles.push(handle);
+        let index = project.handles.len() - 1;
+        if posed {
+            project.overlaid.push(index);
+        }
+        if let Some(hold) = self.deformer().hold(project, index) {
+            project.holds.push(hold);
+        }
+        Ok(())
     }
 
     /// Makes `project` (the document's, with handle `removed` of the partition taken
@@ -939,10 +975,18 @@ impl Document {
     /// contains `p` (the first one, where folds overlap). `None` off the picture.
     pub fn unwarp(&mut self, p: DVec2) -> Option<(DVec2, f64, f64)> {
         self.deformed();
+        // Drawn as parts, the parts' joined mesh, the topmost triangle first.
+        let on_top: Option<Vec<[u32; 3]>> = self.parts().map(|_| {
+            let mut order = self.draw_order();
+            order.reverse();
+            order
+        });
         let deformed = self.deformed.as_ref().map(|(_, d)| d.as_slice())?;
-        let domain = self.rig.domain();
-        let rest = domain.positions();
-        let ([a, b, c], [u, v, w]) = locate(deformed, domain.triangles(), p)?;
+        let (rest, triangles) = match (self.parts(), &on_top) {
+            (Some(parts), Some(order)) => (parts.rest(), order.as_slice()),
+            _ => (self.rig.domain().positions(), self.rig.domain().triangles()),
+        };
+        let ([a, b, c], [u, v, w]) = locate(deformed, triangles, p)?;
         let [pa, pb, pc] = [a, b, c].map(|v| deformed[v as usize]);
         let [ra, rb, rc] = [a, b, c].map(|v| rest[v as usize]);
         let at_rest = ra * u + rb * v + rc * w;
@@ -969,6 +1013,12 @@ impl Document {
     /// weighted by the basis φ(d/r) as the weights will be. `(0, 1)` where nothing is
     /// posed or nothing is there to fit.
     pub fn local_pose(&mut self, rest: DVec2, at: DVec2) -> (f64, f64) {
+        if self.parts().is_some() {
+            // Drawn as parts: the similarity of the part's triangle under `at`.
+            return self
+                .unwarp(at)
+                .map_or((0.0, 1.0), |(_, angle, scale)| (angle, scale));
+        }
         self.deformed();
         let deformed = self
             .deformed

@@ -81,7 +81,13 @@ impl Dialogs for MonkeyDialogs {
             return Answer::Cancelled;
         }
         let names: &[&str] = match action {
-            FileAction::OpenImage => &["small.png", "lizard.png", "corrupt.png", "missing.png"],
+            FileAction::OpenImage => &[
+                "small.png",
+                "lizard.png",
+                "layers.ora",
+                "corrupt.png",
+                "missing.png",
+            ],
             FileAction::OpenProject => &["project.json", "broken.json", "missing.json"],
             FileAction::SaveProject => &["project.json", "project.json", "no-folder/p.json"],
             FileAction::ExportPng => &["warped.png", "no-folder/w.png"],
@@ -109,6 +115,32 @@ fn write_files(dir: &Path) {
         ])
     });
     small.save(dir.join("small.png")).expect("write");
+    // Two layers that overlap, to be drawn as parts and reordered.
+    let disc = |cx: f32, colour: [u8; 3]| {
+        let [r, g, b] = colour;
+        render::Picture::Rgba8(image::RgbaImage::from_fn(120, 90, |x, y| {
+            let inside = (x as f32 - cx).hypot(y as f32 - 45.0) < 30.0;
+            image::Rgba([r, g, b, if inside { 255 } else { 0 }])
+        }))
+    };
+    let layer = |name: &str, pixels| pipeline::Layer {
+        name: name.into(),
+        x: 0,
+        y: 0,
+        opacity: 1.0,
+        visible: true,
+        pixels,
+    };
+    let artwork = pipeline::Artwork {
+        width: 120,
+        height: 90,
+        layers: vec![
+            layer("back", disc(45.0, [200, 60, 40])),
+            layer("front", disc(75.0, [40, 60, 200])),
+        ],
+        notes: Vec::new(),
+    };
+    pipeline::write_ora(&dir.join("layers.ora"), &artwork).expect("write");
 }
 
 struct Monkey {
@@ -134,6 +166,11 @@ const LABELS: &[&str] = &[
     "Send backward",
     "Automatic depth",
     "Overlap regions",
+    "Draw as parts",
+    "Bring back forward",
+    "Send back backward",
+    "Bring front forward",
+    "Send front backward",
     "Painted rigidity",
     "Delete handle",
     "Clear all handles",

@@ -513,6 +513,7 @@ impl Composer {
                 bail!("part {k} has no mesh to draw");
             };
             let base = joined.rest.len() as u32;
+            joined.starts.push((base, k as u32));
             joined.rest.extend_from_slice(&mesh.rest);
             joined.deformed.extend_from_slice(&mesh.deformed);
             (joined.triangles).extend(mesh.triangles.iter().map(|t| t.map(|v| v + base)));
@@ -550,6 +551,7 @@ impl Composer {
             deformed,
             triangles,
             part_of,
+            ..
         } = self.join(meshes)?;
         if deformed.iter().any(|p| !p.is_finite()) {
             bail!("the deformation produced non-finite positions");
@@ -595,6 +597,8 @@ pub struct Joined {
     pub triangles: Vec<[u32; 3]>,
     /// For each triangle, its part (the layer's index).
     pub part_of: Vec<u32>,
+    /// Each part's first vertex, and the part, in the draw order.
+    pub starts: Vec<(u32, u32)>,
 }
 
 /// Layered artwork's parts behind the method seam: one mesh, the parts' meshes joined
@@ -651,6 +655,14 @@ impl PartsDeformer {
     /// For each triangle, its part (the layer's index).
     pub fn part_of(&self) -> &[u32] {
         &self.joined.part_of
+    }
+
+    /// The part (the layer's index) vertex `v` of the joined mesh belongs to.
+    pub fn part_of_vertex(&self, v: u32) -> Option<u32> {
+        // Each part's vertices are one run, in the draw order.
+        let at = self.joined.starts.partition_point(|&(start, _)| start <= v);
+        let (_, part) = *self.joined.starts.get(at.checked_sub(1)?)?;
+        (v < self.joined.rest.len() as u32).then_some(part)
     }
 }
 

@@ -756,6 +756,37 @@ fn a_layered_picture_drawn_as_parts_shows_what_render_draws_of_it() {
     let saved = doc.project_for_saving(None);
     assert!(doc.deformer().deformed() == parts_drawn(&doc, &saved));
     doc.check_reopens().expect("reopens posed");
+    // What is shown under the moved handle is its rest point (on its own part).
+    let shown = DVec2::from(rest) + DVec2::new(-60.0, -120.0);
+    let (found, _, _) = doc.unwarp(shown).expect("on the picture");
+    assert!(
+        found.distance(DVec2::from(rest)) < 1.0,
+        "{found} for {rest:?}"
+    );
+    // A handle on the front arm's shoulder binds the arm and the body (a joint);
+    // bound to the arm alone, it binds the arm alone.
+    let bound_to = |doc: &Document, h: usize| -> Vec<usize> {
+        let set = doc.parts().expect("parts").rig().set();
+        (0..set.bindings.len())
+            .filter(|&k| set.bindings[k].contains(&h))
+            .collect()
+    };
+    let count = doc.project().handles.len();
+    doc.apply(Edit::Add(point(262.0, 338.0))).expect("a joint");
+    let joint = bound_to(&doc, count);
+    assert!(joint.len() >= 2, "a joint binds both: {joint:?}");
+    doc.apply(Edit::Remove(count)).expect("removed");
+    doc.apply(Edit::AddBound(point(262.0, 338.0), joint[1]))
+        .expect("bound to one part");
+    assert_eq!(bound_to(&doc, count), [joint[1]]);
+    doc.check_reopens().expect("reopens with the binding");
+    doc.apply(Edit::Remove(count)).expect("removed");
+    assert!(
+        doc.project()
+            .parts
+            .as_ref()
+            .is_some_and(|p| p.bindings.is_empty())
+    );
     // Sending the tail (bottom) forward puts it on top: saved, reopened the same.
     let order = vec![1, 2, 3, 4, 5, 6, 0];
     doc.apply(Edit::Parts(Some(project::PartsSpec {

@@ -127,7 +127,10 @@ impl HandleTool {
             (_, Some(i)) => host.select(Some(i)),
             (Tool::Puppet, None) => {
                 let at = host.viewport().to_image(pos);
-                if on_picture(host, at) {
+                if on_picture(host, at) && alt {
+                    // Drawn as parts: on the part under the pointer alone.
+                    self.add_point_alone(host, at);
+                } else if on_picture(host, at) {
                     self.add_point(host, at);
                 } else {
                     // Off the picture a click deselects; say so, as a pin was
@@ -139,7 +142,11 @@ impl HandleTool {
             (Tool::Select, None) => host.select(None),
             (Tool::AddPoint, None) => {
                 let at = host.viewport().to_image(pos);
-                self.add_point(host, at);
+                if alt {
+                    self.add_point_alone(host, at);
+                } else {
+                    self.add_point(host, at);
+                }
             }
         }
     }

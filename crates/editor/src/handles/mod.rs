@@ -113,23 +113,25 @@ impl HandleTool {
     /// rest position is the point of the picture shown there, and it starts with the
     /// rotation and scale the pose has around it ([`Document::local_pose`]).
     pub(crate) fn add_point(&mut self, host: &mut dyn Host, at: DVec2) {
-        let Some(doc) = host.document_mut() else {
+        if let Some(handle) = point_under(host, at) {
+            self.add_and_select(host, Edit::Add(handle), "a point handle");
+        }
+    }
+
+    /// Adds a point handle under `at` as [`HandleTool::add_point`] does, bound to the
+    /// part shown there alone (the topmost) rather than to every part under it:
+    /// Alt-click with the layers drawn as parts (otherwise a plain point handle).
+    pub(crate) fn add_point_alone(&mut self, host: &mut dyn Host, at: DVec2) {
+        let Some(part) = host.document_mut().and_then(|doc| doc.part_at(at)) else {
+            return self.add_point(host, at);
+        };
+        let Some(handle) = point_under(host, at) else {
             return;
         };
-        let Some((rest, _, _)) = doc.unwarp(at) else {
-            host.error(&anyhow::anyhow!("click on the picture to add a handle"));
-            return;
-        };
-        let rest = unmoved(rest, at);
-        let (rotate, scale) = doc.local_pose(rest, at);
-        let handle = HandleSpec::Point {
-            rest: rest.to_array(),
-            translate: (at - rest).to_array(),
-            rotate,
-            scale,
-            depth: 0,
-        };
-        self.add_and_select(host, handle, "a point handle");
+        let name = (host.document().and_then(|d| d.layers.as_ref()))
+            .map_or_else(String::new, |l| l.layers[part].name.clone());
+        let what = format!("a point handle on {name} alone");
+        self.add_and_select(host, Edit::AddBound(handle, part), &what);
     }
 
     /// Adds a bar from `a` to `b` (image pixels, current pose) and selects it.
@@ -147,12 +149,12 @@ impl HandleTool {
             pose: Some([a.to_array(), b.to_array()]),
             depth: 0,
         };
-        self.add_and_select(host, handle, "a bar handle");
+        self.add_and_select(host, Edit::Add(handle), "a bar handle");
     }
 
     /// Adds `handle` (one undo step), selects it and says so, naming it `what`.
-    fn add_and_select(&mut self, host: &mut dyn Host, handle: HandleSpec, what: &str) {
-        if self.edit(host, Edit::Add(handle))
+    fn add_and_select(&mut self, host: &mut dyn Host, add: Edit, what: &str) {
+        if self.edit(host, add)
             && let Some(doc) = host.document()
         {
             let (count, ms) = (doc.project().handles.len(), doc.last_update_ms);
@@ -362,6 +364,26 @@ pub(crate) fn auto_rotate(handles: &mut [HandleSpec]) {
             *rotate = cross.atan2(dot);
         }
     }
+}
+
+/// The point handle a click at `at` (image pixels, current pose) places: at rest where
+/// the picture shown there lies, with the rotation and scale the pose has around it
+/// ([`Document::local_pose`]). `None` (and a message) off the picture.
+fn point_under(host: &mut dyn Host, at: DVec2) -> Option<HandleSpec> {
+    let doc = host.document_mut()?;
+    let Some((rest, _, _)) = doc.unwarp(at) else {
+        host.error(&anyhow::anyhow!("click on the picture to add a handle"));
+        return None;
+    };
+    let rest = unmoved(rest, at);
+    let (rotate, scale) = doc.local_pose(rest, at);
+    Some(HandleSpec::Point {
+        rest: rest.to_array(),
+        translate: (at - rest).to_array(),
+        rotate,
+        scale,
+        depth: 0,
+    })
 }
 
 #[cfg(test)]
