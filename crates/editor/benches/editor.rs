@@ -8,7 +8,10 @@
 //!   encoding, atomic write (`export`);
 //! - switching the built-in picture's posed rig from C² weights to ARAP (registration,
 //!   compilation, the pose, the positions for the GPU) and one ARAP drag frame's
-//!   update (`method_switch`).
+//!   update (`method_switch`);
+//! - layered pictures drawn as parts: a 2048 × 2048 picture of 50 layers opened and set
+//!   up as parts, and one drag frame of a character of 12 parts at a total density of
+//!   20,000, a whole egui frame of the real app (`parts`).
 
 use std::hint::black_box;
 use std::time::{Duration, Instant};
@@ -207,9 +210,154 @@ fn method_switch(c: &mut Criterion) {
     });
 }
 
+/// A layer of `w × h` at (`x`, `y`) on the canvas: an ellipse with a bar across it, in
+/// a colour of its own (as scattered cut-out parts are).
+fn blob(name: String, x: i32, y: i32, w: u32, h: u32, k: u32) -> pipeline::Layer {
+    let colour = [
+        (k * 53 % 255) as u8,
+        (k * 97 % 255) as u8,
+        (k * 151 % 255) as u8,
+    ];
+    let pixels = RgbaImage::from_fn(w, h, |px, py| {
+        let (u, v) = (
+            (px as f64 + 0.5) / f64::from(w) * 2.0 - 1.0,
+            (py as f64 + 0.5) / f64::from(h) * 2.0 - 1.0,
+        );
+        let inside = u * u + v * v <= 1.0 || (u.abs() < 0.2);
+        let [r, g, b] = colour;
+        Rgba([r, g, b, if inside { 255 } else { 0 }])
+    });
+    pipeline::Layer {
+        name,
+        x,
+        y,
+        opacity: 1.0,
+        visible: true,
+        pixels: render::Picture::Rgba8(pixels),
+    }
+}
+
+fn parts(c: &mut Criterion) {
+    // 50 layers scattered over a 2048 × 2048 canvas, overlapping, two pins.
+    let mut seed = 7u64;
+    let mut next = |n: u32| {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed % u64::from(n)) as u32
+    };
+    let layers: Vec<pipeline::Layer> = (0..50)
+        .map(|k| {
+            let (w, h) = (200 + next(500), 200 + next(700));
+            let (x, y) = (next(2048 - w), next(2048 - h));
+            blob(format!("part {k}"), x as i32, y as i32, w, h, k)
+        })
+        .collect();
+    let scattered = pipeline::Artwork {
+        width: 2048,
+        height: 2048,
+        layers,
+        notes: Vec::new(),
+    };
+    let first = &scattered.layers[0];
+    let (w, h) = first.dimensions();
+    let centre = [
+        f64::from(first.x) + f64::from(w) / 2.0,
+        f64::from(first.y) + f64::from(h) / 2.0,
+    ];
+    let project = Project {
+        handles: vec![
+            point(centre[0], centre[1]),
+            point(centre[0], centre[1] - 40.0),
+        ],
+        parts: Some(project::PartsSpec::default()),
+        ..Project::default()
+    };
+    let mut group = c.benchmark_group("editor/parts");
+    group.sample_size(10);
+    group.bench_function("open_50_layers_2048", |b| {
+        b.iter(|| {
+            let doc = Document::from_artwork(scattered.clone(), None, project.clone())
+                .expect("opens as parts");
+            black_box(doc.deformer().deformed().len())
+        });
+    });
+    group.finish();
+
+    // A character of 12 parts: a chain of limbs, each overlapping the next at a joint,
+    // a pin at every joint and at both ends; the last pin dragged.
+    let limbs: Vec<pipeline::Layer> = (0..12u32)
+        .map(|k| blob(format!("limb {k}"), 40 + 80 * k as i32, 300, 120, 60, k))
+        .collect();
+    let character = pipeline::Artwork {
+        width: 1100,
+        height: 700,
+        layers: limbs,
+        notes: Vec::new(),
+    };
+    let pins: Vec<HandleSpec> = (0..13)
+        .map(|k| point(50.0 + 80.0 * k as f64, 330.0))
+        .collect();
+    let project = Project {
+        handles: pins,
+        density: Some(20_000),
+        parts: Some(project::PartsSpec::default()),
+        ..Project::default()
+    };
+    let doc = Document::from_artwork(character, None, project).expect("12 parts");
+    let vertices = doc.parts().map_or(0, |p| pipeline::Deformer::rest(p).len());
+    let mut h = Harness::builder()
+        .with_size(Vec2::new(1280.0, 820.0))
+        .build_eframe(move |_cc| EditorApp::with_document(doc));
+    h.run();
+    let grab = h.state().viewport.to_screen(DVec2::new(1010.0, 330.0));
+    h.hover_at(grab);
+    h.run();
+    h.drag_at(grab);
+    h.run();
+    h.hover_at(grab + Vec2::new(10.0, 0.0));
+    h.run();
+    assert_eq!(h.state().selected, Some(12), "the drag holds the last pin");
+    let mut k = 0u32;
+    c.bench_function(
+        &format!(
+            "editor/parts/drag_frame/12_parts_{}k_vertices",
+            vertices / 1000
+        ),
+        |b| {
+            b.iter(|| {
+                k += 1;
+                // The chain's end swung up and down.
+                let wiggle = Vec2::new(4.0, 10.0 * ((k % 8) as f32 - 4.0));
+                h.hover_at(Pos2::new(grab.x, grab.y) + wiggle);
+                h.step();
+            });
+        },
+    );
+    let moved = h
+        .state()
+        .document()
+        .map(|d| d.project().handles[12].clone());
+    assert!(
+        matches!(moved, Some(HandleSpec::Point { translate, .. }) if translate != [0.0; 2]),
+        "the pin follows the pointer: {moved:?}"
+    );
+}
+
 criterion_group! {
     name = benches;
     config = quick();
-    targets = insert_handle, drag_frame, export, method_switch
+    targets = insert_handle, drag_frame, export, method_switch, parts
 }
 criterion_main!(benches);
+
+/// A point handle at rest at (`x`, `y`).
+fn point(x: f64, y: f64) -> HandleSpec {
+    HandleSpec::Point {
+        rest: [x, y],
+        translate: [0.0; 2],
+        rotate: 0.0,
+        scale: 1.0,
+        depth: 0,
+    }
+}

@@ -28,7 +28,7 @@ use glam::DVec2;
 use project::{LbcSettings, MetricChoice, Tau};
 
 use editor::{Answer, Dialogs, Edit, EditorApp, FileAction};
-use support::{Dropped, build};
+use support::{Dropped, build, settle};
 
 /// A small, seedable generator (xorshift64*), so a walk replays exactly.
 struct Rng(u64);
@@ -748,6 +748,14 @@ fn walk(seed: u64, actions: usize) {
         s.density = 3000;
         assert!(monkey.h.state_mut().edit(Edit::Settings(s)));
     }
+    // Some walks start on a layered picture drawn as parts.
+    if monkey.rng.chance(0.35) {
+        let layered = monkey.dir.join("layers.ora");
+        monkey.h.state_mut().open(&layered);
+        let parts = Some(project::PartsSpec::default());
+        assert!(monkey.h.state_mut().edit(Edit::Parts(parts)));
+        settle(&mut monkey.h);
+    }
     let clock = Instant::now();
     let mut slowest: Vec<(f64, String)> = Vec::new();
     // Actions taken in each state of the cage tool: drawing, at rest, posed.
@@ -756,8 +764,8 @@ fn walk(seed: u64, actions: usize) {
     let mut reopened = 0usize;
     // Actions taken with two keys or more, the most keys seen, actions with markers.
     let (mut keyed, mut most_keys, mut marked) = (0usize, 0usize, 0usize);
-    // Actions taken with cuts in the project.
-    let mut with_cuts = 0usize;
+    // Actions taken with cuts in the project, and with a layered picture drawn as parts.
+    let (mut with_cuts, mut with_parts) = (0usize, 0usize);
     // Pins placed under ARAP or C², each checked to have moved nothing.
     let mut held = 0usize;
     // Handles removed in a posed state under C², each checked to have moved nothing
@@ -802,13 +810,17 @@ fn walk(seed: u64, actions: usize) {
                     .is_some_and(|a| !a.spatial_keys.is_empty())
             }));
             with_cuts += usize::from(app.document().is_some_and(|d| !d.project().cuts.is_empty()));
+            with_parts += usize::from(app.document().is_some_and(|d| d.parts().is_some()));
             app.sanity_check()?;
             if let (Some((handles, mesh, shown, posed)), Some(doc)) =
                 (before, monkey.h.state_mut().document_mut())
             {
                 let now = doc.project().handles.clone();
                 let placed = now.len() == handles.len() + 1 && now[..handles.len()] == handles[..];
-                let holding = matches!(doc.method(), project::Method::Arap | project::Method::C2);
+                // (Drawn as parts, a new pin sets its parts up again, on meshes of
+                // their own: not yet held still.)
+                let holding = matches!(doc.method(), project::Method::Arap | project::Method::C2)
+                    && doc.parts().is_none();
                 if pinned && placed && doc.mesh_version() == mesh && holding {
                     held += 1;
                     let moved = shown
@@ -840,6 +852,7 @@ fn walk(seed: u64, actions: usize) {
                     && posed
                     && doc.mesh_version() == mesh
                     && doc.method() == project::Method::C2
+                    && doc.parts().is_none()
                     // (A fixed border is sampled at the closest pair's distance: a
                     // removal may re-sample it, as the paper has it.)
                     && !doc.project().fixed_boundary
@@ -936,7 +949,7 @@ fn walk(seed: u64, actions: usize) {
     println!(
         "  with two keys or more: {keyed} actions (at most {most_keys} keys); with pose \
          markers: {marked}; pins placed in a pose under ARAP or C², none moving the picture: {held}; handles removed in a pose under C², checked: \
-         {removed_checked}; with cuts: {with_cuts}"
+         {removed_checked}; with cuts: {with_cuts}; with parts: {with_parts}"
     );
     slowest.sort_by(|a, b| b.0.total_cmp(&a.0));
     for (s, what) in slowest.iter().take(3) {

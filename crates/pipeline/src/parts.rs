@@ -164,7 +164,7 @@ enum Part {
     /// A hidden layer: nothing.
     Hidden,
     /// Its own method, on its layer, with the handles that bind it.
-    Bound(Box<Warper>),
+    Bound(Box<Bound>),
     /// Its own mesh, each vertex where the part it follows takes it.
     Follows {
         mesh: PartMesh,
@@ -172,6 +172,41 @@ enum Part {
         leader: Option<usize>,
         ties: Vec<Tie>,
     },
+}
+
+/// A part set up by its own method, on its own rectangle of the canvas: the layer's
+/// pixels with the handles that bind it, a margin around them (so meshing and
+/// weighting cost the part's size, not the canvas's).
+#[derive(Clone)]
+struct Bound {
+    /// The method, in the rectangle's pixels.
+    warper: Warper,
+    /// The rectangle's top-left corner on the canvas.
+    origin: DVec2,
+}
+
+impl Bound {
+    /// The mesh's vertices at rest, on the canvas.
+    fn rest(&self) -> Vec<DVec2> {
+        self.warper
+            .deformer
+            .rest()
+            .iter()
+            .map(|&p| p + self.origin)
+            .collect()
+    }
+
+    /// Where the warp takes them, on the canvas.
+    fn deformed(&self) -> Vec<DVec2> {
+        let mut moved = self.warper.deformer.deformed();
+        moved.iter_mut().for_each(|p| *p += self.origin);
+        moved
+    }
+
+    /// Follows `project` (canvas pixels), this part's own.
+    fn follow(&mut self, project: &Project) -> Result<Follow> {
+        self.warper.follow(&shifted(project, -self.origin))
+    }
 }
 
 /// Where a follower's vertex lies on the mesh of the part it follows.
@@ -257,11 +292,19 @@ impl PartRig {
                 continue;
             }
             let part = part_project(project, bound);
-            let placed_layer = on(layer, canvas)?;
-            let warper =
-                prepare_warper(&placed_layer.to_rgba8(), &part, Some(share(area)), listener)
-                    .with_context(|| format!("part \"{}\"", layer.name))?;
-            parts.push(Part::Bound(Box::new(warper)));
+            let probes: Vec<DVec2> = bound
+                .iter()
+                .flat_map(|&h| probes(&project.handles[h]))
+                .collect();
+            let (placed_layer, origin) = own_rectangle(layer, canvas, &probes)?;
+            let warper = prepare_warper(
+                &placed_layer.to_rgba8(),
+                &shifted(&part, -origin),
+                Some(share(area)),
+                listener,
+            )
+            .with_context(|| format!("part \"{}\"", layer.name))?;
+            parts.push(Part::Bound(Box::new(Bound { warper, origin })));
         }
         // The parts no handle binds follow the bound part beneath them (in the draw
         // order) they overlap most.
@@ -281,17 +324,11 @@ impl PartRig {
                 });
             followed[k] = beneath.map(|(j, _)| j);
             let leader = beneath.and_then(|(j, _)| match &parts[j] {
-                Part::Bound(w) => Some(w.as_ref()),
+                Part::Bound(b) => Some(b.as_ref()),
                 _ => None,
             });
-            let (mesh, ties) = follow(
-                &on(layer, canvas)?,
-                leader,
-                project,
-                share(areas[k]),
-                listener,
-            )
-            .with_context(|| format!("part \"{}\"", layer.name))?;
+            let (mesh, ties) = follow(layer, canvas, leader, project, share(areas[k]), listener)
+                .with_context(|| format!("part \"{}\"", layer.name))?;
             parts[k] = Part::Follows {
                 mesh,
                 leader: followed[k],
@@ -320,22 +357,21 @@ impl PartRig {
     }
 
     /// Poses every part as `project` has it, or says that a part needs setting up
-    /// again for it (its handles' rests or its method's settings changed): then
-    /// nothing is posed.
+    /// again for it (its handles' rests or its method's settings changed): the parts
+    /// are then to be set up anew ([`PartRig::new`]), as some may be posed already
+    /// and some not.
     ///
     /// # Errors
     /// What a part's method refuses of the pose, naming the part's layer index.
     pub fn follow(&mut self, project: &Project) -> Result<Follow> {
-        let mut posed = self.parts.clone();
-        for (k, part) in posed.iter_mut().enumerate() {
-            if let Part::Bound(warper) = part {
+        for (k, part) in self.parts.iter_mut().enumerate() {
+            if let Part::Bound(bound) = part {
                 let own = part_project(project, &self.bindings[k]);
-                if warper.follow(&own).with_context(|| format!("part {k}"))? == Follow::NeedsSetup {
+                if bound.follow(&own).with_context(|| format!("part {k}"))? == Follow::NeedsSetup {
                     return Ok(Follow::NeedsSetup);
                 }
             }
         }
-        self.parts = posed;
         self.move_followers();
         Ok(Follow::Followed)
     }
@@ -346,7 +382,7 @@ impl PartRig {
             .parts
             .iter()
             .map(|p| match p {
-                Part::Bound(w) => Some((w.deformer.rest().to_vec(), w.deformer.deformed())),
+                Part::Bound(b) => Some((b.rest(), b.deformed())),
                 _ => None,
             })
             .collect();
@@ -382,16 +418,25 @@ impl PartRig {
         }
     }
 
+    /// Where the warp takes part `k`'s vertices (none for a hidden layer).
+    fn deformed_of(&self, k: usize) -> Vec<DVec2> {
+        match &self.parts[k] {
+            Part::Hidden => Vec::new(),
+            Part::Bound(b) => b.deformed(),
+            Part::Follows { mesh, .. } => mesh.deformed.clone(),
+        }
+    }
+
     /// For each layer, its part's mesh in the current pose; `None` for a hidden layer.
     pub fn meshes(&self) -> Vec<Option<PartMesh>> {
         self.parts
             .iter()
             .map(|p| match p {
                 Part::Hidden => None,
-                Part::Bound(w) => Some(PartMesh {
-                    rest: w.deformer.rest().to_vec(),
-                    deformed: w.deformer.deformed(),
-                    triangles: w.triangles.clone(),
+                Part::Bound(b) => Some(PartMesh {
+                    rest: b.rest(),
+                    deformed: b.deformed(),
+                    triangles: b.warper.triangles.clone(),
                 }),
                 Part::Follows { mesh, .. } => Some(mesh.clone()),
             })
@@ -616,6 +661,8 @@ pub struct PartsDeformer {
     /// What the parts were set up for: the method, the parts' spec and each handle's
     /// rest, so that [`Deformer::follow`] tells a pose from a new setup.
     setup: (Method, Option<project::PartsSpec>, Vec<HandleSpec>),
+    /// How long setting the parts up took, ms.
+    setup_ms: f64,
 }
 
 impl PartsDeformer {
@@ -630,10 +677,12 @@ impl PartsDeformer {
         density: Option<usize>,
         listener: &dyn Listener,
     ) -> Result<Self> {
+        let clock = std::time::Instant::now();
         let rig = PartRig::new(artwork, project, density, listener)?;
         let composer = Composer::new(artwork, &rig.set())?;
         let joined = composer.join(&rig.meshes())?;
         Ok(Self {
+            setup_ms: clock.elapsed().as_secs_f64() * 1e3,
             rig,
             composer: std::sync::Arc::new(composer),
             joined,
@@ -703,7 +752,29 @@ impl Deformer for PartsDeformer {
         if setup_of(project) != self.setup || self.rig.follow(project)? == Follow::NeedsSetup {
             return Ok(Follow::NeedsSetup);
         }
-        self.joined = self.composer.join(&self.rig.meshes())?;
+        // A pose moves the vertices; the joined triangles change only where a part's
+        // own drawing order did (a fold within it), and are kept otherwise, so that a
+        // caller keeping them (the editor's automatic depth) sees the same mesh.
+        let mut deformed = std::mem::take(&mut self.joined.deformed);
+        deformed.clear();
+        let mut triangles = Vec::with_capacity(self.joined.triangles.len());
+        for &k in &self.composer.shown {
+            let base = deformed.len() as u32;
+            deformed.extend(self.rig.deformed_of(k));
+            if let Part::Bound(b) = &self.rig.parts[k] {
+                triangles.extend(b.warper.triangles.iter().map(|t| t.map(|v| v + base)));
+            } else if let Part::Follows { mesh, .. } = &self.rig.parts[k] {
+                triangles.extend(mesh.triangles.iter().map(|t| t.map(|v| v + base)));
+            }
+        }
+        anyhow::ensure!(
+            deformed.len() == self.joined.rest.len(),
+            "the parts' meshes changed without a new setup"
+        );
+        self.joined.deformed = deformed;
+        if triangles != self.joined.triangles {
+            self.joined.triangles = triangles;
+        }
         Ok(Follow::Followed)
     }
 
@@ -721,16 +792,18 @@ impl Deformer for PartsDeformer {
             let name = &self.names[k];
             let entry = match &self.rig.parts[k] {
                 Part::Hidden => continue,
-                Part::Bound(warper) => {
+                Part::Bound(bound) => {
+                    let deformer = &bound.warper.deformer;
                     let own = WeightsListing {
-                        file_vertices: warper.deformer.rest().len(),
+                        file_vertices: deformer.rest().len(),
                         ..listing
                     };
                     serde_json::json!({
                         "layer": k,
                         "name": name,
                         "handles": self.rig.bindings[k],
-                        "weights": warper.deformer.weights(own).with_context(|| format!("part \"{name}\""))?,
+                        "origin": bound.origin.to_array(),
+                        "weights": deformer.weights(own).with_context(|| format!("part \"{name}\""))?,
                     })
                 }
                 Part::Follows { leader, .. } => serde_json::json!({
@@ -780,6 +853,7 @@ impl Deformer for PartsDeformer {
             samples: self.joined.rest.len(),
             triangles: self.joined.triangles.len(),
             real_handles: project.handles.len(),
+            setup_ms: self.setup_ms,
             pose_ms_median: median(times.clone()),
             pose_ms_p90: quantile(times.clone(), 0.9),
             poses: times.len(),
@@ -805,6 +879,9 @@ struct PartsReport {
     samples: usize,
     triangles: usize,
     real_handles: usize,
+    /// Setting every part up (meshing, the methods' setups, the followers tied, the
+    /// texture packed), ms.
+    setup_ms: f64,
     /// One pose of every part (and every follower moved), ms.
     pose_ms_median: f64,
     pose_ms_p90: f64,
@@ -964,11 +1041,12 @@ fn draw(picture: &Picture, mesh: &PartMesh) -> Result<Picture> {
     Ok(out)
 }
 
-/// `part` (on the canvas) meshed on its own, each vertex tied to where it lies on
-/// `leader`'s rest mesh (still, without a leader).
+/// `layer` meshed on its own (in its own rectangle of `canvas`), each vertex tied to
+/// where it lies on `leader`'s rest mesh (still, without a leader).
 fn follow(
-    part: &Picture,
-    leader: Option<&Warper>,
+    layer: &layers::Layer,
+    canvas: Frame,
+    leader: Option<&Bound>,
     project: &Project,
     density: usize,
     listener: &dyn Listener,
@@ -976,14 +1054,20 @@ fn follow(
     // Its own mesh: the method's setup with no handle is the identity on it.
     let mut still = part_project(project, &[]);
     still.method = project::Method::C2;
-    let own = prepare_warper(&part.to_rgba8(), &still, Some(density), listener)?;
-    let rest = own.deformer.rest().to_vec();
+    let (part, origin) = own_rectangle(layer, canvas, &[])?;
+    let own = prepare_warper(
+        &part.to_rgba8(),
+        &shifted(&still, -origin),
+        Some(density),
+        listener,
+    )?;
+    let rest: Vec<DVec2> = own.deformer.rest().iter().map(|&p| p + origin).collect();
     let ties = match leader {
         None => vec![Tie::Still; rest.len()],
         Some(leader) => {
             let lead = Domain::new(
-                leader.deformer.rest().to_vec(),
-                leader.deformer.triangles().to_vec(),
+                leader.rest(),
+                leader.warper.deformer.triangles().to_vec(),
                 Metric::Euclidean,
             )
             .map_err(|e| anyhow::anyhow!("the part beneath: {e}"))?;
@@ -1062,6 +1146,78 @@ fn part_project(project: &Project, bound: &[usize]) -> Project {
     // A part is one picture: the parts' order, visibility and bindings are the whole's.
     part.parts = None;
     part
+}
+
+/// `layer`'s own rectangle of `canvas` — its pixels, and `points` (the handles that
+/// bind it), with a margin of transparent pixels — and the rectangle's top-left
+/// corner on the canvas: the picture a part is meshed and weighted on.
+///
+/// # Errors
+/// Not enough memory for the picture.
+fn own_rectangle(
+    layer: &layers::Layer,
+    canvas: Frame,
+    points: &[DVec2],
+) -> Result<(Picture, DVec2)> {
+    /// Transparent pixels around the layer, so that it is meshed as the cut-out it is
+    /// on the canvas.
+    const MARGIN: i64 = 2;
+    let (w, h) = layer.dimensions();
+    let (mut x0, mut y0) = (i64::from(layer.x), i64::from(layer.y));
+    let (mut x1, mut y1) = (x0 + i64::from(w), y0 + i64::from(h));
+    for p in points.iter().filter(|p| p.is_finite()) {
+        x0 = x0.min(p.x.floor() as i64);
+        y0 = y0.min(p.y.floor() as i64);
+        x1 = x1.max(p.x.ceil() as i64 + 1);
+        y1 = y1.max(p.y.ceil() as i64 + 1);
+    }
+    let x0 = (x0 - MARGIN).max(0);
+    let y0 = (y0 - MARGIN).max(0);
+    let x1 = (x1 + MARGIN).min(i64::from(canvas.width)).max(x0 + 1);
+    let y1 = (y1 + MARGIN).min(i64::from(canvas.height)).max(y0 + 1);
+    let frame = Frame {
+        origin: [0, 0],
+        width: (x1 - x0) as u32,
+        height: (y1 - y0) as u32,
+    };
+    let picture = placed(
+        &layer.pixels,
+        frame,
+        [i64::from(layer.x) - x0, i64::from(layer.y) - y0],
+    )?;
+    Ok((picture, DVec2::new(x0 as f64, y0 as f64)))
+}
+
+/// `project` with everything placed on the picture moved by `by`: the handles, what
+/// they hold, the cuts and the painted rigidity (a part set up on its own rectangle).
+fn shifted(project: &Project, by: DVec2) -> Project {
+    let mv = |p: &mut [f64; 2]| *p = (DVec2::from(*p) + by).to_array();
+    let mut moved = project.clone();
+    for handle in &mut moved.handles {
+        match handle {
+            HandleSpec::Point { rest, .. } => mv(rest),
+            HandleSpec::Bar { rest, pose, .. } => {
+                rest.iter_mut().for_each(mv);
+                pose.iter_mut().flatten().for_each(mv);
+            }
+        }
+    }
+    for hold in &mut moved.holds {
+        (hold
+            .rest
+            .iter_mut()
+            .chain(&mut hold.at)
+            .chain(&mut hold.step_one))
+        .for_each(mv);
+    }
+    for cut in &mut moved.cuts {
+        cut.stroke.iter_mut().for_each(mv);
+    }
+    for stroke in &mut moved.rigidity {
+        stroke.stroke.iter_mut().for_each(mv);
+    }
+    moved.virtual_handles.iter_mut().for_each(mv);
+    moved
 }
 
 /// The rest points a layer must cover for a handle to bind it: a point's place; a
