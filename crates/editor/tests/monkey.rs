@@ -758,7 +758,11 @@ fn walk(seed: u64, actions: usize) {
         let parts = Some(project::PartsSpec::default());
         assert!(monkey.h.state_mut().edit(Edit::Parts(parts)));
         settle(&mut monkey.h);
-        let drawn = monkey.h.state().document().is_some_and(|d| d.parts().is_some());
+        let drawn = monkey
+            .h
+            .state()
+            .document()
+            .is_some_and(|d| d.parts().is_some());
         println!("monkey seed {seed}: starts on a layered picture drawn as parts: {drawn}");
     }
     let clock = Instant::now();

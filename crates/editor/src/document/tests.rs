@@ -814,3 +814,63 @@ fn a_layered_picture_drawn_as_parts_shows_what_render_draws_of_it() {
     assert!(doc.parts().is_none());
     doc.sanity_check().expect("consistent");
 }
+
+#[test]
+fn a_pin_placed_in_a_pose_on_parts_leaves_the_other_parts_where_they_were() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut doc = puppet(dir.path());
+    doc.apply(Edit::Parts(Some(project::PartsSpec::default())))
+        .expect("parts");
+    // Each vertex where it is shown, by its part and where it lies at rest.
+    type Shown = std::collections::HashMap<(u32, [u64; 2]), DVec2>;
+    let shown = |doc: &Document| -> Shown {
+        let parts = doc.parts().expect("parts");
+        let (rest, moved) = (parts.rest(), parts.deformed());
+        (0..rest.len() as u32)
+            .filter_map(|v| {
+                let part = parts.part_of_vertex(v)?;
+                let at = rest[v as usize];
+                Some(((part, [at.x.to_bits(), at.y.to_bits()]), moved[v as usize]))
+            })
+            .collect()
+    };
+    let before = shown(&doc);
+    // On the body, the head and the raised arm, in the rig's pose.
+    for at in [
+        DVec2::new(300.0, 420.0),
+        DVec2::new(250.0, 200.0),
+        DVec2::new(160.0, 330.0),
+    ] {
+        let (rest, angle, scale) = doc.unwarp(at).expect("on the picture");
+        let handle = HandleSpec::Point {
+            rest: rest.to_array(),
+            translate: (at - rest).to_array(),
+            rotate: angle,
+            scale,
+            depth: 0,
+        };
+        doc.apply(Edit::Add(handle)).expect("added");
+        // The parts the pin binds, and those that follow them, are set up again; the
+        // others are drawn exactly where they were.
+        let set = doc.parts().expect("parts").rig().set();
+        let pin = doc.project().handles.len() - 1;
+        let touched = |k: usize| {
+            set.bindings[k].contains(&pin)
+                || set.followed[k].is_some_and(|j| set.bindings[j].contains(&pin))
+        };
+        let after = shown(&doc);
+        let others = (after.iter()).filter(|((part, _), _)| !touched(*part as usize));
+        let mut checked = 0;
+        for (key, p) in others {
+            checked += 1;
+            assert_eq!(
+                before.get(key),
+                Some(p),
+                "a pin at {at}: part {} moved",
+                key.0
+            );
+        }
+        assert!(checked > before.len() / 2, "most of the picture is checked");
+        doc.apply(Edit::Remove(pin)).expect("removed");
+    }
+}
