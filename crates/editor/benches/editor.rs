@@ -304,8 +304,26 @@ fn parts(c: &mut Criterion) {
         parts: Some(project::PartsSpec::default()),
         ..Project::default()
     };
-    let doc = Document::from_artwork(character, None, project).expect("12 parts");
+    let mut doc = Document::from_artwork(character, None, project).expect("12 parts");
     let vertices = doc.parts().map_or(0, |p| pipeline::Deformer::rest(p).len());
+    // A pin inserted on one limb (the parts it binds set up again, the others kept),
+    // then removed again.
+    let mut n = 0u32;
+    c.bench_function(
+        &format!(
+            "editor/parts/insert_and_remove_pin/12_parts_{}k_vertices",
+            vertices / 1000
+        ),
+        |b| {
+            b.iter(|| {
+                n += 1;
+                let at = 250.0 + f64::from(n % 7) * 80.0;
+                doc.apply(Edit::Add(point(at, 320.0))).expect("inserted");
+                let last = doc.project().handles.len() - 1;
+                doc.apply(Edit::Remove(last)).expect("removed");
+            });
+        },
+    );
     let mut h = Harness::builder()
         .with_size(Vec2::new(1280.0, 820.0))
         .build_eframe(move |_cc| EditorApp::with_document(doc));

@@ -283,14 +283,22 @@ impl Document {
         if let Some(layers) = self.layers.clone().filter(|_| self.project.parts.is_some()) {
             // Drawn as parts: each part set up by the method with its own handles,
             // the parts joined into the mesh shown.
+            let mut previous = None;
             if let Some((mesh, deformer)) = &mut self.method
                 && *mesh == self.mesh_version
                 && deformer.as_any().is::<PartsDeformer>()
-                && deformer.follow(&self.project)? == Follow::Followed
             {
-                return Ok(());
+                if deformer.follow(&self.project)? == Follow::Followed {
+                    return Ok(());
+                }
+                previous = deformer.as_any().downcast_ref::<PartsDeformer>();
             }
-            let parts = PartsDeformer::new(&layers, &self.project, None, &())?;
+            // The parts whose own setup is the same are kept (a pin added sets up the
+            // parts it binds).
+            let parts = match previous {
+                Some(previous) => previous.update(&layers, &self.project, None, &())?,
+                None => PartsDeformer::new(&layers, &self.project, None, &())?,
+            };
             self.method = Some((self.mesh_version, Box::new(parts)));
             return Ok(());
         }
@@ -708,6 +716,11 @@ impl Document {
                     .validate(Some(self.image.dimensions()))
                     .context("the animation")?;
             }
+        }
+        // Drawn as parts, every handle must bind a part shown: checked before anything
+        // changes.
+        if let Some(layers) = self.layers.as_ref().filter(|_| project.parts.is_some()) {
+            pipeline::parts::bindings(layers, &project)?;
         }
         self.restore(project)
     }

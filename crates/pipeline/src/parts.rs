@@ -171,6 +171,8 @@ enum Part {
         /// The part followed, and each vertex's place on it.
         leader: Option<usize>,
         ties: Vec<Tie>,
+        /// The vertices it was meshed with.
+        density: usize,
     },
 }
 
@@ -183,6 +185,8 @@ struct Bound {
     warper: Warper,
     /// The rectangle's top-left corner on the canvas.
     origin: DVec2,
+    /// The vertices it was meshed with (its share of the density).
+    density: usize,
 }
 
 impl Bound {
@@ -234,6 +238,36 @@ impl PartRig {
         density: Option<usize>,
         listener: &dyn Listener,
     ) -> Result<Self> {
+        Self::set_up(artwork, project, density, listener, None)
+    }
+
+    /// These parts set up for `project` (another set of handles, another order or
+    /// visibility), as [`PartRig::new`] sets them up, keeping each part whose own
+    /// setup is the same (the same handles at rest, the same share of the density)
+    /// and each follower whose part followed is kept: adding a pin sets up the parts
+    /// it binds, not all of them.
+    ///
+    /// # Errors
+    /// As [`PartRig::new`].
+    pub fn update(
+        &self,
+        artwork: &layers::Artwork,
+        project: &Project,
+        density: Option<usize>,
+        listener: &dyn Listener,
+    ) -> Result<Self> {
+        Self::set_up(artwork, project, density, listener, Some(self))
+    }
+
+    /// [`PartRig::new`], keeping what can be kept of `previous` (see
+    /// [`PartRig::update`]).
+    fn set_up(
+        artwork: &layers::Artwork,
+        project: &Project,
+        density: Option<usize>,
+        listener: &dyn Listener,
+        previous: Option<&Self>,
+    ) -> Result<Self> {
         if project.method.controls() == Controls::Cage {
             bail!("a cage (LBC) deforms the picture as a whole: use it without parts");
         }
@@ -244,29 +278,7 @@ impl PartRig {
         let shown: Vec<bool> = (artwork.layers.iter().enumerate())
             .map(|(k, layer)| spec.shows(k, layer.visible))
             .collect();
-        let bindings: Vec<Vec<usize>> = (artwork.layers.iter().enumerate())
-            .map(|(k, layer)| {
-                if !shown[k] {
-                    return Vec::new();
-                }
-                (0..project.handles.len())
-                    .filter(|&h| match spec.binding(h) {
-                        Some(parts) => parts.contains(&k),
-                        None => probes(&project.handles[h])
-                            .iter()
-                            .all(|p| covers(layer, *p)),
-                    })
-                    .collect()
-            })
-            .collect();
-        if let Some(h) =
-            (0..project.handles.len()).find(|h| !bindings.iter().any(|b| b.contains(h)))
-        {
-            bail!(
-                "handle {} lies on no visible layer: place it on a part",
-                h + 1
-            );
-        }
+        let bindings = bindings(artwork, project)?;
         let areas: Vec<u64> = (artwork.layers.iter().enumerate())
             .map(|(k, l)| {
                 if shown[k] {
@@ -284,6 +296,8 @@ impl PartRig {
         };
         // The bound parts set up, each layer put on the canvas only while it is meshed.
         let mut parts: Vec<Part> = Vec::with_capacity(artwork.layers.len());
+        // Which bound parts are kept from `previous`.
+        let mut kept = vec![false; artwork.layers.len()];
         for (k, ((layer, bound), &area)) in
             (artwork.layers.iter().zip(&bindings).zip(&areas)).enumerate()
         {
@@ -292,6 +306,20 @@ impl PartRig {
                 continue;
             }
             let part = part_project(project, bound);
+            let density = share(area);
+            // The same part with the same setup: posed, not set up again.
+            let same = previous.and_then(|old| match old.parts.get(k)? {
+                Part::Bound(b) if b.density == density => {
+                    let mut b = b.clone();
+                    (b.follow(&part).ok()? == Follow::Followed).then_some(b)
+                }
+                _ => None,
+            });
+            if let Some(b) = same {
+                kept[k] = true;
+                parts.push(Part::Bound(b));
+                continue;
+            }
             let probes: Vec<DVec2> = bound
                 .iter()
                 .flat_map(|&h| probes(&project.handles[h]))
@@ -300,11 +328,15 @@ impl PartRig {
             let warper = prepare_warper(
                 &placed_layer.to_rgba8(),
                 &shifted(&part, -origin),
-                Some(share(area)),
+                Some(density),
                 listener,
             )
             .with_context(|| format!("part \"{}\"", layer.name))?;
-            parts.push(Part::Bound(Box::new(Bound { warper, origin })));
+            parts.push(Part::Bound(Box::new(Bound {
+                warper,
+                origin,
+                density,
+            })));
         }
         // The parts no handle binds follow the bound part beneath them (in the draw
         // order) they overlap most.
@@ -323,16 +355,35 @@ impl PartRig {
                     _ => Some((j, n)),
                 });
             followed[k] = beneath.map(|(j, _)| j);
-            let leader = beneath.and_then(|(j, _)| match &parts[j] {
-                Part::Bound(b) => Some(b.as_ref()),
+            let density = share(areas[k]);
+            // The same follower of a part kept: tied as it was.
+            let same = previous.and_then(|old| match old.parts.get(k)? {
+                Part::Follows {
+                    mesh,
+                    leader,
+                    ties,
+                    density: d,
+                } if *leader == followed[k] && *d == density && leader.is_none_or(|j| kept[j]) => {
+                    Some((mesh.clone(), ties.clone()))
+                }
                 _ => None,
             });
-            let (mesh, ties) = follow(layer, canvas, leader, project, share(areas[k]), listener)
-                .with_context(|| format!("part \"{}\"", layer.name))?;
+            let (mesh, ties) = match same {
+                Some(tied) => tied,
+                None => {
+                    let leader = beneath.and_then(|(j, _)| match &parts[j] {
+                        Part::Bound(b) => Some(b.as_ref()),
+                        _ => None,
+                    });
+                    follow(layer, canvas, leader, project, density, listener)
+                        .with_context(|| format!("part \"{}\"", layer.name))?
+                }
+            };
             parts[k] = Part::Follows {
                 mesh,
                 leader: followed[k],
                 ties,
+                density,
             };
         }
         let mut rig = Self {
@@ -387,7 +438,10 @@ impl PartRig {
             })
             .collect();
         for part in &mut self.parts {
-            let Part::Follows { mesh, leader, ties } = part else {
+            let Part::Follows {
+                mesh, leader, ties, ..
+            } = part
+            else {
                 continue;
             };
             let lead = leader.and_then(|j| leaders[j].as_ref());
@@ -677,8 +731,43 @@ impl PartsDeformer {
         density: Option<usize>,
         listener: &dyn Listener,
     ) -> Result<Self> {
+        Self::with_rig(
+            artwork,
+            project,
+            |listener| PartRig::new(artwork, project, density, listener),
+            listener,
+        )
+    }
+
+    /// These parts set up for `project` as [`PartsDeformer::new`] does, keeping the
+    /// parts whose own setup is the same ([`PartRig::update`]).
+    ///
+    /// # Errors
+    /// As [`PartsDeformer::new`].
+    pub fn update(
+        &self,
+        artwork: &layers::Artwork,
+        project: &Project,
+        density: Option<usize>,
+        listener: &dyn Listener,
+    ) -> Result<Self> {
+        Self::with_rig(
+            artwork,
+            project,
+            |listener| self.rig.update(artwork, project, density, listener),
+            listener,
+        )
+    }
+
+    /// The parts `set_up` sets up, joined.
+    fn with_rig(
+        artwork: &layers::Artwork,
+        project: &Project,
+        set_up: impl FnOnce(&dyn Listener) -> Result<PartRig>,
+        listener: &dyn Listener,
+    ) -> Result<Self> {
         let clock = std::time::Instant::now();
-        let rig = PartRig::new(artwork, project, density, listener)?;
+        let rig = set_up(listener)?;
         let composer = Composer::new(artwork, &rig.set())?;
         let joined = composer.join(&rig.meshes())?;
         Ok(Self {
@@ -1115,6 +1204,40 @@ fn overlap(a: &layers::Layer, b: &layers::Layer) -> u64 {
         }
     }
     n
+}
+
+/// For each layer of `artwork`, the handles of `project` that bind it (none for a
+/// layer hidden there): those its `"parts"` binds to it, and the others with a visible
+/// pixel of it under them (under a bar's ends and middle).
+///
+/// # Errors
+/// A handle that binds no layer shown, or parts that name other layers than
+/// `artwork` has.
+pub fn bindings(artwork: &layers::Artwork, project: &Project) -> Result<Vec<Vec<usize>>> {
+    let spec = project.parts.clone().unwrap_or_default();
+    spec.check_layers(artwork.layers.len())?;
+    let bindings: Vec<Vec<usize>> = (artwork.layers.iter().enumerate())
+        .map(|(k, layer)| {
+            if !spec.shows(k, layer.visible) {
+                return Vec::new();
+            }
+            (0..project.handles.len())
+                .filter(|&h| match spec.binding(h) {
+                    Some(parts) => parts.contains(&k),
+                    None => probes(&project.handles[h])
+                        .iter()
+                        .all(|p| covers(layer, *p)),
+                })
+                .collect()
+        })
+        .collect();
+    if let Some(h) = (0..project.handles.len()).find(|h| !bindings.iter().any(|b| b.contains(h))) {
+        bail!(
+            "handle {} lies on no visible layer: place it on a part",
+            h + 1
+        );
+    }
+    Ok(bindings)
 }
 
 /// `project` with the handles `bound` alone (their holds and overlay kept, renumbered),

@@ -809,6 +809,27 @@ fn a_layered_picture_drawn_as_parts_shows_what_render_draws_of_it() {
         .expect_err("two layers of seven");
     assert!(error.to_string().contains("parts.order"), "{error}");
     assert_eq!(doc.project().parts, saved.parts);
+    // Hiding the head, which pins hold, is refused, naming the pin; nothing changes.
+    let before = doc.project().clone();
+    let head = doc
+        .layers
+        .as_ref()
+        .expect("layers")
+        .layers
+        .iter()
+        .position(|l| l.name == "head");
+    let error = doc
+        .apply(Edit::Parts(Some(project::PartsSpec {
+            hidden: vec![head.expect("a head")],
+            ..saved.parts.clone().unwrap_or_default()
+        })))
+        .expect_err("a pin on the head alone");
+    assert!(
+        error.to_string().contains("lies on no visible layer"),
+        "{error}"
+    );
+    assert_eq!(doc.project(), &before);
+    doc.sanity_check().expect("consistent");
     // Back to one picture.
     doc.apply(Edit::Parts(None)).expect("one picture");
     assert!(doc.parts().is_none());
