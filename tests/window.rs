@@ -56,7 +56,16 @@ fn orange(image: &image::RgbaImage) -> usize {
 #[test]
 fn the_window_draws_the_picture_and_answers_keys() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let number = 100 + std::process::id() % 400;
+    // A display number no server holds, nor left its lock or socket behind (a
+    // server killed outright leaves both, and a new one on that number would not start).
+    let free = |n: u32| {
+        !Path::new(&format!("/tmp/.X{n}-lock")).exists()
+            && !Path::new(&format!("/tmp/.X11-unix/X{n}")).exists()
+    };
+    let number = (0..400)
+        .map(|k| 100 + (std::process::id() + k) % 400)
+        .find(|&n| free(n))
+        .expect("a free display number");
     let display = format!(":{number}");
     let xvfb = Command::new("Xvfb")
         .args([
@@ -79,6 +88,8 @@ fn the_window_draws_the_picture_and_answers_keys() {
             start.elapsed() < Duration::from_secs(20),
             "Xvfb did not start"
         );
+        let exited = running.0[0].try_wait().expect("Xvfb's status");
+        assert!(exited.is_none(), "Xvfb exited at once: {exited:?}");
         sleep(Duration::from_millis(100));
     }
     let app = Command::new(env!("CARGO_BIN_EXE_c2warp"))

@@ -150,6 +150,9 @@ pub fn set_up_parts(
 pub struct PartRig {
     /// The layers' draw order (indices, bottom first).
     order: Vec<usize>,
+    /// With a cage (LBC): the cage solved on the canvas, which moves every part's
+    /// vertices inside it (each tied to the cage's inside mesh).
+    cage: Option<Box<crate::cage::CageDeformer>>,
     /// For each layer, what moves it.
     parts: Vec<Part>,
     /// For each layer, the handles (indices into the project's) that bind it.
@@ -269,7 +272,7 @@ impl PartRig {
         previous: Option<&Self>,
     ) -> Result<Self> {
         if project.method.controls() == Controls::Cage {
-            bail!("a cage (LBC) deforms the picture as a whole: use it without parts");
+            return Self::caged(artwork, project, density, listener, previous);
         }
         let canvas = canvas_of(artwork);
         let spec = project.parts.clone().unwrap_or_default();
@@ -388,6 +391,7 @@ impl PartRig {
         }
         let mut rig = Self {
             order,
+            cage: None,
             parts,
             bindings,
             followed,
@@ -415,6 +419,13 @@ impl PartRig {
     /// # Errors
     /// What a part's method refuses of the pose, naming the part's layer index.
     pub fn follow(&mut self, project: &Project) -> Result<Follow> {
+        if let Some(cage) = &mut self.cage {
+            if cage.follow(project)? == Follow::NeedsSetup {
+                return Ok(Follow::NeedsSetup);
+            }
+            self.move_followers();
+            return Ok(Follow::Followed);
+        }
         for (k, part) in self.parts.iter_mut().enumerate() {
             if let Part::Bound(bound) = part {
                 let own = part_project(project, &self.bindings[k]);
@@ -444,7 +455,16 @@ impl PartRig {
             else {
                 continue;
             };
-            let lead = leader.and_then(|j| leaders[j].as_ref());
+            let caged = (self.cage.as_ref()).map(|c| {
+                (
+                    c.solution().domain.positions().to_vec(),
+                    c.positions().to_vec(),
+                )
+            });
+            let lead = match &caged {
+                Some(cage) => Some(cage),
+                None => leader.and_then(|j| leaders[j].as_ref()),
+            };
             mesh.deformed = mesh
                 .rest
                 .iter()
@@ -1140,9 +1160,28 @@ fn follow(
     density: usize,
     listener: &dyn Listener,
 ) -> Result<(PartMesh, Vec<Tie>)> {
+    let lead = leader.map(|b| (b.rest(), b.warper.deformer.triangles().to_vec()));
+    let lead = lead.as_ref().map(|(rest, triangles)| (rest, triangles));
+    tie(layer, canvas, lead, false, project, density, listener)
+}
+
+/// `layer` meshed on its own (in its own rectangle of `canvas`), each vertex tied to
+/// where it lies on the mesh `leader` (rest positions and triangles; outside it, to
+/// its nearest vertex, or left still where `outside_still`); still without a leader.
+fn tie(
+    layer: &layers::Layer,
+    canvas: Frame,
+    leader: Option<(&Vec<DVec2>, &Vec<[u32; 3]>)>,
+    outside_still: bool,
+    project: &Project,
+    density: usize,
+    listener: &dyn Listener,
+) -> Result<(PartMesh, Vec<Tie>)> {
     // Its own mesh: the method's setup with no handle is the identity on it.
     let mut still = part_project(project, &[]);
     still.method = project::Method::C2;
+    // (Meshed alone: a cage is the whole picture's.)
+    still.cage = None;
     let (part, origin) = own_rectangle(layer, canvas, &[])?;
     let own = prepare_warper(
         &part.to_rgba8(),
@@ -1153,16 +1192,13 @@ fn follow(
     let rest: Vec<DVec2> = own.deformer.rest().iter().map(|&p| p + origin).collect();
     let ties = match leader {
         None => vec![Tie::Still; rest.len()],
-        Some(leader) => {
-            let lead = Domain::new(
-                leader.rest(),
-                leader.warper.deformer.triangles().to_vec(),
-                Metric::Euclidean,
-            )
-            .map_err(|e| anyhow::anyhow!("the part beneath: {e}"))?;
+        Some((rest_of_leader, triangles)) => {
+            let lead = Domain::new(rest_of_leader.clone(), triangles.clone(), Metric::Euclidean)
+                .map_err(|e| anyhow::anyhow!("the part beneath: {e}"))?;
             rest.iter()
                 .map(|&p| match lead.locate(p) {
                     Some((t, b)) => Tie::In(lead.triangles()[t], [b[0], b[1], b[2]]),
+                    None if outside_still => Tie::Still,
                     None => lead.nearest_vertex(p).map_or(Tie::Still, Tie::Near),
                 })
                 .collect()
@@ -1238,6 +1274,105 @@ pub fn bindings(artwork: &layers::Artwork, project: &Project) -> Result<Vec<Vec<
         );
     }
     Ok(bindings)
+}
+
+impl PartRig {
+    /// Every shown layer of `artwork` meshed on its own, each vertex tied to where it
+    /// lies on the inside of `project`'s cage (solved once, on the canvas): the cage
+    /// (LBC) deforms every part inside it; what lies outside the rest cage stays, as
+    /// it does for one picture. A part that `previous` tied the same way is kept.
+    fn caged(
+        artwork: &layers::Artwork,
+        project: &Project,
+        density: Option<usize>,
+        listener: &dyn Listener,
+        previous: Option<&Self>,
+    ) -> Result<Self> {
+        let canvas = canvas_of(artwork);
+        let spec = project.parts.clone().unwrap_or_default();
+        spec.check_layers(artwork.layers.len())?;
+        let order = spec.order_of(artwork.layers.len());
+        // The cage: kept when it is the same, else solved on the canvas.
+        let kept_cage = (previous.and_then(|old| old.cage.as_ref()))
+            .map(|cage| cage.as_ref().clone())
+            .and_then(|mut cage| (cage.follow(project).ok()? == Follow::Followed).then_some(cage));
+        let same_cage = kept_cage.is_some();
+        let cage = match kept_cage {
+            Some(cage) => cage,
+            None => {
+                let blank = image::RgbaImage::new(artwork.width, artwork.height);
+                let source = crate::Source::Picture {
+                    image: &blank,
+                    density,
+                };
+                crate::cage::CageDeformer::set_up(source, project, listener)?
+            }
+        };
+        let areas: Vec<u64> = (artwork.layers.iter().enumerate())
+            .map(|(k, l)| {
+                if spec.shows(k, l.visible) {
+                    visible_pixels(&l.pixels)
+                } else {
+                    0
+                }
+            })
+            .collect();
+        let total_area = areas.iter().sum::<u64>().max(1);
+        let total = density.or(project.density).unwrap_or(DEFAULT_DENSITY);
+        let inside = (
+            cage.solution().domain.positions().to_vec(),
+            cage.solution().domain.triangles().to_vec(),
+        );
+        let mut parts = Vec::with_capacity(artwork.layers.len());
+        for (k, layer) in artwork.layers.iter().enumerate() {
+            if !spec.shows(k, layer.visible) {
+                parts.push(Part::Hidden);
+                continue;
+            }
+            let density = ((total as u128 * u128::from(areas[k]) / u128::from(total_area))
+                as usize)
+                .max(MIN_PART_DENSITY);
+            let same = previous
+                .filter(|_| same_cage)
+                .and_then(|old| match old.parts.get(k)? {
+                    Part::Follows {
+                        mesh,
+                        ties,
+                        density: d,
+                        ..
+                    } if *d == density => Some((mesh.clone(), ties.clone())),
+                    _ => None,
+                });
+            let (mesh, ties) = match same {
+                Some(tied) => tied,
+                None => tie(
+                    layer,
+                    canvas,
+                    Some((&inside.0, &inside.1)),
+                    true,
+                    project,
+                    density,
+                    listener,
+                )
+                .with_context(|| format!("part \"{}\"", layer.name))?,
+            };
+            parts.push(Part::Follows {
+                mesh,
+                leader: None,
+                ties,
+                density,
+            });
+        }
+        let mut rig = Self {
+            order,
+            cage: Some(Box::new(cage)),
+            bindings: vec![Vec::new(); parts.len()],
+            followed: vec![None; parts.len()],
+            parts,
+        };
+        rig.move_followers();
+        Ok(rig)
+    }
 }
 
 /// `project` with the handles `bound` alone (their holds and overlay kept, renumbered),

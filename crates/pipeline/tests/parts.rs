@@ -138,15 +138,33 @@ fn a_handle_on_no_part_or_a_cage_is_refused() {
         error.contains("handle 1 lies on no visible layer"),
         "{error}"
     );
+}
+
+#[test]
+fn a_cage_moves_every_part_inside_it() {
+    // A cage around the right part (and the left part's overlapping end), moved down
+    // by 6 px: LBC reproduces a translation exactly.
     let cage = Project::from_json(
-        r#"{"version": 1, "method": "lbc", "handles": [], "cage": {"rest": [[0, 0], [199, 0], [199, 119], [0, 119]]}}"#,
+        r#"{"version": 1, "method": "lbc", "density": 1200, "handles": [],
+            "cage": {"rest": [[75, 10], [199, 10], [199, 110], [75, 110]],
+                     "pose": [[75, 16], [199, 16], [199, 116], [75, 116]]}}"#,
     )
     .expect("a cage rig");
-    let error = warp_parts(&two_parts(), &cage, None, &())
-        .err()
-        .expect("refused")
-        .to_string();
-    assert!(error.contains("cage"), "{error}");
+    let parts = warp_parts(&two_parts(), &cage, None, &()).expect("caged parts");
+    let right = rgba8(&parts.warped.layers[1]);
+    for (x, y, p) in right.enumerate_pixels() {
+        let inside = (80..190).contains(&x) && (26..106).contains(&y);
+        let expected = if inside { [40, 40, 200, 255] } else { [0; 4] };
+        assert_eq!(
+            p.0, expected,
+            "the right part moved down 6 px, at ({x}, {y})"
+        );
+    }
+    // The left part outside the cage stays where it was.
+    let left = rgba8(&parts.warped.layers[0]);
+    assert_eq!(left.get_pixel(30, 20).0, [200, 40, 40, 255]);
+    assert_eq!(left.get_pixel(30, 19).0, [0; 4]);
+    assert_eq!(left.get_pixel(30, 99).0, [200, 40, 40, 255]);
 }
 
 #[test]

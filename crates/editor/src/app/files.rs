@@ -195,8 +195,8 @@ impl EditorApp {
         };
         let cage = ExportSetup::of(doc, &project);
         // Drawn as parts: the export is `c2warp render` of the saved project, parts
-        // and all.
-        let parts = doc.layers.clone().filter(|_| doc.parts().is_some());
+        // and all (under a cage too, which the view still draws as one picture).
+        let parts = doc.layers.clone().filter(|_| doc.project().parts.is_some());
         Some(move || {
             let clock = Instant::now();
             let result = (|| -> Result<()> {
