@@ -431,3 +431,41 @@ fn a_folder_of_frames_never_loses_a_file_it_did_not_write() {
     animate(&rig, &frames, &["--to", "0.5"]);
     assert_eq!(sequence(&frames).len(), 3);
 }
+
+#[test]
+fn the_sample_characters_wave_animates_its_parts() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let assets = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../assets");
+    let rig = assets.join("puppet-wave.json");
+    let project = project::Project::from_json(&fs::read_to_string(&rig).expect("the rig"))
+        .expect("a rig file");
+    assert!(project.parts.is_some(), "drawn as parts");
+    // Two frames a second over the wave's middle: the arm is up, then down again.
+    let frames = dir.path().join("frames/");
+    animate(
+        &rig,
+        &frames,
+        &["--fps", "2", "--from", "1.5", "--to", "3.5"],
+    );
+    let shots: Vec<image::RgbaImage> = sequence(&frames)
+        .iter()
+        .map(|p| image::open(p).expect("a frame").to_rgba8())
+        .collect();
+    assert_eq!(shots.len(), 5);
+    let differ = |a: &image::RgbaImage, b: &image::RgbaImage| {
+        a.pixels().zip(b.pixels()).filter(|(p, q)| p != q).count()
+    };
+    assert!(differ(&shots[0], &shots[2]) > 1000, "the character moves");
+    // Each frame is `render` of the rig posed at its time.
+    let at = dir.path().join("at-2.5.json");
+    let mut posed = animation::posed_at(&project, 2.5);
+    posed.image = Some(assets.join("puppet.ora"));
+    fs::write(&at, posed.to_json()).expect("the posed rig");
+    let png = dir.path().join("at-2.5.png");
+    ok(&[os("render"), at.as_os_str(), os("-o"), png.as_os_str()]);
+    assert_eq!(
+        differ(&image::open(&png).expect("render").to_rgba8(), &shots[2]),
+        0,
+        "the frame at 2.5 s is render of the pose at 2.5 s"
+    );
+}
