@@ -613,7 +613,7 @@ impl Document {
             }
             Edit::ResetPose => {
                 for h in &mut project.handles {
-                    *h = at_rest(h);
+                    *h = h.at_rest();
                 }
                 // At rest, nothing is held away from it; without keys, every handle
                 // joins the paper's weights again.
@@ -1170,24 +1170,6 @@ pub fn same_rest(a: &HandleSpec, b: &HandleSpec) -> bool {
         (HandleSpec::Point { rest: r, .. }, HandleSpec::Point { rest: s, .. }) => r == s,
         (HandleSpec::Bar { rest: r, .. }, HandleSpec::Bar { rest: s, .. }) => r == s,
         _ => false,
-    }
-}
-
-/// The handle with its pose reset.
-pub fn at_rest(h: &HandleSpec) -> HandleSpec {
-    match *h {
-        HandleSpec::Point { rest, depth, .. } => HandleSpec::Point {
-            rest,
-            translate: [0.0; 2],
-            rotate: 0.0,
-            scale: 1.0,
-            depth,
-        },
-        HandleSpec::Bar { rest, depth, .. } => HandleSpec::Bar {
-            rest,
-            pose: None,
-            depth,
-        },
     }
 }
 

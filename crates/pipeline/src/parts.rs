@@ -827,20 +827,7 @@ impl PartsDeformer {
 /// What a part setup depends on beyond the pose: the method, the parts' spec, the
 /// handles at rest.
 fn setup_of(project: &Project) -> (Method, Option<project::PartsSpec>, Vec<HandleSpec>) {
-    let at_rest = project.handles.iter().map(|h| match *h {
-        HandleSpec::Point { rest, depth, .. } => HandleSpec::Point {
-            rest,
-            translate: [0.0; 2],
-            rotate: 0.0,
-            scale: 1.0,
-            depth,
-        },
-        HandleSpec::Bar { rest, depth, .. } => HandleSpec::Bar {
-            rest,
-            pose: None,
-            depth,
-        },
-    });
+    let at_rest = project.handles.iter().map(HandleSpec::at_rest);
     (project.method, project.parts.clone(), at_rest.collect())
 }
 

@@ -481,6 +481,24 @@ impl HandleSpec {
         }
     }
 
+    /// The same handle with its pose reset (at rest, its depth kept).
+    pub fn at_rest(&self) -> Self {
+        match *self {
+            Self::Point { rest, depth, .. } => Self::Point {
+                rest,
+                translate: [0.0; 2],
+                rotate: 0.0,
+                scale: 1.0,
+                depth,
+            },
+            Self::Bar { rest, depth, .. } => Self::Bar {
+                rest,
+                pose: None,
+                depth,
+            },
+        }
+    }
+
     /// The same handle with depth `depth`.
     pub fn with_depth(&self, depth: i32) -> Self {
         let mut h = self.clone();

@@ -255,7 +255,7 @@ impl HandleTool {
                 ui.close();
             }
             if ui.button("Reset handle pose").clicked() {
-                let rest = crate::document::at_rest(&opened_on);
+                let rest = opened_on.at_rest();
                 let _ = self.edit(host, crate::document::Edit::Pose(i, rest));
                 ui.close();
             }
