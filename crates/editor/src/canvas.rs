@@ -255,7 +255,8 @@ impl EditorApp {
 
     /// Where ARAP takes the mesh vertex under screen point `pos`, as text.
     fn positions_readout_at(&mut self, pos: Pos2) -> Option<String> {
-        let doc = self.doc.as_mut()?;
+        // (Drawn as parts, the mesh shown is the parts', not the picture's.)
+        let doc = self.doc.as_mut().filter(|d| d.parts().is_none())?;
         let method = doc.method().label();
         let (rest, _, _) = doc.unwarp(self.viewport.to_image(pos))?;
         let vertex = doc.rig().domain().nearest_vertex(rest)? as usize;
@@ -269,7 +270,7 @@ impl EditorApp {
 
     /// The C² weights of the mesh vertex under screen point `pos`, as text.
     fn handle_weights_at(&mut self, pos: Pos2) -> Option<String> {
-        let doc = self.doc.as_mut()?;
+        let doc = self.doc.as_mut().filter(|d| d.parts().is_none())?;
         let (rest, _, _) = doc.unwarp(self.viewport.to_image(pos))?;
         let rig = doc.rig();
         let vertex = rig.domain().nearest_vertex(rest)?;
