@@ -37,6 +37,8 @@ fn drawn_as_parts_the_view_is_the_export_and_a_part_brought_forward_is_saved() {
         parts
             .save(Path::new(&folder).join("parts-view.png"))
             .expect("a shot");
+        let window = h.render().expect("the window");
+        (window.save(Path::new(&folder).join("parts-window.png"))).expect("a shot");
     }
     assert!(changed(&flat, &parts) > 0.001, "parts draw another picture");
     // The view at full size is the export, which is `render` of the saved project.
