@@ -644,6 +644,11 @@ impl Composer {
         Ok(joined)
     }
 
+    /// The layers drawn (indices), in the draw order.
+    pub fn shown(&self) -> &[usize] {
+        &self.shown
+    }
+
     /// The texture the joined mesh samples: every drawn layer's pixels, packed.
     pub fn texture(&self) -> &Picture {
         &self.texture
@@ -803,6 +808,11 @@ impl PartsDeformer {
     /// The packed texture and where the joined mesh samples it.
     pub fn composer(&self) -> &Composer {
         &self.composer
+    }
+
+    /// How long setting the parts up took (the last setup, not a pose), ms.
+    pub fn setup_ms(&self) -> f64 {
+        self.setup_ms
     }
 
     /// The parts set up.

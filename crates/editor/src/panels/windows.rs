@@ -16,6 +16,16 @@ impl EditorApp {
                         )),
                         None => ui.label(format!("cage of {cage} vertices, not solved")),
                     };
+                } else if let Some(parts) = doc.parts() {
+                    ui.label(format!(
+                        "{} parts, {} vertices",
+                        parts.composer().shown().len(),
+                        pipeline::Deformer::rest(parts).len()
+                    ));
+                    ui.separator();
+                    ui.label(format!("{} handles", doc.project().handles.len()));
+                    ui.separator();
+                    ui.label(format!("parts set up in {:.1} ms", parts.setup_ms()));
                 } else {
                     let stats = doc.rig().stats();
                     ui.label(format!("{} vertices", stats.samples));
