@@ -19,8 +19,9 @@
 //! (`bindings`: the parts named, whatever lies under the handle).
 //!
 //! The composite is drawn as one mesh ([`composite`]), so automatic depth (the ARAP
-//! paper's §5.1) orders overlaps between parts as within one. Not yet: parts in the
-//! editor, LBC cages over parts.
+//! paper's §5.1) orders overlaps between parts as within one. [`PartsDeformer`] is
+//! the parts behind the method seam (what the editor shows). Under a cage (LBC), every
+//! part's vertices are tied to the cage's inside mesh and move with it.
 
 use anyhow::{Context, Result, bail};
 use glam::{DVec2, Vec2};
