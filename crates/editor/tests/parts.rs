@@ -68,4 +68,22 @@ fn drawn_as_parts_the_view_is_the_export_and_a_part_brought_forward_is_saved() {
     let order = project.parts.map(|p| p.order);
     assert_eq!(order, Some(vec![1, 0, 2, 3, 4, 5, 6]));
     h.state().sanity_check().expect("consistent");
+    // Saved, reopened and exported: the picture `c2warp render` draws of the saved
+    // file, bit for bit.
+    let saved = dir.path().join("saved.json");
+    h.state_mut().save_to(&saved);
+    h.state_mut().request_open(saved.clone());
+    settle(&mut h);
+    assert!(h.state().document().is_some_and(|d| d.parts().is_some()));
+    let exported = support::export_png(&mut h, dir.path());
+    let project = pipeline::load_project(&saved).expect("the saved rig");
+    let artwork = pipeline::load_artwork(&dir.path().join("puppet.ora")).expect("the layers");
+    let rendered = pipeline::warp_parts(&artwork, &project, None, &())
+        .expect("render")
+        .composite
+        .into_rgba8();
+    assert!(
+        exported == rendered,
+        "the reopened export is render of the saved file"
+    );
 }
