@@ -441,14 +441,21 @@ impl PartRig {
 
     /// Moves each follower's vertices where its leader's mesh now takes them.
     fn move_followers(&mut self) {
-        let leaders: Vec<Option<(Vec<DVec2>, Vec<DVec2>)>> = self
-            .parts
-            .iter()
-            .map(|p| match p {
-                Part::Bound(b) => Some((b.rest(), b.deformed())),
+        // The rest and moved vertices of each part some follower follows (of the
+        // cage's inside, under a cage), once.
+        let followed = |j: usize| self.followed.contains(&Some(j));
+        let leaders: Vec<Option<(Vec<DVec2>, Vec<DVec2>)>> = (self.parts.iter().enumerate())
+            .map(|(j, p)| match p {
+                Part::Bound(b) if followed(j) => Some((b.rest(), b.deformed())),
                 _ => None,
             })
             .collect();
+        let caged = (self.cage.as_ref()).map(|c| {
+            (
+                c.solution().domain.positions().to_vec(),
+                c.positions().to_vec(),
+            )
+        });
         for part in &mut self.parts {
             let Part::Follows {
                 mesh, leader, ties, ..
@@ -456,12 +463,6 @@ impl PartRig {
             else {
                 continue;
             };
-            let caged = (self.cage.as_ref()).map(|c| {
-                (
-                    c.solution().domain.positions().to_vec(),
-                    c.positions().to_vec(),
-                )
-            });
             let lead = match &caged {
                 Some(cage) => Some(cage),
                 None => leader.and_then(|j| leaders[j].as_ref()),
@@ -490,6 +491,15 @@ impl PartRig {
             meshes: self.meshes(),
             bindings: self.bindings.clone(),
             followed: self.followed.clone(),
+        }
+    }
+
+    /// Part `k`'s triangles in its drawing order (none for a hidden layer).
+    fn triangles_of(&self, k: usize) -> &[[u32; 3]] {
+        match &self.parts[k] {
+            Part::Hidden => &[],
+            Part::Bound(b) => &b.warper.triangles,
+            Part::Follows { mesh, .. } => &mesh.triangles,
         }
     }
 
@@ -868,11 +878,7 @@ impl Deformer for PartsDeformer {
         for &k in &self.composer.shown {
             let base = deformed.len() as u32;
             deformed.extend(self.rig.deformed_of(k));
-            if let Part::Bound(b) = &self.rig.parts[k] {
-                triangles.extend(b.warper.triangles.iter().map(|t| t.map(|v| v + base)));
-            } else if let Part::Follows { mesh, .. } = &self.rig.parts[k] {
-                triangles.extend(mesh.triangles.iter().map(|t| t.map(|v| v + base)));
-            }
+            triangles.extend(self.rig.triangles_of(k).iter().map(|t| t.map(|v| v + base)));
         }
         anyhow::ensure!(
             deformed.len() == self.joined.rest.len(),
