@@ -305,6 +305,9 @@ fn a_crossing_cage_is_refused_and_can_be_fixed() {
 fn a_cancelled_solve_leaves_everything_as_it_was() {
     let dir = tempfile::tempdir().expect("temp dir");
     let mut h = editor(dir.path());
+    // A solve long enough that Escape always comes before it ends (a small one could
+    // finish between two frames on a fast or an idle machine).
+    h.state_mut().cage.inside_vertices = 10_000;
     draw_cage(&mut h, &BODY);
     let before = h.state().document().expect("doc").project().clone();
     let undo = h.state().history_len();
