@@ -135,7 +135,7 @@ fn insertion_jumps(doc: &mut Document, insertions: usize) -> (Vec<Jump>, Vec<Jum
         let project = doc.project().clone();
         let new = project.handles.len() - 1;
         // (A handle close to another re-meshes around them: the picture is compared
-        // at the old mesh's points.)
+        // at the old mesh's points, where the method itself takes them.)
         let after = {
             let after = doc.deformed().to_vec();
             let rig = doc.rig();
@@ -145,6 +145,8 @@ fn insertion_jumps(doc: &mut Document, insertions: usize) -> (Vec<Jump>, Vec<Jum
                 .map(|(i, p)| {
                     if same_mesh {
                         after[i]
+                    } else if let Some(at) = arap_map(doc, *p) {
+                        at
                     } else {
                         rig.deform_point(&after, *p).unwrap_or(*p)
                     }
@@ -221,6 +223,23 @@ fn removal_jumps(doc: &mut Document) -> Vec<Jump> {
         doc.undo_to(snapshot).expect("undo");
     }
     jumps
+}
+
+/// Where ARAP takes the rest point `p`: through its own mesh, which does not change
+/// with the handles (the picture's mesh, re-meshed around crowded handles, draws that
+/// map sampled at other points, which differs from it by up to a tenth of a pixel).
+fn arap_map(doc: &Document, p: DVec2) -> Option<DVec2> {
+    let arap = doc.arap()?;
+    let (t, b) = arap.arap_mesh().locate(p)?;
+    let corners = arap.arap_mesh().triangles()[t];
+    let at = arap.arap_positions();
+    Some(
+        corners
+            .iter()
+            .zip(b)
+            .map(|(&c, w)| at[c as usize] * w)
+            .sum(),
+    )
 }
 
 /// What `EditorApp::add_point` does.
