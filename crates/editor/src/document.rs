@@ -742,9 +742,12 @@ impl Document {
         if posed {
             project.overlaid.push(index);
         }
-        if let Some(hold) = self.deformer().hold(project, index) {
-            project.holds.push(hold);
-        }
+        let holds = match (self.parts(), self.layers.as_deref()) {
+            // Drawn as parts: held on each part it binds.
+            (Some(parts), Some(layers)) => parts.rig().holds(layers, project, index)?,
+            _ => self.deformer().holds(project, index),
+        };
+        project.holds.extend(holds);
         Ok(())
     }
 

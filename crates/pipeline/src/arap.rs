@@ -431,7 +431,7 @@ impl ArapRig {
             }
             None => Self::new(domain, &handles, strokes, ArapOptions::of(project, None))?,
         };
-        arap.set_handles_and_holds(&handles, &project.holds)?;
+        arap.set_handles_and_holds(&handles, &own_holds(project))?;
         Ok(arap)
     }
 
@@ -625,6 +625,7 @@ impl ArapRig {
             rest: Vec::new(),
             at: Vec::new(),
             step_one: Vec::new(),
+            part: None,
         };
         // How far from its rest place a point may be before it counts as held away.
         let tiny = 1e-9 * self.arap_mesh().mean_edge_length().max(1.0);
@@ -706,7 +707,7 @@ impl Deformer for ArapRig {
         }
         let before = (self.strokes.clone(), self.handles.clone());
         self.set_rigidity(&project.rigidity)?;
-        if let Err(e) = self.set_handles_and_holds(&crate::handles(project), &project.holds) {
+        if let Err(e) = self.set_handles_and_holds(&crate::handles(project), &own_holds(project)) {
             // Leave it as it was: the old rigidity with the old handles.
             let _ = self.set_rigidity(&before.0);
             return Err(e);
@@ -730,10 +731,12 @@ impl Deformer for ArapRig {
         Output::Positions(&self.positions)
     }
 
-    fn hold(&self, project: &Project, index: usize) -> Option<project::Hold> {
+    fn holds(&self, project: &Project, index: usize) -> Vec<project::Hold> {
         self.hold_for(&crate::handles(project), index)
             .ok()
             .flatten()
+            .into_iter()
+            .collect()
     }
 
     fn weights(&self, _listing: WeightsListing) -> Result<serde_json::Value> {
@@ -882,6 +885,21 @@ fn invert(map: glam::DAffine2) -> Option<glam::DAffine2> {
     (det.is_finite() && det.abs() > 1e-300).then(|| map.inverse())
 }
 
+/// A held point this close to a vertex (squared pixels) is that vertex: far below a
+/// mesh edge, far above a coordinate's rounding.
+const SAME_POINT_SQUARED: f64 = 1e-12;
+
+/// `project`'s holds on the picture's own mesh (not those of a part's, which
+/// [`crate::parts`] hands each part as its own).
+fn own_holds(project: &Project) -> Vec<project::Hold> {
+    project
+        .holds
+        .iter()
+        .filter(|hold| hold.is_on(None))
+        .cloned()
+        .collect()
+}
+
 /// For each of `pins`, where its handle holds it (final, step one), from `holds`: the
 /// hold's own entry for the vertex at that rest position, or — on another mesh of
 /// ARAP's (a new `arap.density`) — the affine map that best fits the hold's points,
@@ -915,8 +933,18 @@ fn held_places(
         .map(|&(v, h)| {
             let lookup = by_handle.get(&h)?;
             let rest = positions[v as usize];
-            match lookup.entries.get(&key(rest.to_array())) {
-                Some(&i) => Some((
+            // The vertex itself, or (a part's hold, saved on the canvas and moved into
+            // the part's own rectangle and back) within a rounding of it.
+            let listed = lookup
+                .entries
+                .get(&key(rest.to_array()))
+                .copied()
+                .or_else(|| {
+                    (lookup.hold.rest.iter())
+                        .position(|&r| DVec2::from(r).distance_squared(rest) < SAME_POINT_SQUARED)
+                });
+            match listed {
+                Some(i) => Some((
                     DVec2::from(lookup.hold.at[i]),
                     DVec2::from(lookup.hold.step_one[i]),
                 )),

@@ -129,11 +129,12 @@ pub trait Deformer: Send {
 
     /// Handle `index` of `project` has just been placed, in the pose shown (this
     /// deformer's, which has not followed `project` yet): what it must hold so that
-    /// the picture stays where it is (`None`: nothing, as at rest). ARAP's answer pins
-    /// the new handle's points where the current solve puts them.
-    fn hold(&self, project: &Project, index: usize) -> Option<project::Hold> {
+    /// the picture stays where it is (none: nothing, as at rest). ARAP's answer pins
+    /// the new handle's points where the current solve puts them (on each part the
+    /// handle binds, drawn as parts).
+    fn holds(&self, project: &Project, index: usize) -> Vec<project::Hold> {
         let _ = (project, index);
-        None
+        Vec::new()
     }
 
     /// `c2warp weights`: the nodes and every vertex's non-zero weights, as JSON.

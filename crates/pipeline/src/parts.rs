@@ -309,11 +309,14 @@ impl PartRig {
                 parts.push(Part::Hidden);
                 continue;
             }
-            let part = part_project(project, bound);
+            let part = part_project(project, k, bound);
             let density = share(area);
-            // The same part with the same setup: posed, not set up again.
+            // The same part with the same setup (method, share of the density, handles
+            // at rest): posed, not set up again.
             let same = previous.and_then(|old| match old.parts.get(k)? {
-                Part::Bound(b) if b.density == density => {
+                Part::Bound(b)
+                    if b.density == density && b.warper.deformer.method() == project.method =>
+                {
                     let mut b = b.clone();
                     (b.follow(&part).ok()? == Follow::Followed).then_some(b)
                 }
@@ -401,6 +404,44 @@ impl PartRig {
         Ok(rig)
     }
 
+    /// What handle `index` of `project` (just placed, in the pose shown, on `artwork`
+    /// these parts were set up on) must hold on each part it binds so that the part
+    /// stays where it is: the part's method's holds ([`Deformer::holds`]: ARAP pins
+    /// what is under it where the current solve has it), on the canvas, naming the
+    /// part. A part that no handle bound until now follows another, and has no solve
+    /// of its own to hold.
+    ///
+    /// # Errors
+    /// A handle bound to no part.
+    pub fn holds(
+        &self,
+        artwork: &layers::Artwork,
+        project: &Project,
+        index: usize,
+    ) -> Result<Vec<Hold>> {
+        let mut holds = Vec::new();
+        for (k, bound) in bindings(artwork, project)?.iter().enumerate() {
+            let Some(local) = bound.iter().position(|&h| h == index) else {
+                continue;
+            };
+            let Some(Part::Bound(b)) = self.parts.get(k) else {
+                continue;
+            };
+            let own = shifted(&part_project(project, k, bound), -b.origin);
+            for mut hold in b.warper.deformer.holds(&own, local) {
+                let mv = |p: &mut [f64; 2]| *p = (DVec2::from(*p) + b.origin).to_array();
+                (hold.rest.iter_mut())
+                    .chain(&mut hold.at)
+                    .chain(&mut hold.step_one)
+                    .for_each(mv);
+                hold.handle = index;
+                hold.part = Some(k);
+                holds.push(hold);
+            }
+        }
+        Ok(holds)
+    }
+
     /// Poses every part as `project` (the rig file set up, in another pose) has it.
     ///
     /// # Errors
@@ -429,7 +470,7 @@ impl PartRig {
         }
         for (k, part) in self.parts.iter_mut().enumerate() {
             if let Part::Bound(bound) = part {
-                let own = part_project(project, &self.bindings[k]);
+                let own = part_project(project, k, &self.bindings[k]);
                 if bound.follow(&own).with_context(|| format!("part {k}"))? == Follow::NeedsSetup {
                     return Ok(Follow::NeedsSetup);
                 }
@@ -1182,7 +1223,7 @@ fn tie(
     listener: &dyn Listener,
 ) -> Result<(PartMesh, Vec<Tie>)> {
     // Its own mesh: the method's setup with no handle is the identity on it.
-    let mut still = part_project(project, &[]);
+    let mut still = part_project(project, usize::MAX, &[]);
     still.method = project::Method::C2;
     // (Meshed alone: a cage is the whole picture's.)
     still.cage = None;
@@ -1379,9 +1420,10 @@ impl PartRig {
     }
 }
 
-/// `project` with the handles `bound` alone (their holds and overlay kept, renumbered),
-/// no virtual handle, no animation, on the canvas as it is.
-fn part_project(project: &Project, bound: &[usize]) -> Project {
+/// `project` for layer `layer`'s part with the handles `bound` alone (their overlay
+/// and their holds on this part kept, renumbered, as the part's own), no virtual
+/// handle, no animation, on the canvas as it is.
+fn part_project(project: &Project, layer: usize, bound: &[usize]) -> Project {
     let index = |h: usize| bound.iter().position(|&b| b == h);
     let mut part = project.clone();
     part.handles = bound.iter().map(|&h| project.handles[h].clone()).collect();
@@ -1389,9 +1431,11 @@ fn part_project(project: &Project, bound: &[usize]) -> Project {
     part.holds = project
         .holds
         .iter()
+        .filter(|hold| hold.is_on(Some(layer)))
         .filter_map(|hold| {
             index(hold.handle).map(|handle| Hold {
                 handle,
+                part: None,
                 ..hold.clone()
             })
         })

@@ -850,6 +850,18 @@ pub struct Hold {
     pub at: Vec<[f64; 2]>,
     /// The same for step one's result of the two-step solve (the scale-free fit).
     pub step_one: Vec<[f64; 2]>,
+    /// Drawn as parts: the layer (an index into the picture's layers) whose ARAP mesh
+    /// the points are on; a handle that binds several parts holds on each. `None`:
+    /// the picture's own mesh, as one picture.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub part: Option<usize>,
+}
+
+impl Hold {
+    /// Whether this hold is on `part`'s mesh (`None`: the picture drawn as one).
+    pub fn is_on(&self, part: Option<usize>) -> bool {
+        self.part == part
+    }
 }
 
 /// The most points a [`Hold`] may list.
@@ -1187,11 +1199,17 @@ impl Project {
         }
         let mut held = std::collections::BTreeSet::new();
         for (i, hold) in self.holds.iter().enumerate() {
-            if hold.handle >= self.handles.len() || !held.insert(hold.handle) {
+            if hold.handle >= self.handles.len() || !held.insert((hold.handle, hold.part)) {
                 return bad(format!(
-                    "holds[{i}] names handle {}: there are {} handles, each held once at most",
+                    "holds[{i}] names handle {}: there are {} handles, each held once at most \
+                     (once on each part)",
                     hold.handle,
                     self.handles.len()
+                ));
+            }
+            if hold.part.is_some_and(|k| k >= MAX_PARTS) {
+                return bad(format!(
+                    "holds[{i}].part must be a layer's index, below {MAX_PARTS}"
                 ));
             }
             let n = hold.rest.len();
@@ -1522,10 +1540,31 @@ mod tests {
                 "same points",
             ),
             (text.replace("[[31,12]]", "[[31,1e300]]"), "finite numbers"),
+            (
+                text.replace(r#""handle":1,"#, r#""handle":1,"part":1000,"#),
+                "a layer's index",
+            ),
         ] {
             let error = Project::from_json(&bad).expect_err(says).to_string();
             assert!(error.contains(says), "{error}");
         }
+        // Drawn as parts, a handle that binds two parts holds on each, once.
+        let joint = text.replace(r#""handle":2,"#, r#""handle":1,"part":3,"#);
+        let joint = Project::from_json(&joint).expect("held on the picture and on part 3");
+        assert_eq!(joint.holds[1].part, Some(3));
+        assert!(joint.holds[1].is_on(Some(3)) && joint.holds[0].is_on(None));
+        assert_eq!(
+            Project::from_json(&joint.to_json()).expect("round trip"),
+            joint
+        );
+        let twice = text
+            .replace(r#""handle":2,"#, r#""handle":1,"part":3,"#)
+            .replace(
+                r#""handle":1,"rest":[[30"#,
+                r#""handle":1,"part":3,"rest":[[30"#,
+            );
+        let error = Project::from_json(&twice).expect_err("twice on part 3");
+        assert!(error.to_string().contains("once on each part"), "{error}");
     }
 
     fn sample() -> Project {
