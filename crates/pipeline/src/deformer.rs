@@ -79,8 +79,10 @@ pub struct WeightsListing {
     pub positions: bool,
 }
 
-/// A warping method set up on a rest mesh for a rig file's controls.
-pub trait Deformer: Send {
+/// A warping method set up on a rest mesh for a rig file's controls. (`Sync`, so that
+/// layered parts can share a part's setup between the parts of one rig file and the
+/// next while it is unchanged.)
+pub trait Deformer: Send + Sync {
     /// Which method this is.
     fn method(&self) -> Method;
 

@@ -167,8 +167,9 @@ pub struct PartRig {
 enum Part {
     /// A hidden layer: nothing.
     Hidden,
-    /// Its own method, on its layer, with the handles that bind it.
-    Bound(Box<Bound>),
+    /// Its own method, on its layer, with the handles that bind it (shared with the
+    /// parts this was set up from while it follows the same rig file).
+    Bound(std::sync::Arc<Bound>),
     /// Its own mesh, each vertex where the part it follows takes it.
     Follows {
         mesh: PartMesh,
@@ -191,6 +192,9 @@ struct Bound {
     origin: DVec2,
     /// The vertices it was meshed with (its share of the density).
     density: usize,
+    /// The part's own rig file it follows ([`part_project`], canvas pixels): a rig
+    /// file that gives the part the same is not followed again.
+    own: Project,
 }
 
 impl Bound {
@@ -213,7 +217,14 @@ impl Bound {
 
     /// Follows `project` (canvas pixels), this part's own.
     fn follow(&mut self, project: &Project) -> Result<Follow> {
-        self.warper.follow(&shifted(project, -self.origin))
+        if *project == self.own {
+            return Ok(Follow::Followed);
+        }
+        let followed = self.warper.follow(&shifted(project, -self.origin))?;
+        if followed == Follow::Followed {
+            self.own = project.clone();
+        }
+        Ok(followed)
     }
 }
 
@@ -317,8 +328,12 @@ impl PartRig {
                 Part::Bound(b)
                     if b.density == density && b.warper.deformer.method() == project.method =>
                 {
-                    let mut b = b.clone();
-                    (b.follow(&part).ok()? == Follow::Followed).then_some(b)
+                    if b.own == part {
+                        // Nothing of this part changed: shared as it is.
+                        return Some(b.clone());
+                    }
+                    let mut b = Bound::clone(b);
+                    (b.follow(&part).ok()? == Follow::Followed).then(|| std::sync::Arc::new(b))
                 }
                 _ => None,
             });
@@ -339,10 +354,11 @@ impl PartRig {
                 listener,
             )
             .with_context(|| format!("part \"{}\"", layer.name))?;
-            parts.push(Part::Bound(Box::new(Bound {
+            parts.push(Part::Bound(std::sync::Arc::new(Bound {
                 warper,
                 origin,
                 density,
+                own: part,
             })));
         }
         // The parts no handle binds follow the bound part beneath them (in the draw
@@ -471,6 +487,11 @@ impl PartRig {
         for (k, part) in self.parts.iter_mut().enumerate() {
             if let Part::Bound(bound) = part {
                 let own = part_project(project, k, &self.bindings[k]);
+                if own == bound.own {
+                    // A pose that leaves this part's handles as they were.
+                    continue;
+                }
+                let bound = std::sync::Arc::make_mut(bound);
                 if bound.follow(&own).with_context(|| format!("part {k}"))? == Follow::NeedsSetup {
                     return Ok(Follow::NeedsSetup);
                 }

@@ -72,12 +72,20 @@ impl Document {
         } else {
             Some(self.deformer().triangles())
         };
+        // A pin added to parts sets up a new deformer over the same joined mesh (the
+        // parts it binds posed again, not meshed): the same mesh, element by element.
         let key = shown.map(|t| (t.as_ptr() as usize, t.len(), self.mesh_version));
         let same_mesh = self.depth.as_ref().is_some_and(|d| {
-            d.cage == cage && d.triangles.len() > LIVE_TRIANGLES && Some(d.mesh) == key
+            d.cage == cage
+                && d.triangles.len() > LIVE_TRIANGLES
+                && (Some(d.mesh) == key
+                    || (d.mesh.2 == self.mesh_version && shown == Some(&d.triangles[..])))
         });
         if (self.live || !now) && same_mesh && self.project.auto_depth {
             self.depth_deferred = true;
+            if let (Some(depth), Some(key)) = (&mut self.depth, key) {
+                depth.mesh = key;
+            }
             return;
         }
         self.depth_deferred = false;

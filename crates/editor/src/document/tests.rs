@@ -929,3 +929,33 @@ fn under_arap_a_pin_placed_in_a_pose_on_parts_holds_its_own_parts_too() {
     let own = pins_placed_in_a_pose_on_parts(Method::Arap);
     assert!(own.iter().all(|&d| d <= 0.01), "{own:?}");
 }
+
+#[test]
+fn a_pin_placed_beside_another_on_parts_refines_that_part_as_a_reopen_does() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut doc = puppet(dir.path());
+    doc.apply(Edit::Parts(Some(project::PartsSpec::default())))
+        .expect("parts");
+    // 1 px, then 0.5 px beside the body's pin at (320, 300): the part is meshed
+    // again around the pair (the C² paper's up-sampling), as a fresh setup meshes it.
+    for dx in [1.0, 0.5, 6.0] {
+        let before = doc.project().handles.len();
+        let pin = HandleSpec::Point {
+            rest: [320.0 + dx, 300.0],
+            translate: [0.0; 2],
+            rotate: 0.0,
+            scale: 1.0,
+            depth: 0,
+        };
+        let vertices = doc.parts().map(|p| pipeline::Deformer::rest(p).len());
+        doc.apply(Edit::Add(pin)).expect("beside another pin");
+        let refined = doc.parts().map(|p| pipeline::Deformer::rest(p).len());
+        assert!(
+            refined > vertices,
+            "{dx} px: {vertices:?} vertices, then {refined:?}"
+        );
+        doc.check_reopens().expect("reopens the same");
+        doc.apply(Edit::Remove(before)).expect("removed");
+        doc.check_reopens().expect("reopens the same");
+    }
+}
