@@ -79,7 +79,7 @@ impl FrameBuilder {
             .map(|cage| cage as &dyn Deformer);
         let weights = doc.weights_version;
         // Drawn as parts: the joined mesh samples the layers' pixels packed together.
-        let parts = doc.parts().filter(|_| !view.cage_view);
+        let parts = doc.parts().filter(|_| shows_parts(doc, view.cage_view));
         let parts_key = parts.map(|p| std::ptr::from_ref(p.composer()) as usize);
         let parts_changed = parts_key != self.seen.parts.as_ref().map(|(key, _)| *key);
         if parts_changed {
@@ -110,10 +110,10 @@ impl FrameBuilder {
             || view.cage_view != self.seen.cage_view
             || view.warping != self.seen.warping;
         if mesh_changed {
-            self.update_mesh(doc, view.cage_view, cage);
+            self.update_mesh(doc, view.cage_view, cage, parts.is_some());
         }
         if mesh_changed || doc.pose_version != self.seen.pose {
-            self.update_pose(doc, view.cage_view, cage);
+            self.update_pose(doc, view.cage_view, cage, parts.is_some());
         }
         self.update_overlays(doc, view);
         self.seen.weights = weights;
@@ -125,9 +125,27 @@ impl FrameBuilder {
 
     /// The mesh with its weight rows and triangles in drawing order; in the cage's
     /// view, the backdrop under it.
-    fn update_mesh(&mut self, doc: &Document, cage_view: bool, cage: Option<&dyn Deformer>) {
+    fn update_mesh(
+        &mut self,
+        doc: &Document,
+        cage_view: bool,
+        cage: Option<&dyn Deformer>,
+        as_parts: bool,
+    ) {
         let size = [doc.image.width(), doc.image.height()];
         let mesh = match (cage_view, cage) {
+            // The joined mesh at the texture's places, moved by positions alone.
+            _ if as_parts => {
+                let parts = doc.parts().expect("drawn as parts");
+                let texture = parts.composer().texture().dimensions();
+                MeshData {
+                    rest: parts.composer().uv().to_vec(),
+                    rows: vec![0; parts.rest().len() + 1],
+                    triangles: doc.draw_order(),
+                    source_size: [texture.0, texture.1],
+                    ..MeshData::default()
+                }
+            }
             (true, Some(cage)) => {
                 let order = doc
                     .cage_draw_order()
@@ -140,20 +158,7 @@ impl FrameBuilder {
                 source_size: size,
                 ..MeshData::default()
             },
-            (false, _) => match doc.parts() {
-                // The joined mesh at the texture's places, moved by positions alone.
-                Some(parts) => {
-                    let texture = parts.composer().texture().dimensions();
-                    MeshData {
-                        rest: parts.composer().uv().to_vec(),
-                        rows: vec![0; parts.rest().len() + 1],
-                        triangles: doc.draw_order(),
-                        source_size: [texture.0, texture.1],
-                        ..MeshData::default()
-                    }
-                }
-                None => skinned_mesh(doc.rig(), doc.draw_order(), size),
-            },
+            (false, _) => skinned_mesh(doc.rig(), doc.draw_order(), size),
         };
         let version = self.bump();
         self.frame.mesh = Versioned {
@@ -162,12 +167,12 @@ impl FrameBuilder {
         };
         self.seen.heat = None;
         self.seen.cells = 0;
-        if doc.parts().is_some() && !cage_view {
+        if as_parts {
             // No overlay values for the parts' mesh (see `update_overlays`).
             self.frame.heat.value = Arc::new(Vec::new());
             self.frame.cells.value = Arc::new(Vec::new());
         }
-        if !cage_view {
+        if !cage_view || as_parts {
             self.frame.backdrop = None;
             self.seen.backdrop = None;
             return;
@@ -193,8 +198,21 @@ impl FrameBuilder {
     }
 
     /// The node transforms, and the positions a method solves for.
-    fn update_pose(&mut self, doc: &Document, cage_view: bool, cage: Option<&dyn Deformer>) {
+    fn update_pose(
+        &mut self,
+        doc: &Document,
+        cage_view: bool,
+        cage: Option<&dyn Deformer>,
+        as_parts: bool,
+    ) {
         let (affines, positions) = match (cage_view, cage) {
+            _ if as_parts => {
+                let positions = match doc.deformer().output() {
+                    Output::Positions(p) => p.iter().map(|p| p.as_vec2()).collect(),
+                    Output::Skinned(_) => Vec::new(),
+                };
+                (Vec::new(), positions)
+            }
             (true, Some(cage)) => (transforms(cage), Vec::new()),
             (true, None) => (Vec::new(), Vec::new()),
             (false, _) => {
@@ -202,12 +220,7 @@ impl FrameBuilder {
                     Output::Skinned(_) => Vec::new(),
                     Output::Positions(p) => p.iter().map(|p| p.as_vec2()).collect(),
                 };
-                let affines = if doc.parts().is_some() {
-                    Vec::new()
-                } else {
-                    doc.rig().node_affines()
-                };
-                (affines, positions)
+                (doc.rig().node_affines(), positions)
             }
         };
         let version = self.bump();
@@ -225,9 +238,9 @@ impl FrameBuilder {
     /// The heat map of the shown handle or cage vertex, the cells, the dual graph: each
     /// when on and out of date.
     fn update_overlays(&mut self, doc: &Document, view: &View) {
-        if doc.parts().is_some() && !view.cage_view {
-            // The heat map, cells and dual graph are the whole picture's C² rig's, on
-            // another mesh than the parts'.
+        if doc.parts().is_some() && shows_parts(doc, view.cage_view) {
+            // The heat map, cells and dual graph are the whole picture's C² rig's (the
+            // cage's on its own mesh), on another mesh than the parts'.
             return;
         }
         let weights = doc.weights_version;
@@ -282,7 +295,10 @@ impl FrameBuilder {
             return Ok(());
         }
         let mesh = &self.frame.mesh.value;
-        let (samples, what) = if let Some(parts) = doc.parts().filter(|_| !self.seen.cage_view) {
+        let shown_parts = doc
+            .parts()
+            .filter(|_| shows_parts(doc, self.seen.cage_view));
+        let (samples, what) = if let Some(parts) = shown_parts {
             (parts.rest().len(), "the parts")
         } else if !self.seen.cage_view {
             (doc.rig().domain().len(), "the rig")
@@ -298,7 +314,7 @@ impl FrameBuilder {
                 mesh.rest.len()
             );
         }
-        if self.seen.cage_view && self.frame.backdrop.is_none() {
+        if self.seen.cage_view && shown_parts.is_none() && self.frame.backdrop.is_none() {
             bail!("the cage's view without the picture at rest under it");
         }
         Ok(())
@@ -347,6 +363,13 @@ pub(crate) fn cell_color(key: u32) -> [u8; 4] {
     let hue = (key.wrapping_mul(2_654_435_761) >> 8) as f32 / (1u32 << 24) as f32;
     let rgb = egui::ecolor::Hsva::new(hue, 0.75, 0.95, 1.0).to_srgb();
     [rgb[0], rgb[1], rgb[2], 255]
+}
+
+/// Whether the view draws `doc`'s parts (drawn as parts): under handles outside the
+/// cage's view (which draws the picture at rest while a cage is drawn), and always
+/// under a cage method, whose cage moves the parts.
+fn shows_parts(doc: &Document, cage_view: bool) -> bool {
+    doc.parts().is_some() && (!cage_view || doc.method().controls() == pipeline::Controls::Cage)
 }
 
 #[cfg(test)]

@@ -87,3 +87,55 @@ fn drawn_as_parts_the_view_is_the_export_and_a_part_brought_forward_is_saved() {
         "the reopened export is render of the saved file"
     );
 }
+
+#[test]
+fn a_cage_over_parts_moves_the_parts_in_the_view_as_the_export_draws_them() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    h.state_mut().request_open(puppet(dir.path()));
+    settle(&mut h);
+    click_label(&mut h, "Draw as parts");
+    settle(&mut h);
+    // A cage around the raised arm and the head, solved on the worker, then posed.
+    let rest = vec![
+        [100.0, 120.0],
+        [420.0, 120.0],
+        [420.0, 380.0],
+        [100.0, 380.0],
+    ];
+    assert!(h.state_mut().edit(editor::Edit::Cage {
+        rest: rest.clone(),
+        vertices: 600,
+    }));
+    h.state_mut().solve_cage();
+    settle(&mut h);
+    let doc = h.state().document().expect("doc");
+    assert!(doc.cage_deformer().is_some(), "solved");
+    assert!(doc.parts().is_some(), "the cage moves the parts");
+    let at_rest = shot(&mut h);
+    let mut pose = rest.clone();
+    pose[1] = [450.0, 90.0];
+    assert!(h.state_mut().edit(editor::Edit::CagePose(pose)));
+    settle(&mut h);
+    h.state().sanity_check().expect("consistent");
+    let posed = shot(&mut h);
+    if let Ok(folder) = std::env::var("C2WARP_SHOTS") {
+        let window = h.render().expect("the window");
+        (window.save(Path::new(&folder).join("parts-cage-window.png"))).expect("a shot");
+    }
+    assert!(
+        changed(&at_rest, &posed) > 0.001,
+        "the cage moved the parts"
+    );
+    let doc = h.state().document().expect("doc");
+    doc.check_reopens().expect("reopens as shown");
+    // The view at full size is the export, `render` of the saved project.
+    let gpu = render::GpuContext::new().expect("the software adapter");
+    let view = h.state_mut().view_offscreen(&gpu).expect("the view");
+    let exported = support::export_png(&mut h, dir.path());
+    let differ = changed(&view, &exported);
+    assert!(
+        differ < 0.01,
+        "the view differs from the export at {differ}"
+    );
+}

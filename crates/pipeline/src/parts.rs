@@ -23,6 +23,8 @@
 //! the parts behind the method seam (what the editor shows). Under a cage (LBC), every
 //! part's vertices are tied to the cage's inside mesh and move with it.
 
+use std::sync::Arc;
+
 use anyhow::{Context, Result, bail};
 use glam::{DVec2, Vec2};
 use project::{Canvas, Controls, HandleSpec, Hold, Project};
@@ -169,7 +171,7 @@ enum Part {
     Hidden,
     /// Its own method, on its layer, with the handles that bind it (shared with the
     /// parts this was set up from while it follows the same rig file).
-    Bound(std::sync::Arc<Bound>),
+    Bound(Arc<Bound>),
     /// Its own mesh, each vertex where the part it follows takes it.
     Follows {
         mesh: PartMesh,
@@ -284,7 +286,7 @@ impl PartRig {
         previous: Option<&Self>,
     ) -> Result<Self> {
         if project.method.controls() == Controls::Cage {
-            return Self::caged(artwork, project, density, listener, previous);
+            return Self::caged(artwork, project, density, listener, previous, None);
         }
         let canvas = canvas_of(artwork);
         let spec = project.parts.clone().unwrap_or_default();
@@ -333,7 +335,7 @@ impl PartRig {
                         return Some(b.clone());
                     }
                     let mut b = Bound::clone(b);
-                    (b.follow(&part).ok()? == Follow::Followed).then(|| std::sync::Arc::new(b))
+                    (b.follow(&part).ok()? == Follow::Followed).then(|| Arc::new(b))
                 }
                 _ => None,
             });
@@ -354,7 +356,7 @@ impl PartRig {
                 listener,
             )
             .with_context(|| format!("part \"{}\"", layer.name))?;
-            parts.push(Part::Bound(std::sync::Arc::new(Bound {
+            parts.push(Part::Bound(Arc::new(Bound {
                 warper,
                 origin,
                 density,
@@ -491,7 +493,7 @@ impl PartRig {
                     // A pose that leaves this part's handles as they were.
                     continue;
                 }
-                let bound = std::sync::Arc::make_mut(bound);
+                let bound = Arc::make_mut(bound);
                 if bound.follow(&own).with_context(|| format!("part {k}"))? == Follow::NeedsSetup {
                     return Ok(Follow::NeedsSetup);
                 }
@@ -544,6 +546,11 @@ impl PartRig {
                 })
                 .collect();
         }
+    }
+
+    /// The cage that moves the parts (LBC), if a cage does.
+    pub fn cage(&self) -> Option<&crate::cage::CageDeformer> {
+        self.cage.as_deref()
     }
 
     /// The parts' meshes in the current pose, and what binds them.
@@ -806,7 +813,7 @@ pub struct Joined {
 #[derive(Clone)]
 pub struct PartsDeformer {
     rig: PartRig,
-    composer: std::sync::Arc<Composer>,
+    composer: Arc<Composer>,
     joined: Joined,
     /// The layers' names, for what is listed by part.
     names: Vec<String>,
@@ -871,11 +878,35 @@ impl PartsDeformer {
         Ok(Self {
             setup_ms: clock.elapsed().as_secs_f64() * 1e3,
             rig,
-            composer: std::sync::Arc::new(composer),
+            composer: Arc::new(composer),
             joined,
             names: artwork.layers.iter().map(|l| l.name.clone()).collect(),
             setup: setup_of(project),
         })
+    }
+
+    /// Every visible layer of `artwork` as a part inside `project`'s cage, posed by
+    /// `cage` (its coordinates solved already, as the editor solves them in the
+    /// background; the same as [`PartsDeformer::new`] solves): the parts of
+    /// `previous` tied to the same solve are kept.
+    ///
+    /// # Errors
+    /// A cage that is not `project`'s; as [`PartsDeformer::new`].
+    pub fn with_cage(
+        artwork: &layers::Artwork,
+        project: &Project,
+        cage: crate::cage::CageDeformer,
+        previous: Option<&Self>,
+    ) -> Result<Self> {
+        Self::with_rig(
+            artwork,
+            project,
+            |listener| {
+                let previous = previous.map(|p| &p.rig);
+                PartRig::caged(artwork, project, None, listener, previous, Some(cage))
+            },
+            &(),
+        )
     }
 
     /// The packed texture and where the joined mesh samples it.
@@ -1353,16 +1384,33 @@ impl PartRig {
         density: Option<usize>,
         listener: &dyn Listener,
         previous: Option<&Self>,
+        solved: Option<crate::cage::CageDeformer>,
     ) -> Result<Self> {
         let canvas = canvas_of(artwork);
         let spec = project.parts.clone().unwrap_or_default();
         spec.check_layers(artwork.layers.len())?;
         let order = spec.order_of(artwork.layers.len());
-        // The cage: kept when it is the same, else solved on the canvas.
-        let kept_cage = (previous.and_then(|old| old.cage.as_ref()))
-            .map(|cage| cage.as_ref().clone())
-            .and_then(|mut cage| (cage.follow(project).ok()? == Follow::Followed).then_some(cage));
-        let same_cage = kept_cage.is_some();
+        let old_cage = previous.and_then(|old| old.cage.as_ref());
+        // The cage: given solved, or kept when it is the same, else solved on the
+        // canvas.
+        let (kept_cage, same_cage) = match solved {
+            Some(mut cage) => {
+                if cage.follow(project)? == Follow::NeedsSetup {
+                    bail!("the cage given is not the rig file's");
+                }
+                let same = old_cage.is_some_and(|old| Arc::ptr_eq(old.solution(), cage.solution()));
+                (Some(cage), same)
+            }
+            None => {
+                let kept = old_cage
+                    .map(|cage| cage.as_ref().clone())
+                    .and_then(|mut cage| {
+                        (cage.follow(project).ok()? == Follow::Followed).then_some(cage)
+                    });
+                let same = kept.is_some();
+                (kept, same)
+            }
+        };
         let cage = match kept_cage {
             Some(cage) => cage,
             None => {

@@ -7,7 +7,7 @@ use std::sync::Arc;
 use anyhow::{Context, Result, bail};
 use glam::DVec2;
 use pipeline::cage::{CageCoordinates, CageDeformer, CageMesh};
-use pipeline::{Controls, Follow, Method};
+use pipeline::{Controls, Follow, Method, PartsDeformer};
 use project::{CageSpec, LbcSettings, Project, Tau};
 
 use super::Document;
@@ -97,6 +97,22 @@ impl Document {
             self.method = None;
             return Ok(());
         };
+        if let Some(layers) = self.layers.clone().filter(|_| self.project.parts.is_some()) {
+            // Drawn as parts: every part inside the cage follows it (the parts tied to
+            // the same solve kept).
+            if let Some((_, deformer)) = &mut self.method
+                && (deformer.as_any().downcast_ref::<PartsDeformer>())
+                    .and_then(|parts| parts.rig().cage())
+                    .is_some_and(|cage| Arc::ptr_eq(cage.solution(), &solution))
+                && deformer.follow(&self.project)? == Follow::Followed
+            {
+                return Ok(());
+            }
+            let cage = CageDeformer::new(solution, self.cage_pose())?;
+            let parts = PartsDeformer::with_cage(&layers, &self.project, cage, self.parts())?;
+            self.method = Some((self.mesh_version, Box::new(parts)));
+            return Ok(());
+        }
         if let Some((_, deformer)) = &mut self.method
             && deformer
                 .as_any()
@@ -113,6 +129,9 @@ impl Document {
 
     /// The cage method's deformer, when the rig file's cage is solved and LBC chosen.
     pub fn cage_deformer(&self) -> Option<&CageDeformer> {
+        if let Some(parts) = self.parts() {
+            return parts.rig().cage();
+        }
         let (_, deformer) = self.method.as_ref()?;
         deformer.as_any().downcast_ref::<CageDeformer>()
     }

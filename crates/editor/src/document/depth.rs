@@ -64,7 +64,8 @@ impl Document {
     /// [`Document::rearrange`]; on the mesh arranged last, a large one waits for the
     /// drag's end or the next frame unless `now`.
     pub(super) fn rearrange_now(&mut self, now: bool) {
-        let cage = self.project.method.controls() == Controls::Cage;
+        // (Drawn as parts, a cage moves the parts' joined mesh, which is arranged.)
+        let cage = self.project.method.controls() == Controls::Cage && self.parts().is_none();
         // (Compared by where the shown mesh's triangles lie, not element by element:
         // a pose keeps the mesh, and this runs on every frame of a drag.)
         let shown = if cage {
