@@ -865,11 +865,14 @@ fn pins_placed_in_a_pose_on_parts(method: Method) -> Vec<f64> {
     };
     let before = shown(&doc);
     let mut own_moves = Vec::new();
-    // On the body, the head and the raised arm, in the rig's pose.
+    // On the body, the head, the raised arm and the back arm's shoulder (a joint of
+    // the arm and the body), in the rig's pose.
+    let mut joints = 0;
     for at in [
         DVec2::new(300.0, 420.0),
         DVec2::new(250.0, 200.0),
         DVec2::new(160.0, 330.0),
+        DVec2::new(362.0, 345.0),
     ] {
         let (rest, angle, scale) = doc.unwarp(at).expect("on the picture");
         let handle = HandleSpec::Point {
@@ -884,6 +887,14 @@ fn pins_placed_in_a_pose_on_parts(method: Method) -> Vec<f64> {
         // others are drawn exactly where they were.
         let set = doc.parts().expect("parts").rig().set();
         let pin = doc.project().handles.len() - 1;
+        let bound = set.bindings.iter().filter(|b| b.contains(&pin)).count();
+        joints += usize::from(bound > 1);
+        if method == Method::Arap {
+            // Held on each part it binds (where the pose is not the rest's).
+            let holds = doc.project().holds.iter().filter(|h| h.handle == pin);
+            assert!(holds.clone().all(|h| h.part.is_some()));
+            assert!(holds.count() <= bound);
+        }
         let touched = |k: usize| {
             set.bindings[k].contains(&pin)
                 || set.followed[k].is_some_and(|j| set.bindings[j].contains(&pin))
@@ -911,6 +922,7 @@ fn pins_placed_in_a_pose_on_parts(method: Method) -> Vec<f64> {
         doc.check_reopens().expect("reopens with the new pin");
         doc.apply(Edit::Remove(pin)).expect("removed");
     }
+    assert!(joints > 0, "a joint among the pins");
     own_moves
 }
 
