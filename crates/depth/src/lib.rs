@@ -38,6 +38,7 @@ use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
 use glam::DVec2;
+pub use overlap::PairCache;
 pub use topology::Topology;
 
 /// One overlap region: the triangles (indices into the mesh's list, sorted) of the
@@ -92,6 +93,23 @@ pub fn arrange_on(
     predefined: &[u32],
     remembered: &[Region],
 ) -> Arrangement {
+    arrange_cached(topology, None, positions, triangles, predefined, remembered)
+}
+
+/// As [`arrange_on`], finding the overlapping triangles through `pairs`, the pairs of
+/// the mesh's last pose: only those with a triangle that moved since are tested again
+/// (the same arrangement, sooner when most of the mesh stands still).
+///
+/// # Panics
+/// As [`arrange`].
+pub fn arrange_cached(
+    topology: Option<&Topology>,
+    pairs: Option<&mut PairCache>,
+    positions: &[DVec2],
+    triangles: &[[u32; 3]],
+    predefined: &[u32],
+    remembered: &[Region],
+) -> Arrangement {
     if let Some(topology) = topology.filter(|t| t.is_for(triangles))
         && !topology.may_overlap(positions)
     {
@@ -116,7 +134,10 @@ pub fn arrange_on(
         assert_eq!(rank[t as usize], u32::MAX, "triangle {t} listed twice");
         rank[t as usize] = r as u32;
     }
-    let pairs = overlap::overlapping_pairs(positions, triangles);
+    let pairs = match pairs {
+        Some(cache) => cache.pairs(positions, triangles),
+        None => overlap::overlapping_pairs(positions, triangles),
+    };
     if pairs.is_empty() {
         return Arrangement {
             order: predefined.to_vec(),

@@ -29,6 +29,64 @@ type Shape = ([DVec2; 3], DVec2, DVec2, f64);
 /// one another are a fold, drawn in the mesh's order, not two regions), in increasing
 /// `(s, t)`. Triangles with a non-finite corner or no area take no part.
 pub(crate) fn overlapping_pairs(positions: &[DVec2], triangles: &[[u32; 3]]) -> Vec<Pair> {
+    pairs_among(positions, triangles, None)
+}
+
+/// The overlapping pairs of the mesh's last pose, kept so that the next pose tests
+/// again only the pairs with a triangle that moved: when most of a mesh stands still
+/// (a pin added to one part of many), its pairs are not tested again.
+#[derive(Clone, Debug, Default)]
+pub struct PairCache {
+    /// The positions and triangles the pairs were found for.
+    positions: Vec<DVec2>,
+    triangles: Vec<[u32; 3]>,
+    pairs: Vec<Pair>,
+}
+
+impl PairCache {
+    /// [`overlapping_pairs`] of `positions` and `triangles`, the same pairs with the
+    /// same areas, testing only the pairs with a triangle that moved since the last
+    /// call (all of them the first time, or for other triangles).
+    pub(crate) fn pairs(&mut self, positions: &[DVec2], triangles: &[[u32; 3]]) -> Vec<Pair> {
+        let same_mesh =
+            self.triangles.as_slice() == triangles && self.positions.len() == positions.len();
+        let pairs = if same_mesh {
+            let moved_vertex: Vec<bool> = (positions.iter().zip(&self.positions))
+                .map(|(a, b)| a != b)
+                .collect();
+            let moved: Vec<bool> = triangles
+                .iter()
+                .map(|t| t.iter().any(|&v| moved_vertex[v as usize]))
+                .collect();
+            let count = moved.iter().filter(|&&m| m).count();
+            if count == 0 {
+                self.pairs.clone()
+            } else if count > triangles.len() / 2 {
+                overlapping_pairs(positions, triangles)
+            } else {
+                // The pairs of two triangles that stood still, as they were; the others
+                // tested again.
+                let mut pairs: Vec<Pair> = (self.pairs.iter())
+                    .filter(|p| !moved[p.s as usize] && !moved[p.t as usize])
+                    .copied()
+                    .collect();
+                pairs.extend(pairs_among(positions, triangles, Some(&moved)));
+                pairs.sort_unstable_by_key(|p| (p.s, p.t));
+                pairs
+            }
+        } else {
+            self.triangles = triangles.to_vec();
+            overlapping_pairs(positions, triangles)
+        };
+        self.positions.clear();
+        self.positions.extend_from_slice(positions);
+        self.pairs.clone_from(&pairs);
+        pairs
+    }
+}
+
+/// [`overlapping_pairs`], or with `moved` only the pairs with a triangle it marks.
+fn pairs_among(positions: &[DVec2], triangles: &[[u32; 3]], moved: Option<&[bool]>) -> Vec<Pair> {
     let corners = |t: &[u32; 3]| t.map(|v| positions[v as usize]);
     // Each triangle counter-clockwise, with its bounding box; None where it cannot
     // overlap anything.
@@ -102,37 +160,64 @@ pub(crate) fn overlapping_pairs(positions: &[DVec2], triangles: &[[u32; 3]]) -> 
             }
         }
     }
-    // Each row of cells on a thread of its own.
-    let row_pairs = |y: usize| {
-        let mut pairs = Vec::new();
-        for x in 0..columns {
-            let cell = y * columns + x;
-            let cell_members = &members[starts[cell] as usize..starts[cell + 1] as usize];
-            for (k, &i) in cell_members.iter().enumerate() {
-                let (pi, min_i, max_i, area_i) = shapes[i as usize].expect("live");
-                for &j in &cell_members[k + 1..] {
-                    let (pj, min_j, max_j, area_j) = shapes[j as usize].expect("live");
-                    let (min, max) = (min_i.max(min_j), max_i.min(max_j));
-                    // Boxes apart or only touching (no area in common), or the pair
-                    // is tested in the cell where their boxes' overlap starts.
-                    if min.x >= max.x || min.y >= max.y || index(min) != (x, y) {
-                        continue;
-                    }
-                    let (ti, tj) = (triangles[i as usize], triangles[j as usize]);
-                    if ti.iter().any(|v| tj.contains(v)) {
-                        continue;
-                    }
-                    let area = common_area(pi, pj);
-                    if area > SLIVER * area_i.min(area_j) {
-                        let (s, t) = if i < j { (i, j) } else { (j, i) };
-                        pairs.push(Pair { s, t, area });
+    // The pair of triangles `a < b`, if they overlap, tested in cell (x, y) alone: the
+    // cell where their boxes' overlap starts.
+    let test = |a: u32, b: u32, x: usize, y: usize| -> Option<Pair> {
+        let (pa, min_a, max_a, area_a) = shapes[a as usize].expect("live");
+        let (pb, min_b, max_b, area_b) = shapes[b as usize].expect("live");
+        let (min, max) = (min_a.max(min_b), max_a.min(max_b));
+        // Boxes apart or only touching (no area in common), or another cell's pair.
+        if min.x >= max.x || min.y >= max.y || index(min) != (x, y) {
+            return None;
+        }
+        let (ta, tb) = (triangles[a as usize], triangles[b as usize]);
+        if ta.iter().any(|v| tb.contains(v)) {
+            return None;
+        }
+        let area = common_area(pa, pb);
+        (area > SLIVER * area_a.min(area_b)).then_some(Pair { s: a, t: b, area })
+    };
+    let cell_members = |x: usize, y: usize| {
+        let cell = y * columns + x;
+        &members[starts[cell] as usize..starts[cell + 1] as usize]
+    };
+    let mut pairs: Vec<Pair> = match moved {
+        // Each row of cells on a thread of its own (a cell's members are increasing).
+        None => (0..rows)
+            .into_par_iter()
+            .flat_map_iter(|y| {
+                let mut pairs = Vec::new();
+                for x in 0..columns {
+                    let members = cell_members(x, y);
+                    for (k, &a) in members.iter().enumerate() {
+                        pairs.extend(members[k + 1..].iter().filter_map(|&b| test(a, b, x, y)));
                     }
                 }
-            }
-        }
-        pairs
+                pairs
+            })
+            .collect(),
+        // Each moved triangle with the triangles in its cells (a pair of two moved
+        // ones from the lower's side).
+        Some(moved) => live
+            .par_iter()
+            .filter(|&&a| moved[a as usize])
+            .flat_map_iter(|&a| {
+                let mut pairs = Vec::new();
+                let ((x0, y0), (x1, y1)) = range(a);
+                for y in y0..=y1 {
+                    for x in x0..=x1 {
+                        for &b in cell_members(x, y) {
+                            if b == a || (moved[b as usize] && b < a) {
+                                continue;
+                            }
+                            pairs.extend(test(a.min(b), a.max(b), x, y));
+                        }
+                    }
+                }
+                pairs
+            })
+            .collect(),
     };
-    let mut pairs: Vec<Pair> = (0..rows).into_par_iter().flat_map_iter(row_pairs).collect();
     pairs.sort_unstable_by_key(|p| (p.s, p.t));
     pairs
 }
@@ -191,6 +276,68 @@ mod tests {
         assert_eq!(common_area(a, far), 0.0);
         let beside = tri([[2.0, 0.0], [2.0, 2.0], [0.0, 2.0]]);
         assert!(common_area(a, beside) < 1e-12);
+    }
+
+    /// Two sheets of `n × n` squares (two triangles each), the second over the first,
+    /// shifted: every triangle of one overlaps some of the other.
+    fn sheets(n: u32) -> (Vec<DVec2>, Vec<[u32; 3]>) {
+        let mut positions = Vec::new();
+        let mut triangles = Vec::new();
+        for (sheet, shift) in [(0u32, 0.0), (1, 0.37)] {
+            let base = sheet * (n + 1) * (n + 1);
+            for y in 0..=n {
+                for x in 0..=n {
+                    positions.push(DVec2::new(f64::from(x) + shift, f64::from(y) + shift));
+                }
+            }
+            let at = |x: u32, y: u32| base + y * (n + 1) + x;
+            for y in 0..n {
+                for x in 0..n {
+                    triangles.push([at(x, y), at(x + 1, y), at(x + 1, y + 1)]);
+                    triangles.push([at(x, y), at(x + 1, y + 1), at(x, y + 1)]);
+                }
+            }
+        }
+        (positions, triangles)
+    }
+
+    #[test]
+    fn the_cache_finds_the_pairs_a_full_search_finds() {
+        let (mut positions, triangles) = sheets(12);
+        let mut cache = PairCache::default();
+        assert_eq!(
+            cache.pairs(&positions, &triangles),
+            overlapping_pairs(&positions, &triangles)
+        );
+        // Nothing moved; then a few vertices of the top sheet, then of both; then one
+        // back where it was.
+        assert_eq!(
+            cache.pairs(&positions, &triangles),
+            overlapping_pairs(&positions, &triangles)
+        );
+        let top = 13 * 13;
+        for (v, by) in [
+            (top + 20, [0.6, -0.3]),
+            (top + 100, [-2.5, 1.0]),
+            (7, [0.2, 3.0]),
+        ] {
+            positions[v] += DVec2::from(by);
+            let cached = cache.pairs(&positions, &triangles);
+            let full = overlapping_pairs(&positions, &triangles);
+            assert!(!full.is_empty());
+            assert_eq!(cached, full, "the same pairs, the same areas to the bit");
+        }
+        positions[7] -= DVec2::new(0.2, 3.0);
+        assert_eq!(
+            cache.pairs(&positions, &triangles),
+            overlapping_pairs(&positions, &triangles)
+        );
+        // Another mesh: searched afresh.
+        let fewer = &triangles[..triangles.len() - 2];
+        assert_eq!(
+            cache.pairs(&positions, fewer),
+            overlapping_pairs(&positions, fewer)
+        );
     }
 
     #[test]

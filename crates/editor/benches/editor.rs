@@ -324,6 +324,25 @@ fn parts(c: &mut Criterion) {
             });
         },
     );
+    // The same, each followed by the arrangement of the joined mesh's overlaps, which
+    // an insertion leaves to the next frame (`Document::arrange_deferred`).
+    c.bench_function(
+        &format!(
+            "editor/parts/insert_and_remove_pin_arranged/12_parts_{}k_vertices",
+            vertices / 1000
+        ),
+        |b| {
+            b.iter(|| {
+                n += 1;
+                let at = 250.0 + f64::from(n % 7) * 80.0;
+                doc.apply(Edit::Add(point(at, 320.0))).expect("inserted");
+                doc.arrange_deferred();
+                let last = doc.project().handles.len() - 1;
+                doc.apply(Edit::Remove(last)).expect("removed");
+                doc.arrange_deferred();
+            });
+        },
+    );
     let mut h = Harness::builder()
         .with_size(Vec2::new(1280.0, 820.0))
         .build_eframe(move |_cc| EditorApp::with_document(doc));

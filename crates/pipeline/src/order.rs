@@ -72,6 +72,8 @@ pub struct Arranger {
     part_of: Option<Vec<u32>>,
     /// The last pose's regions.
     regions: Vec<depth::Region>,
+    /// The last pose's overlapping triangles (only those that moved are tested again).
+    pairs: depth::PairCache,
 }
 
 impl Arranger {
@@ -89,6 +91,7 @@ impl Arranger {
             topology: depth::Topology::new(rest, triangles),
             part_of: None,
             regions: Vec::new(),
+            pairs: depth::PairCache::default(),
         };
         arranger.restart(overlaps, rest, triangles);
         arranger
@@ -109,6 +112,7 @@ impl Arranger {
             topology: depth::Topology::new(rest, triangles),
             part_of: Some(part_of),
             regions: Vec::new(),
+            pairs: depth::PairCache::default(),
         };
         arranger.restart(overlaps, rest, triangles);
         arranger
@@ -162,8 +166,9 @@ impl Arranger {
             self.regions.clear();
             return self.predefined.clone();
         }
-        let arranged = depth::arrange_on(
+        let arranged = depth::arrange_cached(
             Some(&self.topology),
+            Some(&mut self.pairs),
             deformed,
             triangles,
             &self.predefined,
