@@ -44,6 +44,9 @@ struct BrushStroke {
     points: Vec<[f64; 2]>,
     /// The same points where the pose shows them, for drawing the stroke under way.
     posed: Vec<DVec2>,
+    /// Drawn as parts: the part under the brush where the stroke began, which it
+    /// paints alone.
+    part: Option<usize>,
 }
 
 /// The painted triangles, by the (GPU mesh version, strokes) they were found for: the
@@ -182,6 +185,9 @@ impl Brush {
         let Some(stroke) = &mut self.stroke else {
             return;
         };
+        if stroke.points.is_empty() {
+            stroke.part = doc.part_at(at);
+        }
         if stroke
             .points
             .last()
@@ -206,6 +212,7 @@ impl Brush {
                 stroke: stroke.points,
                 radius: self.radius,
                 weight: self.weight,
+                part: stroke.part,
             });
             strokes
         };
@@ -346,6 +353,7 @@ mod tests {
             stroke: points.to_vec(),
             radius,
             weight: 100.0,
+            part: None,
         }
     }
 

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use egui_kittest::kittest::Queryable;
 
-use crate::support::{self, changed, click_label, editor, settle, shot};
+use crate::support::{self, at, changed, click_label, drag, editor, settle, shot};
 
 /// The sample character and its rig (at a low density) in `dir`; the rig's path.
 fn puppet(dir: &Path) -> PathBuf {
@@ -138,4 +138,35 @@ fn a_cage_over_parts_moves_the_parts_in_the_view_as_the_export_draws_them() {
         differ < 0.01,
         "the view differs from the export at {differ}"
     );
+}
+
+#[test]
+fn rigidity_painted_on_parts_paints_the_part_under_the_brush() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    h.state_mut().request_open(puppet(dir.path()));
+    settle(&mut h);
+    click_label(&mut h, "Draw as parts");
+    settle(&mut h);
+    click_label(&mut h, "ARAP");
+    settle(&mut h);
+    h.key_press(egui::Key::R);
+    h.run();
+    // From the body's middle across to the shoulder, where the back arm lies under
+    // the body: the stroke paints the body, the part where it began.
+    let (from, to) = ((320.0, 420.0), (362.0, 345.0));
+    let body = h
+        .state_mut()
+        .document_mut()
+        .and_then(|d| d.part_at(glam::DVec2::new(from.0, from.1)));
+    assert!(body.is_some());
+    let (a, b) = (at(&h, from.0, from.1), at(&h, to.0, to.1));
+    drag(&mut h, a, b, egui::Modifiers::NONE);
+    settle(&mut h);
+    let doc = h.state().document().expect("doc");
+    let strokes = &doc.project().rigidity;
+    assert_eq!(strokes.len(), 1, "{:?}", h.state().message);
+    assert_eq!(strokes[0].part, body, "the part under the brush");
+    doc.check_reopens().expect("reopens painted");
+    h.state().sanity_check().expect("consistent");
 }

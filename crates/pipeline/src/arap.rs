@@ -1303,6 +1303,7 @@ mod tests {
             stroke: points,
             radius,
             weight,
+            part: None,
         };
         let centroid = |t: usize| {
             domain.triangles()[t]

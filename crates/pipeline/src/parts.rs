@@ -1490,8 +1490,8 @@ impl PartRig {
 }
 
 /// `project` for layer `layer`'s part with the handles `bound` alone (their overlay
-/// and their holds on this part kept, renumbered, as the part's own), no virtual
-/// handle, no animation, on the canvas as it is.
+/// and their holds on this part kept, renumbered, as the part's own), the rigidity
+/// painted on it, no virtual handle, no animation, on the canvas as it is.
 fn part_project(project: &Project, layer: usize, bound: &[usize]) -> Project {
     let index = |h: usize| bound.iter().position(|&b| b == h);
     let mut part = project.clone();
@@ -1509,6 +1509,9 @@ fn part_project(project: &Project, layer: usize, bound: &[usize]) -> Project {
             })
         })
         .collect();
+    // The rigidity painted on this part, or on every part.
+    part.rigidity
+        .retain(|stroke| stroke.part.is_none_or(|k| k == layer));
     // Virtual handles were placed on the whole picture, some off this part: each part
     // places its own (the C² paper's Algorithm 1 on its shape).
     part.virtual_handles.clear();

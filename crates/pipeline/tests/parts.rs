@@ -466,3 +466,39 @@ fn the_parts_deformer_poses_the_joined_mesh_and_knows_a_new_setup() {
         "the bench leaves the pose as it was"
     );
 }
+
+#[test]
+fn rigidity_painted_on_a_part_stiffens_that_part_alone() {
+    // Under ARAP, each part pulled by its own handle, a joint between them; a stroke
+    // over the joint, where both parts lie.
+    let mut project = rig(r#"{"type": "point", "rest": [20, 60]},
+           {"type": "point", "rest": [85, 60]},
+           {"type": "point", "rest": [60, 90], "translate": [-10, 20]},
+           {"type": "point", "rest": [180, 60]},
+           {"type": "point", "rest": [120, 90], "translate": [12, 18]}"#);
+    project.method = project::Method::Arap;
+    let artwork = two_parts();
+    let drawn = |project: &Project| {
+        let parts = warp_parts(&artwork, project, None, &()).expect("warps");
+        [0, 1].map(|k| rgba8(&parts.warped.layers[k]))
+    };
+    let plain = drawn(&project);
+    let stroke = |part| project::RigidityStroke {
+        stroke: vec![[70.0, 50.0], [100.0, 70.0]],
+        radius: 18.0,
+        weight: 10_000.0,
+        part,
+    };
+    // Painted on the left part: the right one is drawn as without it.
+    project.rigidity = vec![stroke(Some(0))];
+    let [left, right] = drawn(&project);
+    assert!(left != plain[0], "the left part is stiffer");
+    assert!(right == plain[1], "the right part is not painted");
+    // On every part it reaches: both.
+    project.rigidity = vec![stroke(None)];
+    let [left, right] = drawn(&project);
+    assert!(left != plain[0] && right != plain[1]);
+    // It round-trips through the rig file.
+    let reread = Project::from_json(&project.to_json()).expect("reads");
+    assert_eq!(reread.rigidity, project.rigidity);
+}

@@ -189,6 +189,11 @@ pub struct RigidityStroke {
     pub radius: f64,
     /// The weight of the painted triangles (the paper paints 10000).
     pub weight: f64,
+    /// Drawn as parts: the layer (an index into the picture's layers) the stroke
+    /// paints — the part under the brush where the stroke began; `None`: every part
+    /// it reaches (and the picture, drawn as one, always).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub part: Option<usize>,
 }
 
 /// A cage for local barycentric coordinates: a simple polygon in image pixels (either
@@ -1380,6 +1385,11 @@ impl Project {
                     s.weight
                 ));
             }
+            if s.part.is_some_and(|k| k >= MAX_PARTS) {
+                return bad(format!(
+                    "rigidity stroke {i}: part must be a layer's index, below {MAX_PARTS}"
+                ));
+            }
         }
         if let Some(arap) = &self.arap {
             if let Some(r) = arap.pin_radius
@@ -1607,11 +1617,13 @@ mod tests {
                     stroke: vec![[3.0, 4.0], [10.25, 1.0 / 3.0]],
                     radius: 6.5,
                     weight: 10000.0,
+                    part: None,
                 },
                 RigidityStroke {
                     stroke: vec![[20.0, 20.0]],
                     radius: 1.0,
                     weight: 0.5,
+                    part: None,
                 },
             ],
             ..Project::default()
