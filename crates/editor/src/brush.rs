@@ -7,6 +7,7 @@ use std::sync::Arc;
 
 use egui::{Color32, Mesh, PointerButton, Pos2, Response, Shape, Ui};
 use glam::DVec2;
+use pipeline::Deformer as _;
 use pipeline::arap::polyline_distance_squared;
 use project::RigidityStroke;
 
@@ -262,11 +263,25 @@ impl Brush {
             .is_some_and(|(version, painted)| *version == mesh && painted == strokes);
         if !fresh {
             let key = (mesh, strokes.clone());
-            let domain = doc.rig().domain();
-            let weights = pipeline::arap::rigidity_weights(domain, strokes);
+            // The mesh shown: drawn as parts, the parts' joined mesh (a stroke paints
+            // its own part).
+            let (weights, triangles) = match doc.parts() {
+                Some(parts) => {
+                    let (rest, triangles) = (parts.rest(), parts.triangles());
+                    let part_of = Some(parts.part_of());
+                    let weights =
+                        pipeline::arap::rigidity_weights_of(rest, triangles, strokes, part_of);
+                    (weights, triangles)
+                }
+                None => {
+                    let domain = doc.rig().domain();
+                    let weights = pipeline::arap::rigidity_weights(domain, strokes);
+                    (weights, domain.triangles())
+                }
+            };
             let painted: Vec<([u32; 3], f64)> = weights
                 .iter()
-                .zip(domain.triangles())
+                .zip(triangles)
                 .filter(|(w, _)| **w != 1.0)
                 .map(|(&w, &t)| (t, w))
                 .collect();

@@ -167,6 +167,19 @@ fn rigidity_painted_on_parts_paints_the_part_under_the_brush() {
     let strokes = &doc.project().rigidity;
     assert_eq!(strokes.len(), 1, "{:?}", h.state().message);
     assert_eq!(strokes[0].part, body, "the part under the brush");
+    // The overlay shows the painted triangles of that part, on the mesh shown.
+    let joined = doc.parts().expect("parts");
+    let painted = h.state().brush.painted_triangles();
+    assert!(!painted.is_empty(), "the painted triangles are shown");
+    let of_body = painted
+        .iter()
+        .all(|t| joined.part_of_vertex(t[0]).map(|k| k as usize) == body);
+    assert!(of_body, "only the body's triangles are shown painted");
+
     doc.check_reopens().expect("reopens painted");
     h.state().sanity_check().expect("consistent");
+    if let Ok(folder) = std::env::var("C2WARP_SHOTS") {
+        let window = h.render().expect("the window");
+        (window.save(Path::new(&folder).join("parts-rigidity-window.png"))).expect("a shot");
+    }
 }

@@ -1076,9 +1076,19 @@ fn pins(
 /// or a point of the stroke lies inside the triangle (so a thin stroke still paints
 /// the coarse triangles of ARAP's own mesh it crosses).
 pub fn rigidity_weights(mesh: &Domain, strokes: &[RigidityStroke]) -> Vec<f64> {
-    let positions = mesh.positions();
-    let corners: Vec<[DVec2; 3]> = mesh
-        .triangles()
+    rigidity_weights_of(mesh.positions(), mesh.triangles(), strokes, None)
+}
+
+/// [`rigidity_weights`] of the mesh `positions` and `triangles`; with `part_of` (each
+/// triangle's part, a mesh joined from parts), a stroke that names a part paints that
+/// part's triangles alone.
+pub fn rigidity_weights_of(
+    positions: &[DVec2],
+    triangles: &[[u32; 3]],
+    strokes: &[RigidityStroke],
+    part_of: Option<&[u32]>,
+) -> Vec<f64> {
+    let corners: Vec<[DVec2; 3]> = triangles
         .iter()
         .map(|t| t.map(|v| positions[v as usize]))
         .collect();
@@ -1094,9 +1104,13 @@ pub fn rigidity_weights(mesh: &Domain, strokes: &[RigidityStroke]) -> Vec<f64> {
             .fold((*first, *first), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
         let (lo, hi) = (lo - stroke.radius, hi + stroke.radius);
         let r2 = stroke.radius * stroke.radius;
+        let other_part = |t: usize| match (stroke.part, part_of) {
+            (Some(k), Some(parts)) => parts.get(t).is_none_or(|&p| p as usize != k),
+            _ => false,
+        };
         for (t, c) in corners.iter().enumerate() {
             let (tlo, thi) = (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]));
-            if thi.cmplt(lo).any() || tlo.cmpgt(hi).any() {
+            if thi.cmplt(lo).any() || tlo.cmpgt(hi).any() || other_part(t) {
                 continue;
             }
             let centroid = (c[0] + c[1] + c[2]) / 3.0;
