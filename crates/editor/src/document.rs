@@ -1084,25 +1084,81 @@ impl Document {
     /// The share of handle `handle` in every sample's position: its own nodes'
     /// weights plus the virtual nodes' weights times their harmonic coordinate for it.
     pub fn influence(&self, handle: usize) -> Vec<f32> {
-        let rig = &self.rig;
-        let share: Vec<f64> = (0..rig.nodes().len())
-            .map(|k| match rig.nodes()[k].kind {
-                NodeKind::Point { handle: h } | NodeKind::BarSample { handle: h, .. } => {
-                    f64::from(u8::from(h == handle))
-                }
-                NodeKind::Virtual => rig.harmonic_coordinate(k, handle),
-                NodeKind::Boundary => 0.0,
-            })
-            .collect();
-        (0..rig.domain().len())
-            .map(|v| {
-                rig.weights(v)
-                    .map(|(k, w)| w * share[k])
-                    .sum::<f64>()
-                    .clamp(0.0, 1.0) as f32
-            })
-            .collect()
+        let of_part = |rig: &Rig, own: Option<usize>| match own {
+            Some(own) => influence_of(rig, own),
+            None => vec![0.0; rig.domain().len()],
+        };
+        self.per_part(0.0, handle, of_part)
+            .unwrap_or_else(|| influence_of(&self.rig, handle))
     }
+
+    /// Each vertex's Voronoi cell, as the mesh vertex of its node (distinct for every
+    /// node of every part drawn as parts); `None` for a sample no node reaches.
+    pub fn cell_keys(&self) -> Vec<Option<u32>> {
+        let cells = |rig: &Rig, base: u32| -> Vec<Option<u32>> {
+            (rig.cells().iter())
+                .map(|&k| rig.nodes().get(k as usize).map(|node| base + node.vertex))
+                .collect()
+        };
+        let mut base = 0;
+        let of_part = |rig: &Rig, _| {
+            let keys = cells(rig, base);
+            base += rig.domain().len() as u32;
+            keys
+        };
+        self.per_part(None, 0, of_part)
+            .unwrap_or_else(|| cells(&self.rig, 0))
+    }
+
+    /// Drawn as parts, for each vertex of the parts' mesh: what `of_part` gives for
+    /// its part's own C² rig (a part set up by C²), with the index `handle` has among
+    /// that part's handles if it binds it; `none` for a part without one (another
+    /// method's, a follower). `None` when not drawn as parts.
+    fn per_part<T: Clone>(
+        &self,
+        none: T,
+        handle: usize,
+        mut of_part: impl FnMut(&Rig, Option<usize>) -> Vec<T>,
+    ) -> Option<Vec<T>> {
+        let parts = self.parts()?;
+        let mut values = Vec::with_capacity(parts.rest().len());
+        for (k, run) in parts.runs() {
+            let own = (parts.rig().bound(k))
+                .and_then(|(deformer, bound)| {
+                    let rig = deformer.as_any().downcast_ref::<Rig>()?;
+                    Some((rig, bound.iter().position(|&h| h == handle)))
+                })
+                .map(|(rig, local)| of_part(rig, local))
+                .filter(|v| v.len() == run.len());
+            match own {
+                Some(own) => values.extend(own),
+                None => values.extend(std::iter::repeat_n(none.clone(), run.len())),
+            }
+        }
+        Some(values)
+    }
+}
+
+/// How much handle `handle` of `rig` moves each vertex: its nodes' weights, and the
+/// virtual nodes' by their harmonic coordinate of it, within [0, 1].
+fn influence_of(rig: &Rig, handle: usize) -> Vec<f32> {
+    let share: Vec<f64> = (0..rig.nodes().len())
+        .map(|k| match rig.nodes()[k].kind {
+            NodeKind::Point { handle: h } | NodeKind::BarSample { handle: h, .. } => {
+                f64::from(u8::from(h == handle))
+            }
+            NodeKind::Virtual => rig.harmonic_coordinate(k, handle),
+            NodeKind::Boundary => 0.0,
+        })
+        .collect();
+    (0..rig.domain().len())
+        .map(|v| {
+            rig.weights(v)
+                .map(|(k, w)| w * share[k])
+                .sum::<f64>()
+                .clamp(0.0, 1.0) as f32
+        })
+        .collect()
 }
 
 /// The first of `triangles` (corners indexing `points`) that contains `p`, and `p`'s

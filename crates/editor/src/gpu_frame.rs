@@ -168,7 +168,8 @@ impl FrameBuilder {
         self.seen.heat = None;
         self.seen.cells = 0;
         if as_parts {
-            // No overlay values for the parts' mesh (see `update_overlays`).
+            // Overlay values for another mesh are not the parts' (see
+            // `update_overlays`).
             self.frame.heat.value = Arc::new(Vec::new());
             self.frame.cells.value = Arc::new(Vec::new());
         }
@@ -238,17 +239,18 @@ impl FrameBuilder {
     /// The heat map of the shown handle or cage vertex, the cells, the dual graph: each
     /// when on and out of date.
     fn update_overlays(&mut self, doc: &Document, view: &View) {
-        if doc.parts().is_some() && shows_parts(doc, view.cage_view) {
-            // The heat map, cells and dual graph are the whole picture's C² rig's (the
-            // cage's on its own mesh), on another mesh than the parts'.
-            return;
-        }
+        // Drawn as parts: the heat map and cells are each part's own C² rig's, on the
+        // parts' mesh (none for a part another method moves); the cage's heat map and
+        // the dual graph are on other meshes than the parts'.
+        let parts = shows_parts(doc, view.cage_view);
         let weights = doc.weights_version;
         let heat_key = view.shown.filter(|_| view.show.heat).map(|s| (s, weights));
         if let Some((shown, _)) = heat_key
             && heat_key != self.seen.heat
         {
-            let values = if view.cage_view {
+            let values = if parts && view.cage_view {
+                Vec::new()
+            } else if view.cage_view {
                 doc.cage_influence(shown).unwrap_or_default()
             } else {
                 doc.influence(shown)
@@ -261,17 +263,10 @@ impl FrameBuilder {
             self.seen.heat = heat_key;
         }
         if view.show.cells && !view.cage_view && self.seen.cells != weights {
-            let rig = doc.rig();
             // A sample that no node reaches (a rig without nodes, or a piece of the
             // shape without a handle) has no cell: grey.
-            let colors = rig
-                .cells()
-                .iter()
-                .map(|&k| {
-                    rig.nodes()
-                        .get(k as usize)
-                        .map_or(NO_CELL, |node| cell_color(node.vertex))
-                })
+            let colors = (doc.cell_keys().into_iter())
+                .map(|key| key.map_or(NO_CELL, cell_color))
                 .collect();
             let version = self.bump();
             self.frame.cells = Versioned {
@@ -282,7 +277,7 @@ impl FrameBuilder {
         }
         // Keyed by the GPU mesh's version, which no other document shares.
         let mesh_version = self.frame.mesh.version;
-        if view.show.dual_graph && !view.cage_view && self.dual_graph.0 != mesh_version {
+        if view.show.dual_graph && !view.cage_view && !parts && self.dual_graph.0 != mesh_version {
             self.dual_graph = (mesh_version, Arc::new(doc.rig().dual_graph()));
         }
     }

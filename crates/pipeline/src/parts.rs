@@ -548,6 +548,16 @@ impl PartRig {
         }
     }
 
+    /// Part `k`'s own method (set up on its own rectangle of the canvas) and the
+    /// handles that bind it (the rig file's indices); `None` for a part that follows
+    /// another, or is hidden, or moves with a cage.
+    pub fn bound(&self, k: usize) -> Option<(&dyn Deformer, &[usize])> {
+        match self.parts.get(k)? {
+            Part::Bound(b) => Some((b.warper.deformer.as_ref(), &self.bindings[k])),
+            _ => None,
+        }
+    }
+
     /// The cage that moves the parts (LBC), if a cage does.
     pub fn cage(&self) -> Option<&crate::cage::CageDeformer> {
         self.cage.as_deref()
@@ -927,6 +937,20 @@ impl PartsDeformer {
     /// For each triangle, its part (the layer's index).
     pub fn part_of(&self) -> &[u32] {
         &self.joined.part_of
+    }
+
+    /// Each part drawn (a layer's index) with its vertices in the joined mesh, in the
+    /// draw order.
+    pub fn runs(&self) -> Vec<(usize, std::ops::Range<usize>)> {
+        let starts = &self.joined.starts;
+        (starts.iter().enumerate())
+            .map(|(i, &(start, k))| {
+                let end = starts
+                    .get(i + 1)
+                    .map_or(self.joined.rest.len(), |s| s.0 as usize);
+                (k as usize, start as usize..end)
+            })
+            .collect()
     }
 
     /// The part (the layer's index) vertex `v` of the joined mesh belongs to.

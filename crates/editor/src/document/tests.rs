@@ -971,3 +971,37 @@ fn a_pin_placed_beside_another_on_parts_refines_that_part_as_a_reopen_does() {
         doc.check_reopens().expect("reopens the same");
     }
 }
+
+#[test]
+fn drawn_as_parts_the_heat_map_and_cells_are_each_parts_own() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut doc = puppet(dir.path());
+    doc.apply(Edit::Parts(Some(project::PartsSpec::default())))
+        .expect("parts");
+    let parts = doc.parts().expect("parts");
+    let n = parts.rest().len();
+    let set = parts.rig().set();
+    let runs = parts.runs();
+    // The tail's pin (handle 11): weight 1 at its own vertex, none on parts it does
+    // not bind.
+    let heat = doc.influence(11);
+    assert_eq!(heat.len(), n, "one value a vertex of the parts' mesh");
+    for (k, run) in &runs {
+        let values = &heat[run.clone()];
+        if set.bindings[*k].contains(&11) {
+            assert!(values.iter().any(|&w| w > 0.999), "part {k}: its pin");
+        } else {
+            assert!(values.iter().all(|&w| w == 0.0), "part {k}: not bound");
+        }
+    }
+    // Every vertex of a bound part lies in a cell, and no two parts share one.
+    let cells = doc.cell_keys();
+    assert_eq!(cells.len(), n);
+    let mut seen = std::collections::HashMap::new();
+    for (k, run) in &runs {
+        for key in cells[run.clone()].iter().flatten() {
+            assert_eq!(*seen.entry(*key).or_insert(*k), *k, "a cell of two parts");
+        }
+    }
+    assert!(cells.iter().filter(|c| c.is_some()).count() > n / 2);
+}
