@@ -229,7 +229,16 @@ impl Document {
             });
         }
         project.density = Some(project.density.unwrap_or(pipeline::DEFAULT_DENSITY));
-        let prepared = pipeline::prepare(&image, &project, None)?;
+        // Drawn as parts under handles, the parts are set up beside the picture's own
+        // mesh and rig, on the other core.
+        let parts_layers = (layers.as_deref())
+            .filter(|_| project.parts.is_some() && project.method.controls() == Controls::Handles);
+        let (prepared, parts) = rayon::join(
+            || pipeline::prepare(&image, &project, None),
+            || parts_layers.map(|layers| PartsDeformer::new(layers, &project, None, &())),
+        );
+        let prepared = prepared?;
+        let method = (parts.transpose()?).map(|parts| (1, Box::new(parts) as Box<dyn Deformer>));
         // Virtual handles live in the rig while editing; they are written out on save.
         project.virtual_handles.clear();
         project.virtual_placed_for.clear();
@@ -248,7 +257,7 @@ impl Document {
             last_update_ms: ms(clock),
             deformed: None,
             mesh_version: 1,
-            method: None,
+            method,
             solutions: Vec::new(),
             depth: None,
             order_version: 1,
