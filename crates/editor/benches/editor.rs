@@ -307,42 +307,33 @@ fn parts(c: &mut Criterion) {
     let mut doc = Document::from_artwork(character, None, project).expect("12 parts");
     let vertices = doc.parts().map_or(0, |p| pipeline::Deformer::rest(p).len());
     // A pin inserted on one limb (the parts it binds set up again, the others kept),
-    // then removed again.
+    // then removed again; then the same, each followed by the arrangement of the
+    // joined mesh's overlaps, which an insertion leaves to the next frame
+    // (`Document::arrange_deferred`).
     let mut n = 0u32;
-    c.bench_function(
-        &format!(
-            "editor/parts/insert_and_remove_pin/12_parts_{}k_vertices",
-            vertices / 1000
-        ),
-        |b| {
-            b.iter(|| {
-                n += 1;
-                let at = 250.0 + f64::from(n % 7) * 80.0;
-                doc.apply(Edit::Add(point(at, 320.0))).expect("inserted");
-                let last = doc.project().handles.len() - 1;
-                doc.apply(Edit::Remove(last)).expect("removed");
-            });
-        },
-    );
-    // The same, each followed by the arrangement of the joined mesh's overlaps, which
-    // an insertion leaves to the next frame (`Document::arrange_deferred`).
-    c.bench_function(
-        &format!(
-            "editor/parts/insert_and_remove_pin_arranged/12_parts_{}k_vertices",
-            vertices / 1000
-        ),
-        |b| {
-            b.iter(|| {
-                n += 1;
-                let at = 250.0 + f64::from(n % 7) * 80.0;
-                doc.apply(Edit::Add(point(at, 320.0))).expect("inserted");
+    for (name, arranged) in [
+        ("insert_and_remove_pin", false),
+        ("insert_and_remove_pin_arranged", true),
+    ] {
+        let step = |doc: &mut Document, edit: Edit| {
+            doc.apply(edit).expect("inserted or removed");
+            if arranged {
                 doc.arrange_deferred();
-                let last = doc.project().handles.len() - 1;
-                doc.apply(Edit::Remove(last)).expect("removed");
-                doc.arrange_deferred();
-            });
-        },
-    );
+            }
+        };
+        c.bench_function(
+            &format!("editor/parts/{name}/12_parts_{}k_vertices", vertices / 1000),
+            |b| {
+                b.iter(|| {
+                    n += 1;
+                    let at = 250.0 + f64::from(n % 7) * 80.0;
+                    step(&mut doc, Edit::Add(point(at, 320.0)));
+                    let last = doc.project().handles.len() - 1;
+                    step(&mut doc, Edit::Remove(last));
+                });
+            },
+        );
+    }
     let mut h = Harness::builder()
         .with_size(Vec2::new(1280.0, 820.0))
         .build_eframe(move |_cc| EditorApp::with_document(doc));

@@ -88,14 +88,21 @@ fn drawn_as_parts_the_view_is_the_export_and_a_part_brought_forward_is_saved() {
     );
 }
 
-#[test]
-fn a_cage_over_parts_moves_the_parts_in_the_view_as_the_export_draws_them() {
-    let dir = tempfile::tempdir().expect("temp dir");
-    let mut h = editor(dir.path());
-    h.state_mut().request_open(puppet(dir.path()));
+/// The editor on the sample character in `dir`, drawn as parts.
+fn puppet_as_parts(dir: &Path) -> egui_kittest::Harness<'static, editor::EditorApp> {
+    let mut h = editor(dir);
+    h.state_mut().request_open(puppet(dir));
     settle(&mut h);
     click_label(&mut h, "Draw as parts");
     settle(&mut h);
+    assert!(h.state().document().is_some_and(|d| d.parts().is_some()));
+    h
+}
+
+#[test]
+fn a_cage_over_parts_moves_the_parts_in_the_view_as_the_export_draws_them() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = puppet_as_parts(dir.path());
     // A cage around the raised arm and the head, solved on the worker, then posed.
     let rest = vec![
         [100.0, 120.0],
@@ -143,11 +150,7 @@ fn a_cage_over_parts_moves_the_parts_in_the_view_as_the_export_draws_them() {
 #[test]
 fn rigidity_painted_on_parts_paints_the_part_under_the_brush() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let mut h = editor(dir.path());
-    h.state_mut().request_open(puppet(dir.path()));
-    settle(&mut h);
-    click_label(&mut h, "Draw as parts");
-    settle(&mut h);
+    let mut h = puppet_as_parts(dir.path());
     click_label(&mut h, "ARAP");
     settle(&mut h);
     h.key_press(egui::Key::R);
