@@ -833,8 +833,16 @@ impl Document {
     /// # Errors
     /// What the method refuses in the pose (as [`Document::restore`]).
     pub fn settle(&mut self) -> Result<()> {
+        let was_live = self.live;
         self.set_live(false)?;
-        self.arrange_deferred();
+        if was_live {
+            // The pose solved in full moved the vertices (ARAP's): shown and arranged
+            // anew.
+            self.pose_version += 1;
+            self.rearrange_now(true);
+        } else {
+            self.arrange_deferred();
+        }
         Ok(())
     }
 

@@ -699,6 +699,19 @@ impl Warper {
         Ok(followed)
     }
 
+    /// Puts the method in or out of live mode ([`Deformer::set_live`]); out of it,
+    /// the pose solved in full is arranged again.
+    ///
+    /// # Errors
+    /// As [`Deformer::set_live`].
+    pub fn set_live(&mut self, live: bool) -> Result<()> {
+        self.deformer.set_live(live)?;
+        if !live {
+            self.arrange();
+        }
+        Ok(())
+    }
+
     /// Draws the current pose's overlaps in the order automatic depth gives them.
     fn arrange(&mut self) {
         if let Some(arranger) = &mut self.arranger {

@@ -162,6 +162,8 @@ pub struct PartRig {
     bindings: Vec<Vec<usize>>,
     /// For each layer that no handle binds, the layer it follows (if any).
     followed: Vec<Option<usize>>,
+    /// Whether the parts follow a live drag ([`PartRig::set_live`]).
+    live: bool,
 }
 
 /// What moves one layer.
@@ -417,6 +419,7 @@ impl PartRig {
             parts,
             bindings,
             followed,
+            live: false,
         };
         rig.move_followers();
         Ok(rig)
@@ -546,6 +549,35 @@ impl PartRig {
                 })
                 .collect();
         }
+    }
+
+    /// Puts every part's method in or out of live mode (a drag: ARAP's parts start
+    /// from the previous frame's answer; out of it, each part's pose is solved in
+    /// full, as a file of it renders). Returns whether the parts may have moved (out
+    /// of live mode), their followers moved with them.
+    ///
+    /// # Errors
+    /// What a part's method refuses of its pose, naming the part's layer index.
+    pub fn set_live(&mut self, live: bool) -> Result<bool> {
+        if live == self.live {
+            return Ok(false);
+        }
+        self.live = live;
+        let mut moved = false;
+        for (k, part) in self.parts.iter_mut().enumerate() {
+            if let Part::Bound(bound) = part {
+                let bound = Arc::make_mut(bound);
+                bound
+                    .warper
+                    .set_live(live)
+                    .with_context(|| format!("part {k}"))?;
+                moved |= !live;
+            }
+        }
+        if moved {
+            self.move_followers();
+        }
+        Ok(moved)
     }
 
     /// Part `k`'s own method (set up on its own rectangle of the canvas) and the
@@ -919,6 +951,33 @@ impl PartsDeformer {
         )
     }
 
+    /// The joined mesh's positions (and triangles) from the parts' current ones.
+    ///
+    /// # Errors
+    /// Parts meshed anew without a new setup.
+    fn rejoin(&mut self) -> Result<()> {
+        // A pose moves the vertices; the joined triangles change only where a part's
+        // own drawing order did (a fold within it), and are kept otherwise, so that a
+        // caller keeping them (the editor's automatic depth) sees the same mesh.
+        let mut deformed = std::mem::take(&mut self.joined.deformed);
+        deformed.clear();
+        let mut triangles = Vec::with_capacity(self.joined.triangles.len());
+        for &k in &self.composer.shown {
+            let base = deformed.len() as u32;
+            deformed.extend(self.rig.deformed_of(k));
+            triangles.extend(self.rig.triangles_of(k).iter().map(|t| t.map(|v| v + base)));
+        }
+        anyhow::ensure!(
+            deformed.len() == self.joined.rest.len(),
+            "the parts' meshes changed without a new setup"
+        );
+        self.joined.deformed = deformed;
+        if triangles != self.joined.triangles {
+            self.joined.triangles = triangles;
+        }
+        Ok(())
+    }
+
     /// The packed texture and where the joined mesh samples it.
     pub fn composer(&self) -> &Composer {
         &self.composer
@@ -986,26 +1045,16 @@ impl Deformer for PartsDeformer {
         if setup_of(project) != self.setup || self.rig.follow(project)? == Follow::NeedsSetup {
             return Ok(Follow::NeedsSetup);
         }
-        // A pose moves the vertices; the joined triangles change only where a part's
-        // own drawing order did (a fold within it), and are kept otherwise, so that a
-        // caller keeping them (the editor's automatic depth) sees the same mesh.
-        let mut deformed = std::mem::take(&mut self.joined.deformed);
-        deformed.clear();
-        let mut triangles = Vec::with_capacity(self.joined.triangles.len());
-        for &k in &self.composer.shown {
-            let base = deformed.len() as u32;
-            deformed.extend(self.rig.deformed_of(k));
-            triangles.extend(self.rig.triangles_of(k).iter().map(|t| t.map(|v| v + base)));
-        }
-        anyhow::ensure!(
-            deformed.len() == self.joined.rest.len(),
-            "the parts' meshes changed without a new setup"
-        );
-        self.joined.deformed = deformed;
-        if triangles != self.joined.triangles {
-            self.joined.triangles = triangles;
-        }
+        self.rejoin()?;
         Ok(Follow::Followed)
+    }
+
+    fn set_live(&mut self, live: bool) -> Result<()> {
+        // Out of live mode, the parts solved in full (ARAP's) move their vertices.
+        if self.rig.set_live(live)? {
+            self.rejoin()?;
+        }
+        Ok(())
     }
 
     fn deformed(&self) -> Vec<DVec2> {
@@ -1507,6 +1556,7 @@ impl PartRig {
             bindings: vec![Vec::new(); parts.len()],
             followed: vec![None; parts.len()],
             parts,
+            live: false,
         };
         rig.move_followers();
         Ok(rig)

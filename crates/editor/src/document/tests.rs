@@ -1005,3 +1005,29 @@ fn drawn_as_parts_the_heat_map_and_cells_are_each_parts_own() {
     }
     assert!(cells.iter().filter(|c| c.is_some()).count() > n / 2);
 }
+
+#[test]
+fn under_arap_a_drag_on_parts_is_live_and_its_end_is_what_a_file_renders() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut doc = puppet(dir.path());
+    doc.apply(Edit::Parts(Some(project::PartsSpec::default())))
+        .expect("parts");
+    doc.apply(Edit::Method(Method::Arap)).expect("ARAP");
+    // The raised arm's hand dragged on over five frames.
+    let mut project = doc.project().clone();
+    for _ in 0..5 {
+        if let HandleSpec::Point { translate, .. } = &mut project.handles[4] {
+            translate[0] += 6.0;
+            translate[1] += 4.0;
+        }
+        doc.preview(project.clone()).expect("a drag frame");
+    }
+    let live = doc.deformer().deformed();
+    doc.settle().expect("settled");
+    let settled = doc.deformer().deformed();
+    assert!(
+        live != settled,
+        "a drag frame starts from the last and stops early; its end solves in full"
+    );
+    doc.check_reopens().expect("the end of the drag is what the file renders");
+}
