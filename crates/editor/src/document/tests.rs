@@ -1029,5 +1029,6 @@ fn under_arap_a_drag_on_parts_is_live_and_its_end_is_what_a_file_renders() {
         live != settled,
         "a drag frame starts from the last and stops early; its end solves in full"
     );
-    doc.check_reopens().expect("the end of the drag is what the file renders");
+    doc.check_reopens()
+        .expect("the end of the drag is what the file renders");
 }
