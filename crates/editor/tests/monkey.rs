@@ -795,7 +795,18 @@ fn walk(seed: u64, actions: usize) {
                     let project = d.project();
                     let posed =
                         project.is_posed() && project.handles.len() >= project.overlaid.len() + 2;
-                    (handles, d.mesh_version(), d.deformed().to_vec(), posed)
+                    // Drawn as parts: the joined mesh, and which parts follow others.
+                    let parts = d.parts().map(|p| {
+                        use pipeline::Deformer as _;
+                        (p.rest().to_vec(), p.rig().followed().to_vec())
+                    });
+                    (
+                        handles,
+                        d.mesh_version(),
+                        d.deformed().to_vec(),
+                        posed,
+                        parts,
+                    )
                 });
             let started = Instant::now();
             let what = monkey.act();
@@ -821,15 +832,25 @@ fn walk(seed: u64, actions: usize) {
             with_cuts += usize::from(app.document().is_some_and(|d| !d.project().cuts.is_empty()));
             with_parts += usize::from(app.document().is_some_and(|d| d.parts().is_some()));
             app.sanity_check()?;
-            if let (Some((handles, mesh, shown, posed)), Some(doc)) =
+            if let (Some((handles, mesh, shown, posed, parts)), Some(doc)) =
                 (before, monkey.h.state_mut().document_mut())
             {
                 let now = doc.project().handles.clone();
                 let placed = now.len() == handles.len() + 1 && now[..handles.len()] == handles[..];
-                // (Drawn as parts, a new pin sets its parts up again, on meshes of
-                // their own: not yet held still.)
-                let holding = matches!(doc.method(), project::Method::Arap | project::Method::C2)
-                    && doc.parts().is_none();
+                // Drawn as parts, under ARAP, a new pin holds each part it binds where
+                // it was — unless it binds a part that only followed another until
+                // then, or its parts were meshed anew (C² meshes a pin's point in).
+                let holding = match doc.parts() {
+                    None => matches!(doc.method(), project::Method::Arap | project::Method::C2),
+                    Some(now) => {
+                        use pipeline::Deformer as _;
+                        doc.method() == project::Method::Arap
+                            && parts.as_ref().is_some_and(|(rest, followed)| {
+                                now.rest() == rest.as_slice()
+                                    && now.rig().followed() == followed.as_slice()
+                            })
+                    }
+                };
                 if pinned && placed && doc.mesh_version() == mesh && holding {
                     held += 1;
                     let moved = shown

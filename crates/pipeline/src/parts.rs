@@ -580,6 +580,11 @@ impl PartRig {
         Ok(moved)
     }
 
+    /// For each layer that no handle binds, the layer it follows (if any).
+    pub fn followed(&self) -> &[Option<usize>] {
+        &self.followed
+    }
+
     /// Part `k`'s own method (set up on its own rectangle of the canvas) and the
     /// handles that bind it (the rig file's indices); `None` for a part that follows
     /// another, or is hidden, or moves with a cage.
