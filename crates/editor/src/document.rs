@@ -833,9 +833,9 @@ impl Document {
     /// # Errors
     /// What the method refuses in the pose (as [`Document::restore`]).
     pub fn settle(&mut self) -> Result<()> {
-        let was_live = self.live;
+        let live = self.live.then(|| self.deformer().deformed());
         self.set_live(false)?;
-        if was_live {
+        if live.is_some_and(|live| live != self.deformer().deformed()) {
             // The pose solved in full moved the vertices (ARAP's): shown and arranged
             // anew.
             self.pose_version += 1;

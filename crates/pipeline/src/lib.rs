@@ -634,6 +634,9 @@ pub struct Warper {
     pub canvas: Canvas,
     /// Automatic depth (see [`order`]); `None` where the project turns it off.
     arranger: Option<order::Arranger>,
+    /// The overlap orders of the rig file followed last, which an arrangement starts
+    /// from.
+    overlaps: Vec<project::OverlapOrder>,
 }
 
 impl Warper {
@@ -673,6 +676,7 @@ impl Warper {
             triangles,
             canvas: project.canvas,
             arranger,
+            overlaps: project.overlaps.clone(),
         };
         warper.arrange();
         warper
@@ -687,6 +691,7 @@ impl Warper {
     pub fn follow(&mut self, project: &Project) -> Result<Follow> {
         let followed = self.deformer.follow(project)?;
         if followed == Follow::Followed {
+            self.overlaps.clone_from(&project.overlaps);
             if let Some(arranger) = &mut self.arranger {
                 arranger.restart(
                     &project.overlaps,
@@ -707,6 +712,14 @@ impl Warper {
     pub fn set_live(&mut self, live: bool) -> Result<()> {
         self.deformer.set_live(live)?;
         if !live {
+            // As a new setup for the rig file followed last arranges it.
+            if let Some(arranger) = &mut self.arranger {
+                arranger.restart(
+                    &self.overlaps,
+                    self.deformer.rest(),
+                    self.deformer.triangles(),
+                );
+            }
             self.arrange();
         }
         Ok(())
