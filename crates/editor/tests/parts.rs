@@ -42,14 +42,7 @@ fn drawn_as_parts_the_view_is_the_export_and_a_part_brought_forward_is_saved() {
     }
     assert!(changed(&flat, &parts) > 0.001, "parts draw another picture");
     // The view at full size is the export, which is `render` of the saved project.
-    let gpu = render::GpuContext::new().expect("the software adapter");
-    let view = h.state_mut().view_offscreen(&gpu).expect("the view");
-    let exported = support::export_png(&mut h, dir.path());
-    let differ = changed(&view, &exported);
-    assert!(
-        differ < 0.01,
-        "the view differs from the export at {differ}"
-    );
+    assert_view_is_export(&mut h, dir.path());
     // Undo goes back to one picture; redo to parts.
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
     settle(&mut h);
@@ -85,6 +78,19 @@ fn drawn_as_parts_the_view_is_the_export_and_a_part_brought_forward_is_saved() {
     assert!(
         exported == rendered,
         "the reopened export is render of the saved file"
+    );
+}
+
+/// Asserts that the view, drawn off screen at full size, is the picture *Export PNG*
+/// writes (into `dir`), within a hundredth of its pixels.
+fn assert_view_is_export(h: &mut egui_kittest::Harness<'static, editor::EditorApp>, dir: &Path) {
+    let gpu = render::GpuContext::new().expect("the software adapter");
+    let view = h.state_mut().view_offscreen(&gpu).expect("the view");
+    let exported = support::export_png(h, dir);
+    let differ = changed(&view, &exported);
+    assert!(
+        differ < 0.01,
+        "the view differs from the export at {differ}"
     );
 }
 
@@ -137,14 +143,7 @@ fn a_cage_over_parts_moves_the_parts_in_the_view_as_the_export_draws_them() {
     let doc = h.state().document().expect("doc");
     doc.check_reopens().expect("reopens as shown");
     // The view at full size is the export, `render` of the saved project.
-    let gpu = render::GpuContext::new().expect("the software adapter");
-    let view = h.state_mut().view_offscreen(&gpu).expect("the view");
-    let exported = support::export_png(&mut h, dir.path());
-    let differ = changed(&view, &exported);
-    assert!(
-        differ < 0.01,
-        "the view differs from the export at {differ}"
-    );
+    assert_view_is_export(&mut h, dir.path());
 }
 
 #[test]
