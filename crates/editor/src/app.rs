@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use anyhow::{Context as _, Result};
 use glam::DVec2;
-use project::{Controls, Method, Project};
+use project::Project;
 
 use crate::brush::Brush;
 use crate::cage::CageTool;
@@ -302,10 +302,8 @@ impl EditorApp {
             anyhow::bail!("a cage is being drawn with the {:?} tool", self.tool);
         }
         // Under LBC the cage moves the picture: its tool, or the perform tool's markers.
-        if doc.method().controls() == Controls::Cage
-            && !matches!(self.tool, Tool::Cage | Tool::Perform)
-        {
-            anyhow::bail!("LBC with the {:?} tool", self.tool);
+        if let Some(why) = self.set(doc.controls()).refusal(self.tool) {
+            anyhow::bail!("the {:?} tool is in use, but {why}", self.tool);
         }
         Ok(())
     }
@@ -473,126 +471,6 @@ impl EditorApp {
         self.with_handles(|handles, host| handles.add_bar(host, a, b));
     }
 
-    /// Switches tools; a bar or a cage being drawn is dropped, a cage drag ends. The
-    /// cage tool is LBC's: picking it with a cage kept in the project chooses LBC (one
-    /// undo step); under LBC, the handle tools wait until C² or ARAP is chosen.
-    pub fn set_tool(&mut self, tool: Tool) {
-        let lbc = self
-            .doc
-            .as_ref()
-            .is_some_and(|d| d.method().controls() == Controls::Cage);
-        if lbc && !matches!(tool, Tool::Cage | Tool::Perform) {
-            self.info(
-                "under LBC the cage moves the picture: choose C² weights or ARAP under Method \
-                 to work with handles (the cage stays in the project)",
-            );
-            return;
-        }
-        if tool != Tool::Cage {
-            self.with_cage(|cage, host| {
-                cage.finish_gesture(host);
-                cage.cancel();
-            });
-        }
-        if self.tool == Tool::Perform && tool != Tool::Perform {
-            // The control cursor previews poses; with keys, the timeline's pose is back.
-            self.with_perform(|perform, host| perform.finish_gesture(host));
-            self.show_current_time();
-        }
-        self.tool = tool;
-        self.handles.cancel();
-        if tool == Tool::Cage
-            && !lbc
-            && let Some(doc) = &self.doc
-        {
-            if doc.cage().is_some() {
-                if self.edit(Edit::Method(Method::for_controls(Controls::Cage))) {
-                    self.info("LBC cage: the cage kept in the project warps the picture");
-                }
-            } else {
-                self.info(
-                    "draw a cage: click around the subject, then click the first vertex \
-                     (or double-click, or press Enter) to close it — or use Cage from \
-                     outline",
-                );
-            }
-        }
-    }
-
-    /// Under LBC the cage tool is the tool (handles act under C² and ARAP): after any
-    /// change that may have chosen LBC (an undo, an opened project), it is picked.
-    pub(crate) fn sync_tool(&mut self) {
-        let lbc = self
-            .doc
-            .as_ref()
-            .is_some_and(|d| d.method().controls() == Controls::Cage);
-        if lbc && !matches!(self.tool, Tool::Cage | Tool::Perform) {
-            self.with_handles(|handles, host| handles.finish_gesture(host));
-            self.tool = Tool::Cage;
-            self.brush.cancel();
-        }
-    }
-
-    /// After a step through the history: the tool the new state calls for. Into LBC,
-    /// the cage tool; out of LBC with no cage being drawn, the cage tool has nothing
-    /// left to act on, so the puppet tool.
-    fn sync_tool_after_history(&mut self, was_lbc: bool) {
-        let lbc = self
-            .doc
-            .as_ref()
-            .is_some_and(|d| d.method().controls() == Controls::Cage);
-        if was_lbc && !lbc && self.tool == Tool::Cage && self.cage.draft().is_none() {
-            self.end_cage_gesture();
-            self.tool = Tool::Puppet;
-        }
-        self.sync_tool();
-    }
-
-    /// Chooses a warping method (one undo step). LBC without a cage starts the cage
-    /// tool, to draw one; leaving LBC leaves the cage tool and keeps the cage.
-    pub fn choose_method(&mut self, method: Method) {
-        let Some(doc) = &self.doc else { return };
-        if method == doc.method() {
-            // Drawing a cage for LBC, and back to the method already in use.
-            if method.controls() != Controls::Cage && self.tool == Tool::Cage {
-                self.set_tool(Tool::Puppet);
-                self.info(format!("{}: drawing the cage dropped", method.label()));
-            }
-            return;
-        }
-        if method.controls() == Controls::Cage {
-            self.set_tool(Tool::Cage);
-            if !matches!(self.message.as_ref(), Some(m) if m.is_error) {
-                let has_cage = self.doc.as_ref().is_some_and(|d| d.cage().is_some());
-                if !has_cage {
-                    self.info(
-                        "LBC cage: click a polygon around the subject (or Cage from outline), \
-                         then Solve",
-                    );
-                }
-            }
-            return;
-        }
-        if self.edit(Edit::Method(method)) {
-            if self.tool == Tool::Cage {
-                self.set_tool(Tool::Puppet);
-            }
-            let cut_out = self
-                .doc
-                .as_ref()
-                .is_some_and(|d| !d.rig().domain().is_convex());
-            if method == Method::Mls && cut_out && !self.mls_warned {
-                // Once a document: the one surprise MLS has in store on a cut-out.
-                self.mls_warned = true;
-                self.info(
-                    "MLS on a cut-out: its distances are straight lines, not paths inside                      the shape, so a pin moved far from a part it does not hold, across a                      gap, pulls a needle out of that part; pin the parts, or use ARAP or C²                      weights, which keep to the shape",
-                );
-            } else {
-                self.info(format!("{}: {}", method.label(), method.about()));
-            }
-        }
-    }
-
     /// Deletes the selected handle.
     pub fn delete_selected(&mut self) {
         self.with_handles(|handles, host| handles.delete_selected(host));
@@ -629,9 +507,8 @@ impl EditorApp {
         };
         // A posed cage whose coordinates are no longer kept is solved first, on the
         // worker; the history moves when they are in.
-        if target.method.controls() == Controls::Cage
-            && target.cage.as_ref().is_some_and(|c| c.pose.is_some())
-            && let Some(key) = CageKey::of(target)
+        if target.cage.as_ref().is_some_and(|c| c.pose.is_some())
+            && let Some(key) = CageKey::in_use(target)
             && doc.solution_for(&key).is_none()
             && key.problem().is_none()
         {
@@ -669,7 +546,7 @@ impl EditorApp {
             self.history.redo(current)
         };
         let Some((target, what)) = taken else { return };
-        let was_lbc = doc.project().method.controls() == Controls::Cage;
+        let was = doc.controls();
         match doc.undo_to(target.clone()) {
             Ok(()) => {
                 self.dirty = true;
@@ -682,7 +559,7 @@ impl EditorApp {
                 {
                     self.selected = None;
                 }
-                self.sync_tool_after_history(was_lbc);
+                self.sync_tool_after_history(was);
                 self.show_current_time();
                 self.info(format!(
                     "{}: {what}",
@@ -703,16 +580,20 @@ impl EditorApp {
     /// # Errors
     /// No picture open, a grown canvas too large, or a GPU failure.
     pub fn view_offscreen(&mut self, gpu: &render::GpuContext) -> Result<image::RgbaImage> {
+        let (in_hand, warping) = (self.in_hand(), self.cage_warping());
         let Some(doc) = &mut self.doc else {
             anyhow::bail!("no picture is open");
         };
         let (w, h) = doc.image.dimensions();
         let canvas = doc.project().canvas;
-        let lbc = doc.method().controls() == Controls::Cage;
-        let deformed: Vec<glam::Vec2> = match doc.cage_deformed() {
-            Some(cage) if lbc => cage.iter().map(|p| p.as_vec2()).collect(),
-            _ => doc.deformed().iter().map(|p| p.as_vec2()).collect(),
+        // The frame of what the view draws (a cage's mesh, or the picture's or parts').
+        let cage: Option<Vec<glam::Vec2>> = match doc.shown(in_hand, warping) {
+            crate::document::Shown::Cage(Some(cage)) => {
+                Some(cage.positions().iter().map(|p| p.as_vec2()).collect())
+            }
+            _ => None,
         };
+        let deformed = cage.unwrap_or_else(|| doc.deformed().iter().map(|p| p.as_vec2()).collect());
         let frame = pipeline::Frame::new(w, h, &deformed, canvas)?;
         self.update_gpu_frame();
         Ok(self.gpu.frame.draw_offscreen(gpu, frame)?)
@@ -721,15 +602,13 @@ impl EditorApp {
     /// Brings the GPU frame up to date with the document as the view shows it (see
     /// [`FrameBuilder::update`]); the canvas calls it every frame.
     pub fn update_gpu_frame(&mut self) {
-        let cage_view = self.cage_view();
+        let in_hand = self.in_hand();
+        let controls = self.set(in_hand);
         let view = View {
-            cage_view,
+            in_hand,
+            uses_weights: controls.uses_weights(),
             warping: self.cage_warping(),
-            shown: if cage_view {
-                self.cage.focus()
-            } else {
-                self.selected
-            },
+            shown: controls.heat_subject(self),
             show: self.show,
         };
         if let Some(doc) = &self.doc {

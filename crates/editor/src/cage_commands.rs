@@ -3,9 +3,8 @@
 //! run by the tool.
 
 use glam::DVec2;
-use project::Controls;
 
-use crate::app::{EditorApp, Tool};
+use crate::app::EditorApp;
 use crate::cage::{CageState, CageTool};
 use crate::tool::Host;
 
@@ -32,16 +31,6 @@ impl EditorApp {
     /// The polygon being drawn, if any (image pixels).
     pub fn cage_draft(&self) -> Option<&[DVec2]> {
         self.cage.draft()
-    }
-
-    /// Whether the canvas shows the picture as the cage tool sees it (at rest, with a
-    /// solved cage's inside warped) rather than warped by handles.
-    pub(crate) fn cage_view(&self) -> bool {
-        self.tool == Tool::Cage
-            || self
-                .doc
-                .as_ref()
-                .is_some_and(|d| d.method().controls() == Controls::Cage)
     }
 
     /// Whether a solved cage warps the view: LBC with its cage solved, and no new

@@ -5,7 +5,6 @@
 
 use egui::{Color32, Key, PointerButton, Pos2, Rect, Sense, Ui, Vec2};
 use glam::DVec2;
-use weights_core::NodeKind;
 
 use crate::app::{EditorApp, Tool};
 use crate::scene::MeshCallback;
@@ -62,17 +61,14 @@ impl EditorApp {
             }
         }
         self.paint_onion(ui, &painter);
-        let cage_view = self.cage_view();
+        let in_hand = self.in_hand();
         if self.has_gpu {
             let (scale, offset) = self.viewport.device_map();
-            let shown = if cage_view {
-                self.cage.focus().filter(|_| self.cage_warping())
-            } else {
-                self.selected
-            };
+            let controls = self.set(in_hand);
+            let shown = controls.heat_subject(self);
             let overlay = if self.show.heat && shown.is_some() {
                 render::Overlay::Heat
-            } else if self.show.cells && !cage_view {
+            } else if self.show.cells && controls.uses_weights() {
                 render::Overlay::Cells
             } else {
                 render::Overlay::None
@@ -103,23 +99,18 @@ impl EditorApp {
         if self.show.overlaps {
             self.paint_overlaps(&painter);
         }
-        if cage_view {
-            let pointer = ui.input(|i| i.pointer.latest_pos());
-            let active = self.tool == Tool::Cage;
-            self.with_cage(|cage, host| cage.paint(host, &painter, pointer, active));
-        } else {
-            let pointer = ui.input(|i| i.pointer.latest_pos());
-            let brushing = self.tool == Tool::Rigidity;
-            let hover = pointer.filter(|p| rect.contains(*p));
-            self.with_brush(|brush, host| brush.paint(host, &painter, hover, brushing));
-            let cutting = self.tool == Tool::Cut;
-            self.with_cut(|cut, host| cut.paint(host, &painter, hover, cutting));
-            let active = matches!(
-                self.tool,
-                Tool::Puppet | Tool::Select | Tool::AddPoint | Tool::AddBar
-            );
-            self.with_handles(|handles, host| handles.paint(host, &painter, pointer, active));
+        // The controls in hand, and the marks of the tools beside them (painted
+        // rigidity, cuts), each shown as in use when it is the tool.
+        let pointer = ui.input(|i| i.pointer.latest_pos());
+        let hover = pointer.filter(|p| rect.contains(*p));
+        for &companion in self.set(in_hand).companions() {
+            let active = self.tool == companion;
+            self.with_tool(companion, |tool, host| {
+                tool.paint(host, &painter, hover, active);
+            });
         }
+        let active = self.set(in_hand).owns(self.tool);
+        self.with_controls(|controls, host| controls.paint(host, &painter, pointer, active));
         let pointer = ui.input(|i| i.pointer.latest_pos());
         let performing = self.tool == Tool::Perform;
         if performing || self.perform.cursor.is_some() {
@@ -253,51 +244,6 @@ impl EditorApp {
         }
     }
 
-    /// Where ARAP takes the mesh vertex under screen point `pos`, as text.
-    fn positions_readout_at(&mut self, pos: Pos2) -> Option<String> {
-        // (Drawn as parts, the mesh shown is the parts', not the picture's.)
-        let doc = self.doc.as_mut().filter(|d| d.parts().is_none())?;
-        let method = doc.method().label();
-        let (rest, _, _) = doc.unwarp(self.viewport.to_image(pos))?;
-        let vertex = doc.rig().domain().nearest_vertex(rest)? as usize;
-        let at = doc.rig().domain().positions()[vertex];
-        let to = *doc.deformed().get(vertex)?;
-        Some(format!(
-            "vertex {vertex} at ({:.1}, {:.1})\n{method} moves it to ({:.1}, {:.1})",
-            at.x, at.y, to.x, to.y
-        ))
-    }
-
-    /// The C² weights of the mesh vertex under screen point `pos`, as text.
-    fn handle_weights_at(&mut self, pos: Pos2) -> Option<String> {
-        let doc = self.doc.as_mut().filter(|d| d.parts().is_none())?;
-        let (rest, _, _) = doc.unwarp(self.viewport.to_image(pos))?;
-        let rig = doc.rig();
-        let vertex = rig.domain().nearest_vertex(rest)?;
-        let mut weights: Vec<(usize, f64)> = rig.weights(vertex as usize).collect();
-        weights.sort_by(|a, b| b.1.total_cmp(&a.1));
-        let lines: Vec<String> = weights
-            .iter()
-            .take(5)
-            .map(|&(k, w)| format!("{:>6.3}  {}", w, node_name(rig, k)))
-            .collect();
-        let more = weights.len().saturating_sub(5);
-        let mut text = format!(
-            "vertex {vertex} at ({:.1}, {:.1}): {} weights",
-            rest.x,
-            rest.y,
-            weights.len()
-        );
-        for line in &lines {
-            text.push('\n');
-            text.push_str(line);
-        }
-        if more > 0 {
-            text.push_str(&format!("\n… and {more} smaller"));
-        }
-        Some(text)
-    }
-
     /// A box beside the pointer with the weights of the mesh vertex under it.
     fn hover_weights(&mut self, ui: &Ui, response: &egui::Response) {
         self.hover_readout = None;
@@ -312,27 +258,8 @@ impl EditorApp {
         let Some(pos) = response.hover_pos() else {
             return;
         };
-        let text = if self.cage_view() {
-            match self.with_cage(|cage, host| cage.readout(host, pos)) {
-                Some(text) => text,
-                None => return,
-            }
-        } else if self
-            .doc
-            .as_ref()
-            .is_some_and(|d| matches!(d.deformer().output(), pipeline::Output::Positions(_)))
-        {
-            // A method that solves for positions has no weights: where it takes the
-            // vertex under the pointer.
-            match self.positions_readout_at(pos) {
-                Some(text) => text,
-                None => return,
-            }
-        } else {
-            match self.handle_weights_at(pos) {
-                Some(text) => text,
-                None => return,
-            }
+        let Some(text) = self.with_controls(|controls, host| controls.readout(host, pos)) else {
+            return;
         };
         // Painted rather than an egui tooltip: it follows the pointer at once, also
         // while the pointer moves.
@@ -360,38 +287,18 @@ impl EditorApp {
     }
 }
 
-/// How a node is called in the user interface.
-pub(crate) fn node_name(rig: &weights_core::Rig, k: usize) -> String {
-    match rig.nodes()[k].kind {
-        NodeKind::Point { handle } => format!("point handle {}", handle + 1),
-        NodeKind::BarSample { handle, t } => format!("bar {} at {:.0}%", handle + 1, t * 100.0),
-        NodeKind::Boundary => "pinned border".to_owned(),
-        NodeKind::Virtual => match rig.owner_handle(k) {
-            Some(h) => format!("virtual node {k} (mostly handle {})", h + 1),
-            None => format!("virtual node {k}"),
-        },
-    }
-}
-
 impl EditorApp {
     /// The overlap regions of the shown pose outlined: each sheet's boundary (its
     /// triangles' edges that no other triangle of the sheet shares), the front sheet
     /// in yellow, the back one in blue.
     fn paint_overlaps(&mut self, painter: &egui::Painter) {
-        let Some(doc) = &mut self.doc else { return };
-        let cage = doc.method().controls() == pipeline::Controls::Cage;
-        let (positions, triangles): (Vec<DVec2>, Vec<[u32; 3]>) = if cage {
-            match doc.cage_deformer() {
-                Some(c) => (
-                    pipeline::Deformer::deformed(c),
-                    pipeline::Deformer::triangles(c).to_vec(),
-                ),
-                None => return,
-            }
-        } else {
-            let triangles = doc.deformer().triangles().to_vec();
-            (doc.deformed().to_vec(), triangles)
+        let (in_hand, warping) = (self.in_hand(), self.cage_warping());
+        let Some(doc) = &self.doc else { return };
+        // The mesh the view draws (none: the picture at rest, nothing overlaps).
+        let Some(shown) = doc.shown(in_hand, warping).deformer() else {
+            return;
         };
+        let (positions, triangles) = (shown.deformed(), shown.triangles());
         let viewport = &self.viewport;
         let outline = |sheet: &[u32], colour: Color32| {
             let mut edges: std::collections::HashMap<(u32, u32), u32> =

@@ -27,11 +27,13 @@ mod animation;
 mod cage;
 mod checks;
 mod depth;
+mod shown;
 #[cfg(test)]
 mod tests;
 
 pub use animation::PosedMesh;
 pub use cage::{CageKey, solve_cage};
+pub use shown::Shown;
 
 /// The parameters of the weighting a user can change in the side panel.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -2,10 +2,11 @@
 //! document each frame, part by part, each part with a new version only when it
 //! changed (the paint callback in [`crate::scene`] uploads what has a new version).
 //!
-//! The mesh is whatever the shown method draws, through the method seam: the handle
-//! methods draw the picture's mesh skinned by the C² rig (its weights also feed the
-//! heat map and cells), with the positions a method solves for laid over it
-//! ([`pipeline::Output::Positions`]); a cage method draws its own mesh skinned by its
+//! The mesh is what the document shows for the controls in hand ([`Shown`]), through
+//! the method seam: the handle methods draw the picture's mesh skinned by the C² rig
+//! (its weights also feed the heat map and cells), with the positions a method solves
+//! for laid over it ([`pipeline::Output::Positions`]); parts draw their joined mesh by
+//! positions over their packed texture; a cage method draws its own mesh skinned by its
 //! own table, over its backdrop ([`pipeline::backdrop_of`]). While a cage is drawn or
 //! not yet solved, the picture is shown at rest with no mesh.
 
@@ -13,17 +14,19 @@ use std::sync::Arc;
 
 use anyhow::{Result, bail};
 use glam::DVec2;
-use pipeline::{Deformer, Output};
+use pipeline::{Controls, Deformer, Output};
 
-use crate::document::Document;
+use crate::document::{Document, Shown};
 use crate::scene::{GpuFrame, MeshData, Versioned};
 use crate::show::Show;
 
 /// What the view shows, as the app decides it this frame.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct View {
-    /// The cage's view: the cage tool, or LBC chosen.
-    pub cage_view: bool,
+    /// The controls the tools act on (the cage's view: the cage tool, or LBC chosen).
+    pub in_hand: Controls,
+    /// Whether the handles' weights apply (cells, the dual graph, the handles' heat).
+    pub uses_weights: bool,
     /// A solved cage warps the picture (no new polygon being drawn).
     pub warping: bool,
     /// The handle or cage vertex whose weights the heat map shows.
@@ -52,8 +55,8 @@ struct Seen {
     pose: u64,
     heat: Option<(usize, u64)>,
     cells: u64,
-    /// Whether the frame showed the cage tool's view.
-    cage_view: bool,
+    /// The controls in hand the frame was drawn for.
+    in_hand: Option<Controls>,
     /// Whether a solved cage warped it.
     warping: bool,
     /// The picture and rest mesh the backdrop was made for.
@@ -72,14 +75,13 @@ impl FrameBuilder {
     /// structural change, transforms or positions after a pose change, overlay values
     /// when asked for.
     pub fn update(&mut self, doc: &Document, view: &View) {
-        // The cage method's deformer, when it warps the view.
-        let cage = doc
-            .cage_deformer()
-            .filter(|_| view.cage_view && view.warping)
-            .map(|cage| cage as &dyn Deformer);
+        let shown = doc.shown(view.in_hand, view.warping);
         let weights = doc.weights_version;
         // Drawn as parts: the joined mesh samples the layers' pixels packed together.
-        let parts = doc.parts().filter(|_| shows_parts(doc, view.cage_view));
+        let parts = match shown {
+            Shown::Parts(parts) => Some(parts),
+            _ => None,
+        };
         let parts_key = parts.map(|p| std::ptr::from_ref(p.composer()) as usize);
         let parts_changed = parts_key != self.seen.parts.as_ref().map(|(key, _)| *key);
         if parts_changed {
@@ -107,36 +109,29 @@ impl FrameBuilder {
             || parts_changed
             || weights != self.seen.weights
             || doc.order_version != self.seen.order
-            || view.cage_view != self.seen.cage_view
+            || Some(view.in_hand) != self.seen.in_hand
             || view.warping != self.seen.warping;
         if mesh_changed {
-            self.update_mesh(doc, view.cage_view, cage, parts.is_some());
+            self.update_mesh(doc, shown);
         }
         if mesh_changed || doc.pose_version != self.seen.pose {
-            self.update_pose(doc, view.cage_view, cage, parts.is_some());
+            self.update_pose(doc, shown);
         }
-        self.update_overlays(doc, view);
+        self.update_overlays(doc, shown, view);
         self.seen.weights = weights;
         self.seen.order = doc.order_version;
         self.seen.pose = doc.pose_version;
-        self.seen.cage_view = view.cage_view;
+        self.seen.in_hand = Some(view.in_hand);
         self.seen.warping = view.warping;
     }
 
     /// The mesh with its weight rows and triangles in drawing order; in the cage's
     /// view, the backdrop under it.
-    fn update_mesh(
-        &mut self,
-        doc: &Document,
-        cage_view: bool,
-        cage: Option<&dyn Deformer>,
-        as_parts: bool,
-    ) {
+    fn update_mesh(&mut self, doc: &Document, shown: Shown) {
         let size = [doc.image.width(), doc.image.height()];
-        let mesh = match (cage_view, cage) {
+        let mesh = match shown {
             // The joined mesh at the texture's places, moved by positions alone.
-            _ if as_parts => {
-                let parts = doc.parts().expect("drawn as parts");
+            Shown::Parts(parts) => {
                 let texture = parts.composer().texture().dimensions();
                 MeshData {
                     rest: parts.composer().uv().to_vec(),
@@ -146,19 +141,19 @@ impl FrameBuilder {
                     ..MeshData::default()
                 }
             }
-            (true, Some(cage)) => {
+            Shown::Cage(Some(cage)) => {
                 let order = doc
                     .cage_draw_order()
                     .unwrap_or_else(|| cage.triangles().to_vec());
                 skinned_mesh(cage, order, size)
             }
             // No cage to warp by: the picture at rest alone.
-            (true, None) => MeshData {
+            Shown::Cage(None) => MeshData {
                 rows: vec![0],
                 source_size: size,
                 ..MeshData::default()
             },
-            (false, _) => skinned_mesh(doc.rig(), doc.draw_order(), size),
+            Shown::Picture(_) => skinned_mesh(doc.rig(), doc.draw_order(), size),
         };
         let version = self.bump();
         self.frame.mesh = Versioned {
@@ -167,17 +162,17 @@ impl FrameBuilder {
         };
         self.seen.heat = None;
         self.seen.cells = 0;
-        if as_parts {
+        if let Shown::Parts(_) = shown {
             // Overlay values for another mesh are not the parts' (see
             // `update_overlays`).
             self.frame.heat.value = Arc::new(Vec::new());
             self.frame.cells.value = Arc::new(Vec::new());
         }
-        if !cage_view || as_parts {
+        let Shown::Cage(cage) = shown else {
             self.frame.backdrop = None;
             self.seen.backdrop = None;
             return;
-        }
+        };
         let rest = cage.map(|c| c.rest().to_vec()).unwrap_or_default();
         let same = self
             .seen
@@ -199,30 +194,16 @@ impl FrameBuilder {
     }
 
     /// The node transforms, and the positions a method solves for.
-    fn update_pose(
-        &mut self,
-        doc: &Document,
-        cage_view: bool,
-        cage: Option<&dyn Deformer>,
-        as_parts: bool,
-    ) {
-        let (affines, positions) = match (cage_view, cage) {
-            _ if as_parts => {
-                let positions = match doc.deformer().output() {
-                    Output::Positions(p) => p.iter().map(|p| p.as_vec2()).collect(),
-                    Output::Skinned(_) => Vec::new(),
-                };
-                (Vec::new(), positions)
-            }
-            (true, Some(cage)) => (transforms(cage), Vec::new()),
-            (true, None) => (Vec::new(), Vec::new()),
-            (false, _) => {
-                let positions = match doc.deformer().output() {
-                    Output::Skinned(_) => Vec::new(),
-                    Output::Positions(p) => p.iter().map(|p| p.as_vec2()).collect(),
-                };
-                (doc.rig().node_affines(), positions)
-            }
+    fn update_pose(&mut self, doc: &Document, shown: Shown) {
+        let positions = |deformer: &dyn Deformer| match deformer.output() {
+            Output::Positions(p) => p.iter().map(|p| p.as_vec2()).collect(),
+            Output::Skinned(_) => Vec::new(),
+        };
+        let (affines, positions) = match shown {
+            Shown::Parts(parts) => (Vec::new(), positions(parts)),
+            Shown::Cage(Some(cage)) => (transforms(cage), Vec::new()),
+            Shown::Cage(None) => (Vec::new(), Vec::new()),
+            Shown::Picture(deformer) => (doc.rig().node_affines(), positions(deformer)),
         };
         let version = self.bump();
         self.frame.pose = Versioned {
@@ -238,22 +219,19 @@ impl FrameBuilder {
 
     /// The heat map of the shown handle or cage vertex, the cells, the dual graph: each
     /// when on and out of date.
-    fn update_overlays(&mut self, doc: &Document, view: &View) {
+    fn update_overlays(&mut self, doc: &Document, shown: Shown, view: &View) {
         // Drawn as parts: the heat map and cells are each part's own C² rig's, on the
-        // parts' mesh (none for a part another method moves); the cage's heat map and
-        // the dual graph are on other meshes than the parts'.
-        let parts = shows_parts(doc, view.cage_view);
+        // parts' mesh (none for a part another method moves, or under a cage); the
+        // cage's heat map and the dual graph are on other meshes than the parts'.
         let weights = doc.weights_version;
         let heat_key = view.shown.filter(|_| view.show.heat).map(|s| (s, weights));
-        if let Some((shown, _)) = heat_key
+        if let Some((subject, _)) = heat_key
             && heat_key != self.seen.heat
         {
-            let values = if parts && view.cage_view {
-                Vec::new()
-            } else if view.cage_view {
-                doc.cage_influence(shown).unwrap_or_default()
-            } else {
-                doc.influence(shown)
+            let values = match shown {
+                Shown::Cage(_) => doc.cage_influence(subject).unwrap_or_default(),
+                _ if !view.uses_weights => Vec::new(),
+                _ => doc.influence(subject),
             };
             let version = self.bump();
             self.frame.heat = Versioned {
@@ -262,7 +240,7 @@ impl FrameBuilder {
             };
             self.seen.heat = heat_key;
         }
-        if view.show.cells && !view.cage_view && self.seen.cells != weights {
+        if view.show.cells && view.uses_weights && self.seen.cells != weights {
             // A sample that no node reaches (a rig without nodes, or a piece of the
             // shape without a handle) has no cell: grey.
             let colors = (doc.cell_keys().into_iter())
@@ -277,7 +255,11 @@ impl FrameBuilder {
         }
         // Keyed by the GPU mesh's version, which no other document shares.
         let mesh_version = self.frame.mesh.version;
-        if view.show.dual_graph && !view.cage_view && !parts && self.dual_graph.0 != mesh_version {
+        if view.show.dual_graph
+            && view.uses_weights
+            && matches!(shown, Shown::Picture(_))
+            && self.dual_graph.0 != mesh_version
+        {
             self.dual_graph = (mesh_version, Arc::new(doc.rig().dual_graph()));
         }
     }
@@ -289,19 +271,16 @@ impl FrameBuilder {
         if self.seen.weights != doc.weights_version || self.frame.mesh.version == 0 {
             return Ok(());
         }
+        let Some(in_hand) = self.seen.in_hand else {
+            return Ok(());
+        };
         let mesh = &self.frame.mesh.value;
-        let shown_parts = doc
-            .parts()
-            .filter(|_| shows_parts(doc, self.seen.cage_view));
-        let (samples, what) = if let Some(parts) = shown_parts {
-            (parts.rest().len(), "the parts")
-        } else if !self.seen.cage_view {
-            (doc.rig().domain().len(), "the rig")
-        } else if self.seen.warping {
-            let solved = doc.cage_deformer().map(|c| c.rest().len());
-            (solved.unwrap_or(0), "the cage's mesh")
-        } else {
-            (0, "no mesh (a cage being drawn)")
+        let shown = doc.shown(in_hand, self.seen.warping);
+        let (samples, what) = match shown {
+            Shown::Parts(parts) => (parts.rest().len(), "the parts"),
+            Shown::Picture(_) => (doc.rig().domain().len(), "the rig"),
+            Shown::Cage(Some(cage)) => (cage.rest().len(), "the cage's mesh"),
+            Shown::Cage(None) => (0, "no mesh (a cage being drawn)"),
         };
         if mesh.rest.len() != samples || mesh.rows.len() != samples + 1 {
             bail!(
@@ -309,7 +288,7 @@ impl FrameBuilder {
                 mesh.rest.len()
             );
         }
-        if self.seen.cage_view && shown_parts.is_none() && self.frame.backdrop.is_none() {
+        if shown.over_backdrop() && self.frame.backdrop.is_none() {
             bail!("the cage's view without the picture at rest under it");
         }
         Ok(())
@@ -358,13 +337,6 @@ pub(crate) fn cell_color(key: u32) -> [u8; 4] {
     let hue = (key.wrapping_mul(2_654_435_761) >> 8) as f32 / (1u32 << 24) as f32;
     let rgb = egui::ecolor::Hsva::new(hue, 0.75, 0.95, 1.0).to_srgb();
     [rgb[0], rgb[1], rgb[2], 255]
-}
-
-/// Whether the view draws `doc`'s parts (drawn as parts): under handles outside the
-/// cage's view (which draws the picture at rest while a cage is drawn), and always
-/// under a cage method, whose cage moves the parts.
-fn shows_parts(doc: &Document, cage_view: bool) -> bool {
-    doc.parts().is_some() && (!cage_view || doc.method().controls() == pipeline::Controls::Cage)
 }
 
 #[cfg(test)]

@@ -4,8 +4,7 @@
 use std::time::Instant;
 
 use egui::{Key, KeyboardShortcut, Modifiers, Ui};
-use pipeline::ArapRig;
-use project::{Controls, Method, MetricChoice, Middle, Placement};
+use project::{Method, MetricChoice, Middle, Placement};
 
 use crate::app::{EditorApp, Pending, Tool};
 use crate::dialogs::FileAction;
@@ -150,13 +149,13 @@ impl eframe::App for EditorApp {
             });
         // Beside the cage tool's view whenever it shows, so that solving does not
         // resize the canvas under the pointer.
-        if self.show.locality && self.cage_view() {
+        if self.set(self.in_hand()).has_aside(self.show) {
             egui::Panel::right("locality")
                 .resizable(false)
                 .default_size(300.0)
                 .show(ui, |ui| {
                     egui::ScrollArea::vertical().show(ui, |ui| {
-                        self.with_cage(|cage, host| cage.locality_panel(host, ui));
+                        self.with_controls(|controls, host| controls.aside(host, ui));
                     });
                 });
         }
@@ -480,35 +479,19 @@ impl EditorApp {
         }
     }
 
+    /// The edit buttons of the controls that move the picture.
     fn edit_buttons(&mut self, ui: &mut Ui) {
-        if self
-            .doc
-            .as_ref()
-            .is_some_and(|d| d.method().controls() == Controls::Cage)
-        {
-            self.with_cage(|cage, host| cage.edit_buttons(host, ui));
-            return;
-        }
-        if ui
-            .add_enabled(self.selected.is_some(), egui::Button::new("Delete handle"))
-            .clicked()
-        {
-            self.delete_selected();
-        }
-        if ui.button("Clear all handles").clicked() {
-            let _ = self.edit(Edit::Clear);
-            self.selected = None;
-        }
-        if ui.button("Reset pose").clicked() {
-            let _ = self.edit(Edit::ResetPose);
-        }
+        self.with_set(self.controls(), |controls, host| {
+            controls.edit_buttons(host, ui)
+        });
     }
 
     /// The overlays' checkboxes; with the cage tool's view, the ones that apply to it.
     fn overlay_toggles(&mut self, ui: &mut Ui) {
-        let cage = self.cage_view();
+        let controls = self.set(self.in_hand());
+        let (weighted, heat_hint) = (controls.uses_weights(), controls.heat_hint());
         ui.checkbox(&mut self.show.mesh, "Show mesh");
-        if !cage {
+        if weighted {
             // Virtual handles and their dual graph belong to the C² weights.
             let c2 = self
                 .doc
@@ -527,11 +510,7 @@ impl EditorApp {
             });
         }
         ui.checkbox(&mut self.show.heat, "Weight heat map")
-            .on_hover_text(if cage {
-                "The selected cage vertex's coordinate, with isolines every 0.1"
-            } else {
-                "The selected handle's weight, with isolines every 0.1"
-            });
+            .on_hover_text(heat_hint);
         ui.checkbox(&mut self.show.folds, "Fold-overs");
         ui.checkbox(&mut self.show.overlaps, "Overlap regions")
             .on_hover_text(
@@ -539,7 +518,7 @@ impl EditorApp {
              yellow, the part behind in blue (automatic depth)",
             );
         ui.checkbox(&mut self.show.hover_weights, "Weights under cursor");
-        if !cage {
+        if weighted {
             ui.checkbox(&mut self.show.rigidity, "Painted rigidity");
         }
     }
@@ -548,11 +527,6 @@ impl EditorApp {
         ui.heading("Tools");
         ui.horizontal_wrapped(|ui| {
             let mut tool = self.tool;
-            // Under LBC the cage moves the picture: handles wait for C² or ARAP.
-            let handles = self
-                .doc
-                .as_ref()
-                .is_none_or(|d| d.method().controls() != Controls::Cage);
             let tools = [
                 (
                     Tool::Puppet,
@@ -597,11 +571,13 @@ impl EditorApp {
                 ),
             ];
             for (t, label, hover) in tools {
-                let enabled = handles || matches!(t, Tool::Cage | Tool::Perform);
+                // Under LBC the cage moves the picture: handles wait for C² or ARAP.
+                let refusal = self.tool_refusal(t);
                 let button = egui::Button::selectable(tool == t, label);
                 if ui
-                    .add_enabled(enabled, button)
+                    .add_enabled(refusal.is_none(), button)
                     .on_hover_text(hover)
+                    .on_disabled_hover_text(refusal.unwrap_or_default())
                     .clicked()
                 {
                     tool = t;
@@ -632,9 +608,14 @@ impl EditorApp {
         }
         ui.checkbox(&mut self.auto_rotate, "Auto-rotate points")
             .on_hover_text("Point handles turn with their neighbours' motion");
-        // The selected handle right under the tools, so it shows whatever else the
-        // panel holds.
-        self.with_handles(|handles, host| handles.panel(host, ui));
+        // The section of the controls in hand (the selected handle, or the cage)
+        // right under the tools, so it shows whatever else the panel holds.
+        self.with_controls(|controls, host| controls.panel(host, ui));
+        // A cage begun from the panel (New cage, under the perform tool) is drawn
+        // with the cage tool.
+        if self.cage.draft().is_some() && self.tool != Tool::Cage {
+            self.set_tool(Tool::Cage);
+        }
         ui.separator();
         ui.heading("Method");
         self.method_choice(ui);
@@ -649,26 +630,12 @@ impl EditorApp {
             self.layers_panel(ui);
             ui.separator();
         }
-        let lbc = self
-            .doc
-            .as_ref()
-            .is_some_and(|d| d.method().controls() == Controls::Cage);
-        if lbc || self.tool == Tool::Cage {
-            ui.heading("Cage");
-            self.with_cage(|cage, host| cage.panel(host, ui));
-            // A cage begun from the panel (New cage, under the perform tool) is drawn
-            // with the cage tool.
-            if self.cage.draft().is_some() && self.tool != Tool::Cage {
-                self.set_tool(Tool::Cage);
-            }
-            ui.separator();
-        }
         if self.doc.as_ref().is_some_and(|d| d.method() == Method::Mls) {
             ui.heading("MLS");
             self.mls_panel(ui);
             ui.separator();
         }
-        if !lbc {
+        if self.set(self.controls()).uses_weights() {
             ui.heading("Weights");
             self.parameters(ui);
             ui.separator();
@@ -742,10 +709,11 @@ impl EditorApp {
     /// tool draws a cage (drawing one is LBC's, even before it exists).
     pub fn method_shown(&self) -> Option<Method> {
         let doc = self.doc.as_ref()?;
-        Some(if self.tool == Tool::Cage {
-            Method::for_controls(Controls::Cage)
-        } else {
+        let in_hand = self.in_hand();
+        Some(if in_hand == doc.controls() {
             doc.method()
+        } else {
+            Method::for_controls(in_hand)
         })
     }
 

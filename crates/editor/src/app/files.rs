@@ -282,8 +282,7 @@ impl ExportSetup {
     /// What exporting `project` (the document's, as saved) needs of `doc`.
     pub(super) fn of(doc: &Document, project: &project::Project) -> Self {
         Self(
-            CageKey::of(project)
-                .filter(|_| project.method.controls() == Controls::Cage)
+            CageKey::in_use(project)
                 .map(|key| (doc.solution_for(&key).cloned(), key, doc.cage_pose())),
         )
     }

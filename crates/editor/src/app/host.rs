@@ -145,6 +145,25 @@ impl EditorApp {
         out
     }
 
+    /// Runs `f` on the tool that acts as `tool` with the app as its host (lent out
+    /// for the call): the handle tools for theirs, the brush, the cut tool, the cage
+    /// tool, the perform tool.
+    pub(crate) fn with_tool<R>(
+        &mut self,
+        tool: Tool,
+        f: impl FnOnce(&mut dyn CanvasTool, &mut dyn Host) -> R,
+    ) -> R {
+        match tool {
+            Tool::Puppet | Tool::Select | Tool::AddPoint | Tool::AddBar => {
+                self.with_handles(|t, host| f(t, host))
+            }
+            Tool::Rigidity => self.with_brush(|t, host| f(t, host)),
+            Tool::Cut => self.with_cut(|t, host| f(t, host)),
+            Tool::Cage => self.with_cage(|t, host| f(t, host)),
+            Tool::Perform => self.with_perform(|t, host| f(t, host)),
+        }
+    }
+
     /// Runs `f` on the perform tool with the app as its host (lent out for the call).
     pub(crate) fn with_perform<R>(
         &mut self,

@@ -198,9 +198,9 @@ impl EditorApp {
                     (false, n) => format!("{n} pictures as layers:"),
                 };
                 self.end_gesture();
-                let lbc = doc.method().controls() == Controls::Cage;
-                let unsolved = lbc && doc.cage_solution().is_none();
-                let problem = CageKey::of(doc.project()).and_then(|k| k.problem());
+                let in_use = CageKey::in_use(doc.project());
+                let unsolved = in_use.is_some() && doc.cage_solution().is_none();
+                let problem = in_use.and_then(|k| k.problem());
                 self.doc = Some(doc);
                 self.history.clear();
                 self.dirty = false;
@@ -210,9 +210,8 @@ impl EditorApp {
                 self.perform = crate::perform::PerformTool::default();
                 self.show_current_time();
                 self.cage.forget_document();
-                if lbc {
-                    self.tool = Tool::Cage;
-                }
+                // A project a cage moves opens with the cage tool.
+                self.sync_tool();
                 self.needs_fit = true;
                 self.settings_draft = None;
                 let notes = self
@@ -292,10 +291,7 @@ impl EditorApp {
     /// cages, file and versions), and the history moves as its cause says.
     fn rebuilt(&mut self, cause: Rebuild, mut doc: Document) {
         self.end_gesture();
-        let was_lbc = self
-            .doc
-            .as_ref()
-            .is_some_and(|d| d.method().controls() == Controls::Cage);
+        let was = self.controls();
         let mut history = None;
         let mut kept = Ok(());
         if let Some(old) = &self.doc {
@@ -351,7 +347,7 @@ impl EditorApp {
             stats.samples,
             short.unwrap_or_default()
         ));
-        self.sync_tool_after_history(was_lbc);
+        self.sync_tool_after_history(was);
         self.show_current_time();
     }
 }
@@ -402,8 +398,8 @@ fn open_outcome(paths: Vec<PathBuf>, cancel: &CancelFlag, progress: &SolveProgre
         ))
     } else if is_project {
         Document::open_project(&paths[0]).map(|mut doc| {
-            let solvable = CageKey::of(doc.project()).is_some_and(|k| k.problem().is_none());
-            if doc.method().controls() == Controls::Cage && solvable {
+            let solvable = CageKey::in_use(doc.project()).is_some_and(|k| k.problem().is_none());
+            if solvable {
                 // Failing (cancelled) leaves the cage unsolved.
                 let _ = doc.solve_cage(&mut |step| {
                     progress.set(*step);

@@ -250,6 +250,8 @@ impl CanvasTool for CageTool {
 
     /// What the tool does now, its buttons, τ and the density inside the cage.
     fn panel(&mut self, host: &mut dyn Host, ui: &mut Ui) {
+        ui.separator();
+        ui.heading("Cage");
         self.cage_panel(host, ui);
     }
 

@@ -205,7 +205,7 @@ impl CageTool {
     /// The coordinates of the cage mesh's vertex under screen point `pointer`, as the
     /// text shown beside it: none while a gesture is under way or no solved cage warps
     /// the view.
-    pub(crate) fn readout(&self, host: &mut dyn Host, pointer: Pos2) -> Option<String> {
+    pub(crate) fn coordinates_readout(&self, host: &mut dyn Host, pointer: Pos2) -> Option<String> {
         if self.gesture_under_way() {
             return None;
         }

@@ -7,7 +7,8 @@ use pipeline::cage::CageCoordinates;
 use project::{Controls, Method, Tau};
 
 use super::{CAGE, CageState, CageTool, SELECTED};
-use crate::document::{CageKey, Edit};
+use crate::controls::StatusField;
+use crate::document::{CageKey, Document, Edit};
 use crate::tool::Host;
 
 /// What the side panel's buttons need to know of the document.
@@ -207,13 +208,26 @@ impl CageTool {
     }
 
     /// The side panel's edit buttons for the cage, in the method's place of handles.
-    pub(crate) fn edit_buttons(&mut self, host: &mut dyn Host, ui: &mut Ui) {
+    pub(crate) fn cage_buttons(&mut self, host: &mut dyn Host, ui: &mut Ui) {
         if ui.button("Reset pose").clicked() {
             self.reset_pose(host);
         }
         if ui.button("Clear cage").clicked() {
             self.clear(host);
         }
+    }
+
+    /// The status bar's fields: the cage, and the mesh inside it once solved.
+    pub(crate) fn status_fields(&self, doc: &Document) -> Vec<StatusField> {
+        let cage = doc.cage().map_or(0, |c| c.rest.len());
+        let text = match doc.cage_solution() {
+            Some(solution) => format!(
+                "cage of {cage} vertices; {} mesh vertices inside",
+                solution.domain.positions().len()
+            ),
+            None => format!("cage of {cage} vertices, not solved"),
+        };
+        vec![(text, None)]
     }
 
     /// The panel of the paper's locality statistics of the solved cage (§5, eqs.

@@ -39,6 +39,12 @@ impl CageKey {
         })
     }
 
+    /// The key of the cage that moves `project`'s picture: its cage, with LBC chosen
+    /// (`None` under a handle method, or without a cage).
+    pub fn in_use(project: &Project) -> Option<Self> {
+        Self::of(project).filter(|_| project.method.controls() == Controls::Cage)
+    }
+
     /// Why this cage cannot be solved (not a simple polygon), if it cannot.
     pub fn problem(&self) -> Option<String> {
         let points = self.rest.iter().map(|&p| DVec2::from(p)).collect();

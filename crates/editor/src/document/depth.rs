@@ -3,8 +3,8 @@
 //! pose's, and their orders are written into the rig file (`overlaps`), so what is
 //! shown is what a save, an export or `c2warp render` draws.
 
+use pipeline::Deformer;
 use pipeline::order::{Arranger, as_triangles, predefined_order};
-use pipeline::{Controls, Deformer};
 use project::{HandleSpec, OverlapOrder};
 
 use super::Document;
@@ -64,15 +64,10 @@ impl Document {
     /// [`Document::rearrange`]; on the mesh arranged last, a large one waits for the
     /// drag's end or the next frame unless `now`.
     pub(super) fn rearrange_now(&mut self, now: bool) {
-        // (Drawn as parts, a cage moves the parts' joined mesh, which is arranged.)
-        let cage = self.project.method.controls() == Controls::Cage && self.parts().is_none();
+        let (cage, arranged) = self.arranged();
         // (Compared by where the shown mesh's triangles lie, not element by element:
         // a pose keeps the mesh, and this runs on every frame of a drag.)
-        let shown = if cage {
-            self.cage_deformer().map(Deformer::triangles)
-        } else {
-            Some(self.deformer().triangles())
-        };
+        let shown = arranged.map(Deformer::triangles);
         // A pin added to parts sets up a new deformer over the same joined mesh (the
         // parts it binds posed again, not meshed): the same mesh, element by element.
         let key = shown.map(|t| (t.as_ptr() as usize, t.len(), self.mesh_version));
@@ -92,12 +87,7 @@ impl Document {
         self.depth_deferred = false;
         let mut previous = self.depth.take();
         let old_order = previous.as_mut().map(|d| std::mem::take(&mut d.order));
-        let deformer: Option<&dyn Deformer> = if cage {
-            self.cage_deformer().map(|c| c as &dyn Deformer)
-        } else {
-            Some(self.deformer())
-        };
-        let Some(deformer) = deformer.filter(|_| self.project.auto_depth) else {
+        let Some(deformer) = self.arranged().1.filter(|_| self.project.auto_depth) else {
             if !self.project.auto_depth {
                 self.project.overlaps.clear();
             }
@@ -190,6 +180,15 @@ impl Document {
             self.order_version += 1;
         }
         self.depth = Some(depth);
+    }
+
+    /// The mesh automatic depth arranges — what the view shows for the document's own
+    /// controls: the picture's mesh or the parts' under handles, the cage's mesh under
+    /// LBC (the parts' joined mesh, when a cage moves parts) — and whether it is a
+    /// cage's (`None`: an unsolved cage, nothing to arrange).
+    fn arranged(&self) -> (bool, Option<&dyn Deformer>) {
+        let shown = self.shown(self.controls(), true);
+        (shown.over_backdrop(), shown.deformer())
     }
 
     /// The cage's mesh's triangles in drawing order (with LBC chosen and solved).

@@ -11,6 +11,7 @@
 
 mod input;
 mod paint;
+mod status;
 
 use egui::{Painter, Pos2, Response, Ui};
 use glam::DVec2;

@@ -7,48 +7,16 @@ impl EditorApp {
     pub(super) fn status_bar(&mut self, ui: &mut Ui) {
         ui.horizontal(|ui| {
             if let Some(doc) = &self.doc {
-                if doc.method().controls() == Controls::Cage {
-                    let cage = doc.cage().map_or(0, |c| c.rest.len());
-                    match doc.cage_solution() {
-                        Some(solution) => ui.label(format!(
-                            "cage of {cage} vertices; {} mesh vertices inside",
-                            solution.domain.positions().len()
-                        )),
-                        None => ui.label(format!("cage of {cage} vertices, not solved")),
-                    };
-                } else if let Some(parts) = doc.parts() {
-                    ui.label(format!(
-                        "{} parts, {} vertices",
-                        parts.composer().shown().len(),
-                        pipeline::Deformer::rest(parts).len()
-                    ));
-                    ui.separator();
-                    ui.label(format!("{} handles", doc.project().handles.len()));
-                    ui.separator();
-                    ui.label(format!("parts set up in {:.1} ms", parts.setup_ms()));
-                } else {
-                    let stats = doc.rig().stats();
-                    ui.label(format!("{} vertices", stats.samples));
-                    ui.separator();
-                    ui.label(format!(
-                        "{} handles ({} nodes) + {} virtual",
-                        stats.real_handles, stats.handle_nodes, stats.virtual_nodes
-                    ));
-                    ui.separator();
-                    ui.label(format!("weights updated in {:.1} ms", doc.last_update_ms));
-                }
-                if let Some(times) = doc.arap().map(ArapRig::times) {
-                    ui.separator();
-                    ui.label(format!(
-                        "ARAP: compiled in {:.1} ms, updated in {:.2} ms",
-                        times.compile_ms, times.update_ms
-                    ))
-                    .on_hover_text(format!(
-                        "registration {:.1} ms (once per mesh); compilation when handles \
-                         are added or removed or rigidity is painted; an update every \
-                         drag frame",
-                        times.registration_ms
-                    ));
+                for (k, (text, hover)) in
+                    self.set(doc.controls()).status(doc).into_iter().enumerate()
+                {
+                    if k > 0 {
+                        ui.separator();
+                    }
+                    let label = ui.label(text);
+                    if let Some(hover) = hover {
+                        label.on_hover_text(hover);
+                    }
                 }
                 ui.separator();
                 ui.label(format!("frame {:.1} ms", self.frame_ms));
