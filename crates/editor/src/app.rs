@@ -67,6 +67,8 @@ pub struct EditorApp {
     pub tool: Tool,
     /// The selected handle.
     pub selected: Option<usize>,
+    /// The part (a layer's index) selected in the Layers panel: outlined on the canvas.
+    pub selected_part: Option<usize>,
     /// The handle tools: a drag or a bar under way, the right-click menu's handle.
     pub(crate) handles: HandleTool,
     /// The drag under way pans the view.
@@ -198,6 +200,7 @@ impl EditorApp {
             fit_settling: 0,
             tool: Tool::Puppet,
             selected: None,
+            selected_part: None,
             handles: HandleTool::default(),
             panning: false,
             show: Show::default(),

@@ -99,6 +99,7 @@ impl EditorApp {
         if self.show.overlaps {
             self.paint_overlaps(&painter);
         }
+        self.paint_selected_part(&painter);
         // The controls in hand, and the marks of the tools beside them (painted
         // rigidity, cuts), each shown as in use when it is the tool.
         let pointer = ui.input(|i| i.pointer.latest_pos());
@@ -299,35 +300,38 @@ impl EditorApp {
             return;
         };
         let (positions, triangles) = (shown.deformed(), shown.triangles());
-        let viewport = &self.viewport;
         let outline = |sheet: &[u32], colour: Color32| {
-            let mut edges: std::collections::HashMap<(u32, u32), u32> =
-                std::collections::HashMap::new();
-            for &t in sheet {
-                let Some(&[a, b, c]) = triangles.get(t as usize) else {
-                    continue;
-                };
-                for (u, v) in [(a, b), (b, c), (c, a)] {
-                    *edges.entry((u.min(v), u.max(v))).or_default() += 1;
-                }
-            }
-            for ((u, v), count) in edges {
-                let (Some(&p), Some(&q)) = (positions.get(u as usize), positions.get(v as usize))
-                else {
-                    continue;
-                };
-                if count == 1 {
-                    painter.line_segment(
-                        [viewport.to_screen(p), viewport.to_screen(q)],
-                        egui::Stroke::new(1.5, colour),
-                    );
-                }
-            }
+            let sheet = sheet.iter().filter_map(|&t| triangles.get(t as usize));
+            outline(painter, &self.viewport, &positions, sheet, colour);
         };
         for region in doc.overlap_regions() {
             outline(&region.back, Color32::from_rgb(90, 160, 255));
             outline(&region.front, Color32::from_rgb(255, 220, 60));
         }
+    }
+
+    /// The part selected in the Layers panel outlined where the view draws it (drawn
+    /// as parts).
+    fn paint_selected_part(&mut self, painter: &egui::Painter) {
+        let (in_hand, warping) = (self.in_hand(), self.cage_warping());
+        let (Some(doc), Some(k)) = (&self.doc, self.selected_part) else {
+            return;
+        };
+        let crate::document::Shown::Parts(parts) = doc.shown(in_hand, warping) else {
+            return;
+        };
+        let positions = pipeline::Deformer::deformed(parts);
+        let part = (pipeline::Deformer::triangles(parts).iter())
+            .zip(parts.part_of())
+            .filter(|&(_, &p)| p as usize == k)
+            .map(|(t, _)| t);
+        outline(
+            painter,
+            &self.viewport,
+            &positions,
+            part,
+            Color32::from_rgb(255, 120, 200),
+        );
     }
 
     /// The onion skin, when on (and not while playing): the previous and next keys'
@@ -352,6 +356,34 @@ impl EditorApp {
         let uv = Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0));
         for ghost in &self.onion.ghosts {
             painter.image(ghost.id(), frame, uv, Color32::WHITE);
+        }
+    }
+}
+
+/// The outline of a sheet of `triangles` (its edges that no other triangle of it
+/// shares) at `positions`, in `colour`.
+fn outline<'a>(
+    painter: &egui::Painter,
+    viewport: &crate::viewport::Viewport,
+    positions: &[DVec2],
+    triangles: impl Iterator<Item = &'a [u32; 3]>,
+    colour: Color32,
+) {
+    let mut edges: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
+    for &[a, b, c] in triangles {
+        for (u, v) in [(a, b), (b, c), (c, a)] {
+            *edges.entry((u.min(v), u.max(v))).or_default() += 1;
+        }
+    }
+    for ((u, v), count) in edges {
+        let (Some(&p), Some(&q)) = (positions.get(u as usize), positions.get(v as usize)) else {
+            continue;
+        };
+        if count == 1 {
+            painter.line_segment(
+                [viewport.to_screen(p), viewport.to_screen(q)],
+                egui::Stroke::new(1.5, colour),
+            );
         }
     }
 }

@@ -568,7 +568,7 @@ impl Document {
     pub fn apply(&mut self, edit: Edit) -> Result<()> {
         let mut project = self.project.clone();
         match edit {
-            Edit::Add(handle) => self.push_handle(&mut project, handle)?,
+            Edit::Add(handle) => self.push_handle(&mut project, handle, None)?,
             Edit::AddBound(handle, part) => {
                 let Some(parts) = &project.parts else {
                     bail!("a handle is bound to one part when the layers are drawn as parts");
@@ -577,14 +577,7 @@ impl Document {
                 if self.layers.as_ref().is_none_or(|l| part >= l.layers.len()) {
                     bail!("there is no part {part}");
                 }
-                self.push_handle(&mut project, handle)?;
-                let handle = project.handles.len() - 1;
-                if let Some(parts) = &mut project.parts {
-                    parts.bindings.push(project::Binding {
-                        handle,
-                        parts: vec![part],
-                    });
-                }
+                self.push_handle(&mut project, handle, Some(part))?;
             }
             Edit::Remove(index) => {
                 if index >= project.handles.len() {
@@ -647,7 +640,24 @@ impl Document {
                 )
             }
             Edit::Method(method) => project.method = method,
-            Edit::Rigidity(strokes) => project.rigidity = strokes,
+            Edit::Rigidity(strokes) => {
+                // New paint on a locked part is refused; erasing (what is left of
+                // strokes already there) is not.
+                let kept = |s: &RigidityStroke| {
+                    (project.rigidity.iter())
+                        .any(|o| o.part == s.part && s.stroke.iter().all(|p| o.stroke.contains(p)))
+                };
+                let locked = (strokes.iter())
+                    .filter(|s| !kept(s))
+                    .find_map(|s| s.part.filter(|&k| self.is_locked(k)));
+                if let Some(k) = locked {
+                    bail!(
+                        "{} is locked: unlock it under Layers to paint it",
+                        self.part_name(k)
+                    );
+                }
+                project.rigidity = strokes;
+            }
             Edit::Cuts(cuts) => project.cuts = cuts,
             Edit::Cage { rest, vertices } => {
                 if project.lbc.and_then(|l| l.density).is_none() {
@@ -739,7 +749,15 @@ impl Document {
     /// Appends `handle` to `project` (the document's, being edited) with what goes with
     /// it: its place in every key, and in a posed state what holds the picture where
     /// it is (C² lays it over the weights it is placed on, ARAP pins what is under it).
-    fn push_handle(&mut self, project: &mut Project, handle: HandleSpec) -> Result<()> {
+    fn push_handle(
+        &mut self,
+        project: &mut Project,
+        handle: HandleSpec,
+        only: Option<usize>,
+    ) -> Result<()> {
+        // Drawn as parts: bound to chosen parts (`only`, or the unlocked ones under it
+        // where a locked part lies under it too), else to every part under it.
+        let chosen = self.parts_to_bind(project, &handle, only)?;
         // Every key gets the new handle where its pose takes it.
         let fitted = self.fit_into_keys(&handle)?;
         if let Some(animation) = &mut project.animation {
@@ -753,6 +771,12 @@ impl Document {
         if posed {
             project.overlaid.push(index);
         }
+        if let (Some(parts), Some(spec)) = (chosen, &mut project.parts) {
+            spec.bindings.push(project::Binding {
+                handle: index,
+                parts,
+            });
+        }
         let holds = match (self.parts(), self.layers.as_deref()) {
             // Drawn as parts: held on each part it binds.
             (Some(parts), Some(layers)) => parts.rig().holds(layers, project, index)?,
@@ -760,6 +784,63 @@ impl Document {
         };
         project.holds.extend(holds);
         Ok(())
+    }
+
+    /// The parts a new `handle` binds when that is not every part under it: `only`
+    /// (which must not be locked), or the unlocked parts under it where a locked one
+    /// lies under it too (none unlocked: refused). `None`: every part under it, or
+    /// not drawn as parts.
+    fn parts_to_bind(
+        &self,
+        project: &Project,
+        handle: &HandleSpec,
+        only: Option<usize>,
+    ) -> Result<Option<Vec<usize>>> {
+        let (Some(spec), Some(layers)) = (&project.parts, self.layers.as_deref()) else {
+            return Ok(None);
+        };
+        if let Some(k) = only {
+            if spec.is_locked(k) {
+                bail!(
+                    "{} is locked: unlock it under Layers to pin it",
+                    self.part_name(k)
+                );
+            }
+            return Ok(Some(vec![k]));
+        }
+        let under = pipeline::parts::layers_under(layers, spec, handle);
+        if !under.iter().any(|&k| spec.is_locked(k)) {
+            return Ok(None);
+        }
+        let free: Vec<usize> = under
+            .iter()
+            .copied()
+            .filter(|&k| !spec.is_locked(k))
+            .collect();
+        if free.is_empty() {
+            let names: Vec<String> = under.iter().map(|&k| self.part_name(k)).collect();
+            match names.as_slice() {
+                [one] => bail!("{one} is locked: unlock it under Layers to pin it"),
+                _ => bail!(
+                    "{} are locked: unlock one under Layers to pin it",
+                    names.join(", ")
+                ),
+            }
+        }
+        Ok(Some(free))
+    }
+
+    /// Whether part `k` is locked (drawn as parts).
+    pub fn is_locked(&self, k: usize) -> bool {
+        self.project.parts.as_ref().is_some_and(|p| p.is_locked(k))
+    }
+
+    /// Layer `k`'s name, as the Layers panel shows it.
+    pub fn part_name(&self, k: usize) -> String {
+        match self.layers.as_deref().and_then(|l| l.layers.get(k)) {
+            Some(layer) => layer.name.clone(),
+            None => format!("part {k}"),
+        }
     }
 
     /// Makes `project` (the document's, with handle `removed` of the partition taken

@@ -655,6 +655,7 @@ impl EditorApp {
         let spec = doc.project().parts.clone();
         let mut as_parts = spec.is_some();
         let mut chosen = None;
+        let mut select = None;
         if ui
             .checkbox(&mut as_parts, "Draw as parts")
             .on_hover_text(
@@ -688,6 +689,16 @@ impl EditorApp {
                         });
                         button.on_hover_text(what).clicked()
                     };
+                    let locked = spec.is_locked(k);
+                    let lock = egui::Button::selectable(locked, if locked { "🔒" } else { "🔓" });
+                    let what = format!("Lock {} against new pins and paint", layer.name);
+                    let response = ui.add(lock);
+                    response.widget_info(|| {
+                        egui::WidgetInfo::selected(egui::Role::CheckBox, true, locked, &what)
+                    });
+                    if response.on_hover_text(what).clicked() {
+                        chosen = Some(Some(with_locked(spec, k, !locked)));
+                    }
                     let (top, bottom) = (at + 1 == order.len(), at == 0);
                     if step(ui, !top, "⏶", format!("Bring {} forward", layer.name)) {
                         chosen = Some(Some(with_order(spec, &order, at, at + 1)));
@@ -695,9 +706,26 @@ impl EditorApp {
                     if step(ui, !bottom, "⏷", format!("Send {} backward", layer.name)) {
                         chosen = Some(Some(with_order(spec, &order, at, at - 1)));
                     }
-                    ui.label(&layer.name);
+                    let selected = self.selected_part == Some(k);
+                    if ui
+                        .selectable_label(selected, &layer.name)
+                        .on_hover_text("Select: outlined on the canvas, its pins listed")
+                        .clicked()
+                    {
+                        select = Some((!selected).then_some(k));
+                    }
                 });
             }
+            if let Some(k) = self.selected_part.filter(|&k| k < layers.layers.len()) {
+                ui.label(part_summary(doc, k)).on_hover_text(
+                    "A part is moved by the pins that bind it (those placed on it, a joint \
+                     where two parts overlap); a part no pin binds follows the part beneath \
+                     it that it overlaps most",
+                );
+            }
+        }
+        if let Some(part) = select {
+            self.selected_part = part;
         }
         if let Some(parts) = chosen {
             // Refused, the status line says why.
@@ -874,6 +902,46 @@ fn with_shown(
     spec.hidden.sort_unstable();
     spec.shown.sort_unstable();
     spec
+}
+
+/// `spec` with layer `k` locked or not.
+fn with_locked(spec: &project::PartsSpec, k: usize, locked: bool) -> project::PartsSpec {
+    let mut spec = spec.clone();
+    spec.locked.retain(|&l| l != k);
+    if locked {
+        spec.locked.push(k);
+        spec.locked.sort_unstable();
+    }
+    spec
+}
+
+/// What moves part `k` of `doc`, in a line: the pins that bind it, the part it
+/// follows, or the cage.
+fn part_summary(doc: &crate::document::Document, k: usize) -> String {
+    let name = doc.part_name(k);
+    let Some(parts) = doc.parts() else {
+        return format!("{name}: hidden");
+    };
+    let rig = parts.rig();
+    let pins = rig.bindings().get(k).map_or(&[][..], Vec::as_slice);
+    let numbers: Vec<String> = pins.iter().map(|h| (h + 1).to_string()).collect();
+    let locked = if doc.is_locked(k) { " (locked)" } else { "" };
+    if !parts.part_of().iter().any(|&p| p as usize == k) {
+        format!("{name}{locked}: hidden")
+    } else if rig.cage().is_some() {
+        format!("{name}{locked}: moved by the cage")
+    } else if let [one] = numbers.as_slice() {
+        format!("{name}{locked}: pinned by handle {one}")
+    } else if !numbers.is_empty() {
+        format!("{name}{locked}: pinned by handles {}", numbers.join(", "))
+    } else if let Some(leader) = rig.followed().get(k).copied().flatten() {
+        format!(
+            "{name}{locked}: no pin binds it; follows {}",
+            doc.part_name(leader)
+        )
+    } else {
+        format!("{name}{locked}: no pin binds it; stays where it is")
+    }
 }
 
 /// `spec` with the layer at place `from` of the draw order `order` swapped with the

@@ -185,3 +185,65 @@ fn rigidity_painted_on_parts_paints_the_part_under_the_brush() {
         (window.save(Path::new(&folder).join("parts-rigidity-window.png"))).expect("a shot");
     }
 }
+
+#[test]
+fn a_locked_part_lets_pins_through_and_a_selected_part_says_what_moves_it() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = puppet_as_parts(dir.path());
+    // At rest, so that what shows under a point is the point itself.
+    click_label(&mut h, "Reset pose");
+    settle(&mut h);
+    let handles = |h: &egui_kittest::Harness<'static, editor::EditorApp>| {
+        h.state().document().expect("doc").project().handles.len()
+    };
+    // The body locked: one undo step, saved in the rig file.
+    h.get_by_label("Lock body against new pins and paint")
+        .click();
+    h.step();
+    settle(&mut h);
+    let locked = |h: &egui_kittest::Harness<'static, editor::EditorApp>| {
+        let doc = h.state().document().expect("doc");
+        doc.project_for_saving(None).parts.map(|p| p.locked)
+    };
+    assert_eq!(locked(&h), Some(vec![3]));
+    // A click on the body alone pins nothing, and says why.
+    let before = handles(&h);
+    let body = at(&h, 300.0, 420.0);
+    support::click_at(&mut h, body);
+    settle(&mut h);
+    assert_eq!(handles(&h), before, "no pin on a locked part");
+    let said = h.state().message.as_ref().map(|m| m.text.clone());
+    assert!(
+        said.as_deref().is_some_and(|m| m.contains("locked")),
+        "{said:?}"
+    );
+    // Where the front arm lies over the body: a pin on the arm alone.
+    let shoulder = at(&h, 233.0, 398.0);
+    support::click_at(&mut h, shoulder);
+    settle(&mut h);
+    assert_eq!(handles(&h), before + 1, "{:?}", h.state().message);
+    let doc = h.state().document().expect("doc");
+    let spec = doc.project().parts.clone().expect("parts");
+    assert_eq!(spec.binding(before), Some(&[6][..]), "the arm alone");
+    // The body selected: outlined, and what moves it said.
+    h.get_by_label("body").click();
+    h.step();
+    settle(&mut h);
+    assert_eq!(h.state().selected_part, Some(3));
+    let summary = h
+        .query_by_label_contains("body (locked): pinned by handles")
+        .is_some();
+    assert!(summary, "the selected part's pins are listed");
+    if let Ok(folder) = std::env::var("C2WARP_SHOTS") {
+        let window = h.render().expect("the window");
+        (window.save(Path::new(&folder).join("parts-locked-window.png"))).expect("a shot");
+    }
+    // Undone: the pin gone, unlocked again.
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    settle(&mut h);
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    settle(&mut h);
+    assert_eq!(handles(&h), before);
+    assert_eq!(locked(&h), Some(Vec::new()));
+    h.state().sanity_check().expect("consistent");
+}

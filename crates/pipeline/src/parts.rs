@@ -580,6 +580,11 @@ impl PartRig {
         Ok(moved)
     }
 
+    /// For each layer, the handles (indices into the rig file's) that bind it.
+    pub fn bindings(&self) -> &[Vec<usize>] {
+        &self.bindings
+    }
+
     /// For each layer that no handle binds, the layer it follows (if any).
     pub fn followed(&self) -> &[Option<usize>] {
         &self.followed
@@ -1030,7 +1035,12 @@ impl PartsDeformer {
 /// handles at rest.
 fn setup_of(project: &Project) -> (Method, Option<project::PartsSpec>, Vec<HandleSpec>) {
     let at_rest = project.handles.iter().map(HandleSpec::at_rest);
-    (project.method, project.parts.clone(), at_rest.collect())
+    // (Locking a part changes what new handles bind, not what moves the parts.)
+    let spec = (project.parts.clone()).map(|spec| project::PartsSpec {
+        locked: Vec::new(),
+        ..spec
+    });
+    (project.method, spec, at_rest.collect())
 }
 
 impl Deformer for PartsDeformer {
@@ -1687,6 +1697,23 @@ fn probes(handle: &HandleSpec) -> Vec<DVec2> {
             vec![a, (a + b) / 2.0, b]
         }
     }
+}
+
+/// The shown layers under `handle` at rest (each with a visible pixel under every
+/// point it is probed at: a point's place, a bar's ends and middle), bottom first by
+/// index: the parts it binds unless the rig file binds it to chosen ones.
+pub fn layers_under(
+    artwork: &layers::Artwork,
+    spec: &project::PartsSpec,
+    handle: &HandleSpec,
+) -> Vec<usize> {
+    let probes = probes(handle);
+    (artwork.layers.iter().enumerate())
+        .filter(|(k, layer)| {
+            spec.shows(*k, layer.visible) && probes.iter().all(|p| covers(layer, *p))
+        })
+        .map(|(k, _)| k)
+        .collect()
 }
 
 /// Whether `layer` has a visible pixel (alpha > 0) at canvas point `p`.

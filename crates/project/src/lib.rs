@@ -648,6 +648,11 @@ pub struct PartsSpec {
     /// Handles bound to the parts named rather than to every visible part under them.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub bindings: Vec<Binding>,
+    /// The layers locked against new handles and rigidity paint, ascending: a handle
+    /// placed over a locked part binds the unlocked parts under it alone (written to
+    /// `bindings`). What already binds a locked part keeps moving it.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub locked: Vec<usize>,
 }
 
 /// A handle bound to chosen parts only (`{"handle": 3, "parts": [2]}`).
@@ -682,6 +687,11 @@ impl PartsSpec {
         }
     }
 
+    /// Whether layer `layer` is locked against new handles and rigidity paint.
+    pub fn is_locked(&self, layer: usize) -> bool {
+        self.locked.binary_search(&layer).is_ok()
+    }
+
     /// The parts handle `handle` is bound to, where it is bound to chosen ones.
     pub fn binding(&self, handle: usize) -> Option<&[usize]> {
         self.bindings
@@ -707,6 +717,7 @@ impl PartsSpec {
             ("order", &self.order),
             ("hidden", &self.hidden),
             ("shown", &self.shown),
+            ("locked", &self.locked),
         ] {
             if let Some(k) = past(list) {
                 return bad(format!(
@@ -750,7 +761,11 @@ impl PartsSpec {
                 && list.windows(2).all(|w| w[0] < w[1])
                 && list.iter().all(|&k| k < MAX_PARTS)
         };
-        for (name, list) in [("hidden", &self.hidden), ("shown", &self.shown)] {
+        for (name, list) in [
+            ("hidden", &self.hidden),
+            ("shown", &self.shown),
+            ("locked", &self.locked),
+        ] {
             if !ascending(list) {
                 return bad(format!(
                     "parts.{name} must be layer indices below {MAX_PARTS}, ascending, each once"
@@ -1454,7 +1469,7 @@ mod tests {
         let text = r#"{"version":1,"image":"cat.ora","handles":[
             {"type":"point","rest":[10,10]},{"type":"point","rest":[30,10]},
             {"type":"point","rest":[50,10]}],
-            "parts":{"order":[2,0,1],"hidden":[1],"shown":[3],
+            "parts":{"order":[2,0,1],"hidden":[1],"shown":[3],"locked":[2],
                      "bindings":[{"handle":0,"parts":[0]},{"handle":2,"parts":[1,2]}]}}"#;
         let mut project = Project::from_json(text).expect("a rig with parts");
         assert_eq!(
@@ -1467,6 +1482,7 @@ mod tests {
         assert!(!parts.shows(1, true) && parts.shows(0, true));
         assert!(parts.shows(3, false) && !parts.shows(4, false));
         assert_eq!(parts.binding(2), Some(&[1, 2][..]));
+        assert!(parts.is_locked(2) && !parts.is_locked(0));
         assert_eq!(parts.binding(1), None);
         // The order is checked against the picture's layers when it is read.
         let error = parts.check_layers(4).expect_err("4 layers").to_string();
@@ -1479,6 +1495,14 @@ mod tests {
         .expect_err("no layer 3")
         .to_string();
         assert!(error.contains("parts.shown names layer 3"), "{error}");
+        let error = PartsSpec {
+            locked: vec![3],
+            ..PartsSpec::default()
+        }
+        .check_layers(3)
+        .expect_err("no layer 3")
+        .to_string();
+        assert!(error.contains("parts.locked names layer 3"), "{error}");
         project.remove_handle(0);
         let parts = project.parts.as_ref().expect("parts");
         assert_eq!(parts.bindings.len(), 1, "the removed handle's binding gone");
@@ -1488,6 +1512,8 @@ mod tests {
             (r#""order":[2,0,1]"#, r#""order":[3,0,1]"#),
             (r#""hidden":[1]"#, r#""hidden":[1,1]"#),
             (r#""hidden":[1]"#, r#""hidden":[3]"#),
+            (r#""locked":[2]"#, r#""locked":[2,0]"#),
+            (r#""locked":[2]"#, r#""locked":[1000]"#),
             (
                 r#"{"handle":2,"parts":[1,2]}"#,
                 r#"{"handle":3,"parts":[1]}"#,

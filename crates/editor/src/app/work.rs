@@ -206,6 +206,7 @@ impl EditorApp {
                 self.dirty = false;
                 self.mls_warned = false;
                 self.selected = None;
+                self.selected_part = None;
                 self.timeline = crate::timeline::Timeline::default();
                 self.perform = crate::perform::PerformTool::default();
                 self.show_current_time();

@@ -1032,3 +1032,84 @@ fn under_arap_a_drag_on_parts_is_live_and_its_end_is_what_a_file_renders() {
     doc.check_reopens()
         .expect("the end of the drag is what the file renders");
 }
+
+#[test]
+fn a_locked_part_takes_no_new_pin_or_paint_and_moves_as_before() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut doc = puppet(dir.path());
+    doc.apply(Edit::Parts(Some(project::PartsSpec::default())))
+        .expect("drawn as parts");
+    let bound_to = |doc: &Document, h: usize| -> Vec<usize> {
+        let rig = doc.parts().expect("parts").rig();
+        (0..rig.bindings().len())
+            .filter(|&k| rig.bindings()[k].contains(&h))
+            .collect()
+    };
+    // The front arm's shoulder: a joint of the arm and the body.
+    let count = doc.project().handles.len();
+    doc.apply(Edit::Add(point(262.0, 338.0))).expect("a joint");
+    let joint = bound_to(&doc, count);
+    assert!(joint.len() >= 2, "a joint binds both: {joint:?}");
+    doc.apply(Edit::Remove(count)).expect("removed");
+    // (Layer 3, beneath the arm.)
+    let body = *joint.iter().min().expect("the body");
+    // Locked: nothing moves, nothing is set up again.
+    let before = doc.deformer().deformed();
+    let composer = std::ptr::from_ref(doc.parts().expect("parts").composer());
+    doc.apply(Edit::Parts(Some(project::PartsSpec {
+        locked: vec![body],
+        ..Default::default()
+    })))
+    .expect("locked");
+    assert!(doc.deformer().deformed() == before, "locking moves nothing");
+    let after = std::ptr::from_ref(doc.parts().expect("parts").composer());
+    assert_eq!(composer, after, "locking sets nothing up again");
+    // A pin on the joint binds the unlocked part alone, written as a binding.
+    doc.apply(Edit::Add(point(262.0, 338.0)))
+        .expect("pinned beside the locked part");
+    let free: Vec<usize> = joint.iter().copied().filter(|&k| k != body).collect();
+    assert_eq!(bound_to(&doc, count), free);
+    let spec = doc.project().parts.clone().expect("parts");
+    assert_eq!(spec.binding(count), Some(free.as_slice()));
+    doc.check_reopens().expect("reopens with the binding");
+    // Bound to the locked part, or placed where it alone lies: refused, nothing changed.
+    let project = doc.project().clone();
+    let refused = doc.apply(Edit::AddBound(point(262.0, 338.0), body));
+    assert!(refused.is_err_and(|e| e.to_string().contains("locked")));
+    let on_body = point(300.0, 420.0);
+    assert_eq!(
+        pipeline::parts::layers_under(doc.layers.as_ref().expect("layers"), &spec, &on_body),
+        [body],
+        "the body alone there"
+    );
+    let refused = doc.apply(Edit::Add(on_body));
+    assert!(refused.is_err_and(|e| e.to_string().contains("locked")));
+    assert!(
+        doc.project() == &project,
+        "a refused pin leaves the document"
+    );
+    // Rigidity painted on it is refused; erasing what was painted before is not.
+    let stroke = |part| RigidityStroke {
+        stroke: vec![[300.0, 400.0], [300.0, 430.0]],
+        radius: 12.0,
+        weight: 100.0,
+        part,
+    };
+    let refused = doc.apply(Edit::Rigidity(vec![stroke(Some(body))]));
+    assert!(refused.is_err_and(|e| e.to_string().contains("locked")));
+    doc.apply(Edit::Parts(Some(project::PartsSpec::default())))
+        .expect("unlocked");
+    doc.apply(Edit::Rigidity(vec![stroke(Some(body))]))
+        .expect("painted, unlocked");
+    doc.apply(Edit::Parts(Some(project::PartsSpec {
+        locked: vec![body],
+        bindings: spec.bindings.clone(),
+        ..Default::default()
+    })))
+    .expect("locked again");
+    let erased = crate::brush::erase(&doc.project().rigidity, &[[300.0, 430.0]], 4.0);
+    assert!(!erased.is_empty() && erased != doc.project().rigidity);
+    doc.apply(Edit::Rigidity(erased))
+        .expect("erased on a locked part");
+    doc.sanity_check().expect("consistent");
+}
