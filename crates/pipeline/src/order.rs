@@ -118,6 +118,11 @@ impl Arranger {
         arranger
     }
 
+    /// Each triangle's part, for a mesh of parts joined.
+    pub fn part_of(&self) -> Option<&[u32]> {
+        self.part_of.as_deref()
+    }
+
     /// Takes another predefined order for the same mesh (new handle depths), keeping
     /// what it remembers.
     pub fn set_predefined(&mut self, predefined: Vec<u32>) {

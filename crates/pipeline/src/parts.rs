@@ -336,6 +336,13 @@ impl PartRig {
                         // Nothing of this part changed: shared as it is.
                         return Some(b.clone());
                     }
+                    if !same_but_poses(&b.own, &part) {
+                        // Handles added or removed (or held, or painted): set up anew,
+                        // as the saved file is reopened — an incremental update keeps
+                        // what its own history placed (C²'s virtual handles, which a
+                        // part does not save).
+                        return None;
+                    }
                     let mut b = Bound::clone(b);
                     (b.follow(&part).ok()? == Follow::Followed).then(|| Arc::new(b))
                 }
@@ -495,6 +502,11 @@ impl PartRig {
                 if own == bound.own {
                     // A pose that leaves this part's handles as they were.
                     continue;
+                }
+                if !same_but_poses(&bound.own, &own) {
+                    // More than a pose (a handle laid over the weights or held, new
+                    // settings): the part is set up anew, as a reopen sets it up.
+                    return Ok(Follow::NeedsSetup);
                 }
                 let bound = Arc::make_mut(bound);
                 if bound.follow(&own).with_context(|| format!("part {k}"))? == Follow::NeedsSetup {
@@ -1029,6 +1041,15 @@ impl PartsDeformer {
         let (_, part) = *self.joined.starts.get(at.checked_sub(1)?)?;
         (v < self.joined.rest.len() as u32).then_some(part)
     }
+}
+
+/// Whether two rig files of a part differ in their handles' poses alone.
+fn same_but_poses(a: &Project, b: &Project) -> bool {
+    let at_rest = |p: &Project| Project {
+        handles: p.handles.iter().map(HandleSpec::at_rest).collect(),
+        ..p.clone()
+    };
+    a.handles.len() == b.handles.len() && at_rest(a) == at_rest(b)
 }
 
 /// What a part setup depends on beyond the pose: the method, the parts' spec, the
@@ -1612,6 +1633,9 @@ fn part_project(project: &Project, layer: usize, bound: &[usize]) -> Project {
     part.overlaps.clear();
     // A part is one picture: the parts' order, visibility and bindings are the whole's.
     part.parts = None;
+    // A cage kept while handles move the parts is the whole canvas's (a cage moves
+    // the parts through `PartRig::caged`, not through a part's own rig file).
+    part.cage = None;
     part
 }
 

@@ -95,6 +95,25 @@ impl Document {
                 if parts.rest().len() != parts.composer().uv().len() {
                     bail!("the parts' mesh and texture disagree");
                 }
+                let layers = self.layers.as_deref().context("parts without layers")?;
+                if parts.rig().bindings() != pipeline::parts::bindings(layers, &self.project)? {
+                    bail!("the parts are bound otherwise than the rig file binds them");
+                }
+                // Each overlap's order is kept at a triangle's rest centroid on the
+                // part it names.
+                let (rest, triangles) = (parts.rest(), parts.triangles());
+                for place in self.project.overlaps.iter().flat_map(|o| [o.front, o.back]) {
+                    let on = (triangles.iter().zip(parts.part_of())).any(|(t, &k)| {
+                        let centroid =
+                            t.iter().map(|&v| rest[v as usize]).sum::<glam::DVec2>() / 3.0;
+                        Some(k as usize) == place.part && centroid.to_array() == place.at
+                    });
+                    if !on {
+                        bail!(
+                            "an overlap's order is kept at {place:?}, on no triangle of that part"
+                        );
+                    }
+                }
             }
             Controls::Handles => {
                 if *mesh != self.mesh_version || deformer.rest() != self.rig.domain().positions() {

@@ -3,6 +3,7 @@
 //! pose's, and their orders are written into the rig file (`overlaps`), so what is
 //! shown is what a save, an export or `c2warp render` draws.
 
+use glam::DVec2;
 use pipeline::Deformer;
 use pipeline::order::{Arranger, as_triangles, predefined_order};
 use project::{HandleSpec, OverlapOrder};
@@ -25,6 +26,11 @@ pub(super) struct Depth {
     depths: Vec<i32>,
     /// The mesh's triangles (in its own order).
     triangles: Vec<[u32; 3]>,
+    /// The mesh's rest positions: parts reordered join their meshes in another order,
+    /// which can list the same triangles over other places (two parts of the same
+    /// shape) or on other parts (two at the same place), and what the arranger
+    /// remembers names triangles by index (and its parts by triangle).
+    rest: Vec<DVec2>,
     /// Where the shown mesh's triangles lay, how many, and the mesh's version.
     mesh: (usize, usize, u64),
     arranger: Arranger,
@@ -68,6 +74,7 @@ impl Document {
         // (Compared by where the shown mesh's triangles lie, not element by element:
         // a pose keeps the mesh, and this runs on every frame of a drag.)
         let shown = arranged.map(Deformer::triangles);
+        let rest = arranged.map(Deformer::rest);
         // A pin added to parts sets up a new deformer over the same joined mesh (the
         // parts it binds posed again, not meshed): the same mesh, element by element.
         let key = shown.map(|t| (t.as_ptr() as usize, t.len(), self.mesh_version));
@@ -75,7 +82,9 @@ impl Document {
             d.cage == cage
                 && d.triangles.len() > LIVE_TRIANGLES
                 && (Some(d.mesh) == key
-                    || (d.mesh.2 == self.mesh_version && shown == Some(&d.triangles[..])))
+                    || (d.mesh.2 == self.mesh_version
+                        && shown == Some(&d.triangles[..])
+                        && rest == Some(&d.rest[..])))
         });
         if (self.live || !now) && same_mesh && self.project.auto_depth {
             self.depth_deferred = true;
@@ -125,7 +134,12 @@ impl Document {
         };
         // The same mesh keeps its arranger (its topology, and what it remembers: a
         // handle added or removed changes no overlap's order).
-        let kept = previous.filter(|d| d.cage == cage && d.triangles == triangles);
+        let kept = previous.filter(|d| {
+            d.cage == cage
+                && d.triangles == triangles
+                && d.rest == deformer.rest()
+                && d.arranger.part_of() == part_of.as_deref()
+        });
         let mut arranger = match kept {
             Some(depth) => {
                 let mut arranger = depth.arranger;
@@ -171,6 +185,7 @@ impl Document {
                 self.mesh_version,
             ),
             triangles: triangles.to_vec(),
+            rest: deformer.rest().to_vec(),
             arranger,
             order,
             wrote: wrote.clone(),

@@ -1113,3 +1113,144 @@ fn a_locked_part_takes_no_new_pin_or_paint_and_moves_as_before() {
         .expect("erased on a locked part");
     doc.sanity_check().expect("consistent");
 }
+
+/// Two discs of the same size side by side, overlapping in the middle: the layers of
+/// a picture drawn as parts, whose meshes are the same but for where they lie.
+fn twin_discs(density: usize) -> Document {
+    discs(density, [45.0, 75.0])
+}
+
+/// Two discs of radius 30 on a 120 × 90 canvas, centred at `centres` (x), each a layer.
+fn discs(density: usize, centres: [f32; 2]) -> Document {
+    let disc = |cx: f32, colour: [u8; 3]| {
+        let [r, g, b] = colour;
+        render::Picture::Rgba8(RgbaImage::from_fn(120, 90, |x, y| {
+            let inside = (x as f32 - cx).hypot(y as f32 - 45.0) < 30.0;
+            image::Rgba([r, g, b, if inside { 255 } else { 0 }])
+        }))
+    };
+    let layer = |name: &str, pixels| pipeline::Layer {
+        name: name.into(),
+        x: 0,
+        y: 0,
+        opacity: 1.0,
+        visible: true,
+        pixels,
+    };
+    let artwork = pipeline::Artwork {
+        width: 120,
+        height: 90,
+        layers: vec![
+            layer("back", disc(centres[0], [200, 60, 40])),
+            layer("front", disc(centres[1], [40, 60, 200])),
+        ],
+        notes: Vec::new(),
+    };
+    let project = Project {
+        density: Some(density),
+        parts: Some(project::PartsSpec::default()),
+        ..Project::default()
+    };
+    Document::from_artwork(artwork, None, project).expect("drawn as parts")
+}
+
+#[test]
+fn parts_reordered_over_the_same_mesh_are_arranged_as_a_reopen_arranges_them() {
+    // Two discs at the same place, meshed alike: reordered, the joined mesh lists the
+    // same triangles at the same places, on the other part.
+    let mut doc = discs(3_000, [60.0, 60.0]);
+    assert!(
+        !doc.overlap_regions().is_empty(),
+        "the discs overlap at rest"
+    );
+    doc.apply(Edit::Parts(Some(project::PartsSpec {
+        order: vec![1, 0],
+        ..Default::default()
+    })))
+    .expect("reordered");
+    doc.sanity_check()
+        .expect("the orders kept on the parts they name");
+    doc.check_reopens().expect("reopens reordered");
+    let mut doc = twin_discs(3_000);
+    // The front disc's pin dragged over the back disc: the two overlap more.
+    doc.apply(Edit::Add(point(28.0, 45.0)))
+        .expect("a pin on the back disc");
+    doc.apply(Edit::Add(point(92.0, 45.0)))
+        .expect("a pin on the front disc");
+    let HandleSpec::Point { rest, .. } = doc.project().handles[1].clone() else {
+        panic!("a point");
+    };
+    let moved = HandleSpec::Point {
+        rest,
+        translate: [-30.0, 0.0],
+        rotate: 0.0,
+        scale: 1.0,
+        depth: 0,
+    };
+    doc.apply(Edit::Pose(1, moved)).expect("posed");
+    assert!(!doc.overlap_regions().is_empty(), "the discs overlap");
+    doc.check_reopens().expect("reopens");
+    // Reordered, the joined mesh lists the same triangles over other places: the
+    // overlaps are arranged on the parts where they now lie.
+    doc.apply(Edit::Parts(Some(project::PartsSpec {
+        order: vec![1, 0],
+        ..Default::default()
+    })))
+    .expect("reordered");
+    doc.check_reopens().expect("reopens reordered");
+    doc.sanity_check().expect("consistent");
+}
+
+#[test]
+fn a_part_is_set_up_as_a_reopen_sets_it_up_whatever_came_before() {
+    let mut doc = twin_discs(3_000);
+    let mut settings = doc.settings();
+    settings.alpha = 0.25;
+    settings.fixed_boundary = true;
+    doc.apply(Edit::Settings(settings)).expect("settings");
+    // Pins added one by one at rest: each part's rig as one built with them all.
+    for at in [(28.0, 45.0), (22.0, 30.0), (35.0, 62.0), (40.0, 40.0)] {
+        doc.apply(Edit::Add(point(at.0, at.1)))
+            .expect("a pin on the back disc");
+        doc.check_reopens().expect("reopens with the pin");
+    }
+    doc.apply(Edit::Remove(1)).expect("removed at rest");
+    doc.check_reopens().expect("reopens without it");
+    let HandleSpec::Point { rest, .. } = doc.project().handles[0].clone() else {
+        panic!("a point");
+    };
+    let moved = HandleSpec::Point {
+        rest,
+        translate: [6.0, -4.0],
+        rotate: 0.2,
+        scale: 1.1,
+        depth: 0,
+    };
+    doc.apply(Edit::Pose(0, moved)).expect("posed");
+    // Pins placed in the pose (laid over the weights), removed, and the pose reset:
+    // each state reopens to the same picture.
+    for at in [(40.0, 30.0), (50.0, 60.0), (20.0, 50.0)] {
+        doc.apply(Edit::Add(point(at.0, at.1)))
+            .expect("a pin in the pose");
+        doc.check_reopens().expect("reopens with the pin");
+    }
+    doc.apply(Edit::Remove(4)).expect("removed");
+    doc.check_reopens().expect("reopens without it");
+    doc.apply(Edit::Remove(1))
+        .expect("a pin of the partition removed in the pose");
+    doc.check_reopens().expect("reopens without it");
+    doc.apply(Edit::ResetPose).expect("at rest");
+    doc.check_reopens().expect("reopens at rest");
+    // A cage kept while handles move the parts: reopened, the parts are set up
+    // without it.
+    doc.apply(Edit::Cage {
+        rest: vec![[2.0, 2.0], [118.0, 2.0], [118.0, 88.0], [2.0, 88.0]],
+        vertices: 300,
+    })
+    .expect("a cage");
+    doc.apply(Edit::Method(Method::C2))
+        .expect("back to handles");
+    assert!(doc.cage().is_some(), "the cage is kept");
+    doc.check_reopens().expect("reopens with the kept cage");
+    doc.sanity_check().expect("consistent");
+}
