@@ -494,7 +494,6 @@ pub fn prepare_with_progress(
             project.virtual_handles.len()
         );
     }
-    let handles = handles(project);
     let options = MeshOptions {
         target_vertices,
         // Refined where handles crowd together, so each has samples of its own.
@@ -508,6 +507,23 @@ pub fn prepare_with_progress(
         mesh.triangles,
         metric(project.metric, convex),
     )?;
+    Ok(Prepared {
+        rig: rig_on_domain(domain, project, progress)?,
+    })
+}
+
+/// [`prepare_with_progress`]'s second half: `project`'s rig built on `domain`, the
+/// mesh [`prepare_with_progress`] made of its picture (a part set up again with a pin
+/// that asks for no other mesh keeps its mesh: the rig is what a build gives).
+///
+/// # Errors
+/// As [`prepare`], past meshing.
+pub(crate) fn rig_on_domain(
+    domain: Domain,
+    project: &Project,
+    progress: &(dyn Fn(weights_core::Progress) + Sync),
+) -> Result<Rig> {
+    let handles = handles(project);
     // A saved virtual handle sits on a vertex of this mesh; one off the shape was not
     // saved from it, and is refused as a handle off the shape is.
     if let Some((i, p)) = project
@@ -534,15 +550,14 @@ pub fn prepare_with_progress(
             })
         })
         .collect();
-    let rig = Rig::with_overlaid(
+    Ok(Rig::with_overlaid(
         domain,
         handles,
         &project.overlaid,
         &virtual_handles,
         rig_options(project)?,
         progress,
-    )?;
-    Ok(Prepared { rig })
+    )?)
 }
 
 /// Builds `project`'s C² rig on a given mesh (`--mesh`): its vertices are used as

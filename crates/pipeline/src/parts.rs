@@ -199,6 +199,34 @@ struct Bound {
     /// The part's own rig file it follows ([`part_project`], canvas pixels): a rig
     /// file that gives the part the same is not followed again.
     own: Project,
+    /// What its mesh was made from: a setup that asks for the same mesh keeps it.
+    mesh: MeshKey,
+}
+
+/// What a part's mesh depends on: the rectangle of the canvas it is meshed on (its
+/// corner and size), the vertices asked for, the points refined around crowded
+/// handles, the cuts and the metric asked for (all in the rectangle's pixels).
+#[derive(Clone, PartialEq)]
+struct MeshKey {
+    origin: DVec2,
+    size: (u32, u32),
+    density: usize,
+    refine: Vec<DVec2>,
+    cuts: Vec<project::Cut>,
+    metric: project::MetricChoice,
+}
+
+impl MeshKey {
+    fn of(project: &Project, origin: DVec2, size: (u32, u32), density: usize) -> Self {
+        Self {
+            origin,
+            size,
+            density,
+            refine: crate::crowding::refinement(project, size.0, size.1, density),
+            cuts: project.cuts.clone(),
+            metric: project.metric,
+        }
+    }
 }
 
 impl Bound {
@@ -358,18 +386,38 @@ impl PartRig {
                 .flat_map(|&h| probes(&project.handles[h]))
                 .collect();
             let (placed_layer, origin) = own_rectangle(layer, canvas, &probes)?;
-            let warper = prepare_warper(
-                &placed_layer.to_rgba8(),
-                &shifted(&part, -origin),
-                Some(density),
-                listener,
-            )
+            let placed = shifted(&part, -origin);
+            let picture = placed_layer.to_rgba8();
+            let mesh = MeshKey::of(&placed, origin, picture.dimensions(), density);
+            // C² on the mesh it had (a pin that asks for no refinement there): the rig
+            // built again on it, as a build on the picture gives it.
+            let old_domain = previous
+                .and_then(|old| match old.parts.get(k)? {
+                    Part::Bound(b) if b.mesh == mesh && project.method == Method::C2 => b
+                        .warper
+                        .deformer
+                        .as_any()
+                        .downcast_ref::<weights_core::Rig>(),
+                    _ => None,
+                })
+                .map(|rig| rig.domain().clone());
+            let warper = match old_domain {
+                Some(domain) => placed
+                    .validate(Some(picture.dimensions()))
+                    .map_err(anyhow::Error::from)
+                    .and_then(|()| {
+                        crate::rig_on_domain(domain, &placed, &|p| listener.weighting(p))
+                    })
+                    .and_then(|rig| Warper::on_rig(rig, &placed, Some(&picture))),
+                None => prepare_warper(&picture, &placed, Some(density), listener),
+            }
             .with_context(|| format!("part \"{}\"", layer.name))?;
             parts.push(Part::Bound(Arc::new(Bound {
                 warper,
                 origin,
                 density,
                 own: part,
+                mesh,
             })));
         }
         // The parts no handle binds follow the bound part beneath them (in the draw
