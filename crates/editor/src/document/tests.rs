@@ -715,6 +715,26 @@ fn puppet(dir: &Path) -> Document {
     Document::open_project(&path).expect("opens")
 }
 
+/// The parts (layer indices) handle `h` of `doc` binds, drawn as parts.
+fn bound_to(doc: &Document, h: usize) -> Vec<usize> {
+    let bindings = doc.parts().expect("parts").rig().bindings();
+    (0..bindings.len())
+        .filter(|&k| bindings[k].contains(&h))
+        .collect()
+}
+
+/// The sample character's front shoulder, where the front arm lies over the body: a
+/// pin placed there binds both (a joint), and is removed again. The index a new handle
+/// takes, and the parts the pin bound.
+fn shoulder_joint(doc: &mut Document) -> (usize, Vec<usize>) {
+    let count = doc.project().handles.len();
+    doc.apply(Edit::Add(point(262.0, 338.0))).expect("a joint");
+    let joint = bound_to(doc, count);
+    assert!(joint.len() >= 2, "a joint binds both: {joint:?}");
+    doc.apply(Edit::Remove(count)).expect("removed");
+    (count, joint)
+}
+
 /// The positions of the parts `project` draws (`c2warp render --parts`), joined.
 fn parts_drawn(doc: &Document, project: &Project) -> Vec<DVec2> {
     let layers = doc.layers.as_ref().expect("layers");
@@ -765,17 +785,7 @@ fn a_layered_picture_drawn_as_parts_shows_what_render_draws_of_it() {
     );
     // A handle on the front arm's shoulder binds the arm and the body (a joint);
     // bound to the arm alone, it binds the arm alone.
-    let bound_to = |doc: &Document, h: usize| -> Vec<usize> {
-        let set = doc.parts().expect("parts").rig().set();
-        (0..set.bindings.len())
-            .filter(|&k| set.bindings[k].contains(&h))
-            .collect()
-    };
-    let count = doc.project().handles.len();
-    doc.apply(Edit::Add(point(262.0, 338.0))).expect("a joint");
-    let joint = bound_to(&doc, count);
-    assert!(joint.len() >= 2, "a joint binds both: {joint:?}");
-    doc.apply(Edit::Remove(count)).expect("removed");
+    let (count, joint) = shoulder_joint(&mut doc);
     doc.apply(Edit::AddBound(point(262.0, 338.0), joint[1]))
         .expect("bound to one part");
     assert_eq!(bound_to(&doc, count), [joint[1]]);
@@ -1039,18 +1049,7 @@ fn a_locked_part_takes_no_new_pin_or_paint_and_moves_as_before() {
     let mut doc = puppet(dir.path());
     doc.apply(Edit::Parts(Some(project::PartsSpec::default())))
         .expect("drawn as parts");
-    let bound_to = |doc: &Document, h: usize| -> Vec<usize> {
-        let rig = doc.parts().expect("parts").rig();
-        (0..rig.bindings().len())
-            .filter(|&k| rig.bindings()[k].contains(&h))
-            .collect()
-    };
-    // The front arm's shoulder: a joint of the arm and the body.
-    let count = doc.project().handles.len();
-    doc.apply(Edit::Add(point(262.0, 338.0))).expect("a joint");
-    let joint = bound_to(&doc, count);
-    assert!(joint.len() >= 2, "a joint binds both: {joint:?}");
-    doc.apply(Edit::Remove(count)).expect("removed");
+    let (count, joint) = shoulder_joint(&mut doc);
     // (Layer 3, beneath the arm.)
     let body = *joint.iter().min().expect("the body");
     // Locked: nothing moves, nothing is set up again.
