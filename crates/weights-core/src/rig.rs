@@ -947,10 +947,15 @@ impl Rig {
             stays[i] = true;
         }
         let first_arrival = stays.iter().position(|s| !s);
-        // Radii of the surviving nodes, by sample (node numbers change below).
-        let old_radius: HashMap<u32, f64> = (0..self.nodes.len())
+        // Support radii and distances to the nearest other node (which bounds the
+        // support exactly) of the surviving nodes, by sample (node numbers change
+        // below).
+        let old_radius: HashMap<u32, (f64, f64)> = (0..self.nodes.len())
             .filter(|k| doomed.binary_search(k).is_err())
-            .map(|k| (self.nodes[k].vertex, self.radii[k]))
+            .map(|k| {
+                let r_h = self.partition.stats[k].r_h;
+                (self.nodes[k].vertex, (self.radii[k], r_h))
+            })
             .collect();
         // Samples the doomed nodes reach: their rows must be redone.
         let dirty: Vec<u32> = doomed
@@ -1132,10 +1137,11 @@ impl Rig {
             .enumerate()
             .filter_map(|(k, n)| {
                 let old = old_radius.get(&n.vertex).copied();
-                let unchanged = old == Some(self.radii[k]);
+                let now = (self.radii[k], self.partition.stats[k].r_h);
+                let unchanged = old == Some(now);
                 (!unchanged).then_some(Change {
                     node: k,
-                    old_radius: old,
+                    old_radius: old.map(|(radius, _)| radius),
                 })
             })
             .collect();

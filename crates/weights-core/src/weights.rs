@@ -336,18 +336,19 @@ impl Ball {
         self.radius >= radius
     }
 
-    /// Support entries from the cached field.
+    /// Support entries from the cached field (`r_h`: the node's distance to its
+    /// nearest other node).
     fn support(
         &self,
         basis: &Basis,
-        radius: f64,
+        (radius, r_h): (f64, f64),
         nodes: &SampleSet,
         source: u32,
     ) -> Vec<(u32, f32)> {
         self.entries
             .iter()
             .filter_map(|&(v, d)| {
-                support_entry(basis, nodes, source, v, d as f32, radius).map(|f| (v, f))
+                support_entry(basis, nodes, source, v, d, (radius, r_h)).map(|f| (v, f))
             })
             .collect()
     }
@@ -383,24 +384,31 @@ impl SampleSet {
     }
 }
 
-/// The basis value node `source` gives sample `v` at (rounded) distance `d` with support
-/// `radius` (an f32-representable value), or `None`: 1 at its own sample, nothing at any
-/// other node's sample (so weights interpolate exactly), φ(d / radius) for d < radius.
-/// Every path that makes weights goes through here.
+/// The basis value node `source` gives sample `v` at distance `d` with support
+/// `radius` (an f32-representable value, at or above the exact support) and `r_h` (its
+/// distance to its nearest other node), or `None`: 1 at its own sample, nothing at any
+/// other node's sample (so weights interpolate exactly) nor at or beyond `r_h`,
+/// φ(d / radius) for d (rounded to f32) < radius. Every path that makes weights goes
+/// through here.
+///
+/// (Distances are kept as f32, and the support is rounded up to match; without the
+/// exact `r_h` limit, a sample just beyond the nearest node could round inside it —
+/// and one that stops carrying a node would then take entries that an update, which
+/// keeps the entries of nodes that did not change, could not give it.)
 #[inline]
 fn support_entry(
     basis: &Basis,
     nodes: &SampleSet,
     source: u32,
     v: u32,
-    d: f32,
-    radius: f64,
+    exact: f64,
+    (radius, r_h): (f64, f64),
 ) -> Option<f32> {
     if v == source {
         return Some(1.0);
     }
-    let d = f64::from(d);
-    if d >= radius || nodes.contains(v) {
+    let d = f64::from(exact as f32);
+    if d >= radius || exact >= r_h || nodes.contains(v) {
         return None;
     }
     let phi = basis.eval(d / radius) as f32;
@@ -547,7 +555,10 @@ impl Weights {
         let supports: Vec<Vec<(u32, f32)>> = balls
             .par_iter()
             .enumerate()
-            .map(|(k, b)| b.support(basis, radii[k], &nodes, partition.node_vertex[k]))
+            .map(|(k, b)| {
+                let limits = (radii[k], partition.stats[k].r_h);
+                b.support(basis, limits, &nodes, partition.node_vertex[k])
+            })
             .collect();
         let mut order: Vec<usize> = (0..partition.len()).collect();
         order.sort_unstable_by_key(|&k| partition.node_vertex[k]);
@@ -652,10 +663,9 @@ impl Weights {
                     let mut sum = 0.0;
                     for &k in &by_cell[cell_start[c] as usize..cell_start[c + 1] as usize] {
                         let source = partition.node_vertex[k as usize];
-                        let d = (positions[source as usize] - p).length() as f32;
-                        if let Some(f) =
-                            support_entry(basis, &nodes, source, v as u32, d, radii[k as usize])
-                        {
+                        let d = (positions[source as usize] - p).length();
+                        let limits = (radii[k as usize], partition.stats[k as usize].r_h);
+                        if let Some(f) = support_entry(basis, &nodes, source, v as u32, d, limits) {
                             rows.nodes.push(k);
                             rows.phi.push(f);
                             sum += f64::from(f);
@@ -807,14 +817,14 @@ impl Weights {
                 // Every sample the node reaches or reached gets its row redone.
                 mark(source);
                 let mut by_chunk = vec![Vec::new(); chunk_count];
+                let limits = (r, partition.stats[c.node].r_h);
                 for &(v, d) in &ball.entries {
-                    let d = d as f32;
-                    if f64::from(d) >= reach && v != source {
+                    if f64::from(d as f32) >= reach && v != source {
                         // Beyond the support now and before: no row changes.
                         continue;
                     }
                     mark(v);
-                    if let Some(f) = support_entry(basis, &nodes, source, v, d, r) {
+                    if let Some(f) = support_entry(basis, &nodes, source, v, d, limits) {
                         by_chunk[v as usize / CHUNK].push((v, c.node as u32, f));
                     }
                 }

@@ -1253,3 +1253,26 @@ fn a_part_is_set_up_as_a_reopen_sets_it_up_whatever_came_before() {
     doc.check_reopens().expect("reopens with the kept cage");
     doc.sanity_check().expect("consistent");
 }
+
+#[test]
+fn pins_added_one_by_one_weigh_as_a_build_with_euclidean_distances_and_a_fixed_border() {
+    // Distances kept in single precision put samples just beyond a node's nearest node
+    // inside its rounded support; a virtual node that a new pin replaces leaves such a
+    // sample behind. The insertions must weigh it as a build of the saved file does.
+    for alpha in [1.0, 0.25] {
+        let doc = twin_discs(3_000);
+        let mut project = doc.project().clone();
+        project.parts = None;
+        let layers = (**doc.layers.as_ref().expect("layers")).clone();
+        let mut doc = Document::from_artwork(layers, None, project).expect("one picture");
+        let mut settings = doc.settings();
+        settings.metric = MetricChoice::Euclidean;
+        settings.fixed_boundary = true;
+        settings.alpha = alpha;
+        doc.apply(Edit::Settings(settings)).expect("settings");
+        for at in [(28.0, 45.0), (22.0, 30.0), (35.0, 62.0), (40.0, 40.0)] {
+            doc.apply(Edit::Add(point(at.0, at.1))).expect("a pin");
+            doc.check_reopens().expect("reopens with the pin");
+        }
+    }
+}
