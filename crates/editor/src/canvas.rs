@@ -294,15 +294,19 @@ impl EditorApp {
     /// in yellow, the back one in blue.
     fn paint_overlaps(&mut self, painter: &egui::Painter) {
         let (in_hand, warping) = (self.in_hand(), self.cage_warping());
-        let Some(doc) = &self.doc else { return };
+        let Some(doc) = &mut self.doc else { return };
+        // (The method's positions, kept between frames.)
+        doc.deformed();
+        let doc = &*doc;
         // The mesh the view draws (none: the picture at rest, nothing overlaps).
-        let Some(shown) = doc.shown(in_hand, warping).deformer() else {
+        let shown = doc.shown(in_hand, warping);
+        let (Some(mesh), Some(positions)) = (shown.deformer(), shown.positions(doc)) else {
             return;
         };
-        let (positions, triangles) = (shown.deformed(), shown.triangles());
+        let triangles = mesh.triangles();
         let outline = |sheet: &[u32], colour: Color32| {
             let sheet = sheet.iter().filter_map(|&t| triangles.get(t as usize));
-            outline(painter, &self.viewport, &positions, sheet, colour);
+            outline(painter, &self.viewport, positions, sheet, colour);
         };
         for region in doc.overlap_regions() {
             outline(&region.back, Color32::from_rgb(90, 160, 255));
@@ -314,13 +318,17 @@ impl EditorApp {
     /// as parts).
     fn paint_selected_part(&mut self, painter: &egui::Painter) {
         let (in_hand, warping) = (self.in_hand(), self.cage_warping());
-        let (Some(doc), Some(k)) = (&self.doc, self.selected_part) else {
+        let (Some(doc), Some(k)) = (&mut self.doc, self.selected_part) else {
             return;
         };
-        let crate::document::Shown::Parts(parts) = doc.shown(in_hand, warping) else {
+        // (The parts' positions, kept between frames.)
+        doc.deformed();
+        let doc = &*doc;
+        let shown = doc.shown(in_hand, warping);
+        let (crate::document::Shown::Parts(parts), Some(positions)) = (shown, shown.positions(doc))
+        else {
             return;
         };
-        let positions = pipeline::Deformer::deformed(parts);
         let part = (pipeline::Deformer::triangles(parts).iter())
             .zip(parts.part_of())
             .filter(|&(_, &p)| p as usize == k)
@@ -328,7 +336,7 @@ impl EditorApp {
         outline(
             painter,
             &self.viewport,
-            &positions,
+            positions,
             part,
             Color32::from_rgb(255, 120, 200),
         );

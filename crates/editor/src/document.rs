@@ -1086,6 +1086,15 @@ impl Document {
         self.deformed.as_ref().map_or(&[], |(_, d)| d)
     }
 
+    /// [`Document::deformed`] as last brought up to date, if it is for the current pose
+    /// and weights (for readers that hold the document shared, after calling it).
+    pub fn current_deformed(&self) -> Option<&[DVec2]> {
+        let version = (self.pose_version, self.weights_version);
+        (self.deformed.as_ref())
+            .filter(|(v, _)| *v == version)
+            .map(|(_, d)| d.as_slice())
+    }
+
     /// The rest position under `p` in the current pose, and the local similarity the
     /// pose applies there (rotation, scale), found from the deformed triangle that
     /// contains `p` (the first one, where folds overlap). `None` off the picture.

@@ -52,6 +52,17 @@ impl<'a> Shown<'a> {
         }
     }
 
+    /// Where the mesh drawn lies in the current pose: the cage's mesh as the cage
+    /// moves it, else the method's positions as [`Document::deformed`] last brought
+    /// them up to date (`None` if it has not since the pose changed, or for the
+    /// picture at rest alone).
+    pub fn positions(&self, doc: &'a Document) -> Option<&'a [glam::DVec2]> {
+        match *self {
+            Shown::Cage(cage) => cage.map(CageDeformer::positions),
+            Shown::Picture(_) | Shown::Parts(_) => doc.current_deformed(),
+        }
+    }
+
     /// Whether the cage's view is drawn: the picture at rest under the cage's
     /// mesh.
     pub fn over_backdrop(&self) -> bool {
