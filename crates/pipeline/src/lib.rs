@@ -209,6 +209,43 @@ pub fn mesh_picture(
     mesh_along_cuts(&domain, options, cuts)
 }
 
+/// The outline tolerance (pixels) of a layer meshed as a part whose exact outline
+/// would take more than [`PART_OUTLINE_SHARE`] of its vertices: it keeps the one-pixel
+/// margin of the exact outline (every visible pixel's centre stays at least 0.25 px
+/// inside), but no longer follows each step of a pixel staircase.
+pub const PART_OUTLINE_TOLERANCE: f64 = 1.25;
+
+/// The share of a part's vertices its exact outline may take before the part is
+/// outlined at [`PART_OUTLINE_TOLERANCE`] instead.
+pub const PART_OUTLINE_SHARE: f64 = 0.25;
+
+/// A layer meshed as a part ([`mesh_picture`], with one difference): its share of the
+/// density is often small, and the exact outline of a smooth edge (0.75 px from the
+/// traced one, each step of the pixel staircase kept) would then take most of it, and
+/// the mesh graded from that fine outline to the coarse inside two to three times the
+/// vertices asked for. Such a part is outlined at [`PART_OUTLINE_TOLERANCE`] px
+/// instead, so the parts share the density as one picture would spend it.
+///
+/// # Errors
+/// As [`mesh_picture`].
+pub fn mesh_part(
+    image: &RgbaImage,
+    options: &MeshOptions,
+    cuts: &[project::Cut],
+) -> Result<(Mesh, bool), MeshError> {
+    let exact = DomainOptions::default();
+    let mut domain = mesh::domain_for_density(image, &exact, options.target_vertices)?;
+    let outline: usize = domain.rings().map(<[DVec2]>::len).sum();
+    if outline as f64 > PART_OUTLINE_SHARE * options.target_vertices as f64 {
+        let coarser = DomainOptions {
+            simplify_tolerance: PART_OUTLINE_TOLERANCE,
+            ..exact
+        };
+        domain = mesh::domain_for_density(image, &coarser, options.target_vertices)?;
+    }
+    mesh_along_cuts(&domain, options, cuts)
+}
+
 /// `domain` meshed at `options` with each of `cuts`' parts inside it as edges, then
 /// split along them ([`mesh::split_along`]); and whether the result is convex (never
 /// with a cut inside).
@@ -477,6 +514,20 @@ pub fn prepare_with_progress(
     density: Option<usize>,
     progress: &(dyn Fn(weights_core::Progress) + Sync),
 ) -> Result<Prepared> {
+    prepare_meshed(image, project, density, progress, mesh_picture)
+}
+
+/// How a picture is meshed: [`mesh_picture`], or [`mesh_part`] for a layer of parts.
+type Mesher = fn(&RgbaImage, &MeshOptions, &[project::Cut]) -> Result<(Mesh, bool), MeshError>;
+
+/// [`prepare_with_progress`], meshing by `mesher`.
+fn prepare_meshed(
+    image: &RgbaImage,
+    project: &Project,
+    density: Option<usize>,
+    progress: &(dyn Fn(weights_core::Progress) + Sync),
+    mesher: Mesher,
+) -> Result<Prepared> {
     if let Some(density) = density {
         project::validate_density(density)?;
     }
@@ -500,8 +551,7 @@ pub fn prepare_with_progress(
         refine,
         ..MeshOptions::default()
     };
-    let (mesh, convex) =
-        mesh_picture(image, &options, &project.cuts).context("cannot mesh the image")?;
+    let (mesh, convex) = mesher(image, &options, &project.cuts).context("cannot mesh the image")?;
     let domain = Domain::new(
         mesh.vertices,
         mesh.triangles,
@@ -852,6 +902,22 @@ pub fn prepare_warper(
     listener: &dyn Listener,
 ) -> Result<Warper> {
     setup(Source::Picture { image, density }, project, listener)
+}
+
+/// [`prepare_warper`] for a layer drawn as a part, meshed by [`mesh_part`] (a handle
+/// method; a cage deforms the parts on the canvas, [`parts`]).
+///
+/// # Errors
+/// As [`prepare_warper`].
+pub(crate) fn prepare_part_warper(
+    image: &RgbaImage,
+    project: &Project,
+    density: usize,
+    listener: &dyn Listener,
+) -> Result<Warper> {
+    let weighting = |p| listener.weighting(p);
+    let rig = prepare_meshed(image, project, Some(density), &weighting, mesh_part)?.rig;
+    Warper::on_rig(rig, project, Some(image))
 }
 
 /// Where an output picture lies over the source's pixels: its pixel `(0, 0)` is the

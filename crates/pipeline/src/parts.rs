@@ -32,7 +32,7 @@ use render::Picture;
 use weights_core::{Domain, Metric};
 
 use crate::deformer::{Deformer, Follow, Method, Output, WeightsListing, json, median, quantile};
-use crate::{DEFAULT_DENSITY, Frame, Listener, Warper, blank, placed, prepare_warper};
+use crate::{DEFAULT_DENSITY, Frame, Listener, Warper, blank, placed, prepare_part_warper};
 
 /// The fewest vertices a part is meshed with, whatever its share of the density.
 const MIN_PART_DENSITY: usize = 200;
@@ -409,7 +409,7 @@ impl PartRig {
                         crate::rig_on_domain(domain, &placed, &|p| listener.weighting(p))
                     })
                     .and_then(|rig| Warper::on_rig(rig, &placed, Some(&picture))),
-                None => prepare_warper(&picture, &placed, Some(density), listener),
+                None => prepare_part_warper(&picture, &placed, density, listener),
             }
             .with_context(|| format!("part \"{}\"", layer.name))?;
             parts.push(Part::Bound(Arc::new(Bound {
@@ -1437,10 +1437,10 @@ fn tie(
     // (Meshed alone: a cage is the whole picture's.)
     still.cage = None;
     let (part, origin) = own_rectangle(layer, canvas, &[])?;
-    let own = prepare_warper(
+    let own = prepare_part_warper(
         &part.to_rgba8(),
         &shifted(&still, -origin),
-        Some(density),
+        density,
         listener,
     )?;
     let rest: Vec<DVec2> = own.deformer.rest().iter().map(|&p| p + origin).collect();

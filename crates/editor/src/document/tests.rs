@@ -881,10 +881,12 @@ fn pins_placed_in_a_pose_on_parts(method: Method) -> Vec<f64> {
     for at in [
         DVec2::new(300.0, 420.0),
         DVec2::new(250.0, 200.0),
-        DVec2::new(160.0, 330.0),
+        DVec2::new(170.0, 326.0),
         DVec2::new(362.0, 345.0),
     ] {
-        let (rest, angle, scale) = doc.unwarp(at).expect("on the picture");
+        let (rest, angle, scale) = doc
+            .unwarp(at)
+            .unwrap_or_else(|| panic!("{at} is on the picture"));
         let handle = HandleSpec::Point {
             rest: rest.to_array(),
             translate: (at - rest).to_array(),
