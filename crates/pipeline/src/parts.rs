@@ -457,7 +457,7 @@ impl PartRig {
                         Part::Bound(b) => Some(b.as_ref()),
                         _ => None,
                     });
-                    follow(layer, canvas, leader, project, density, listener)
+                    follow(layer, canvas, leader, project, density)
                         .with_context(|| format!("part \"{}\"", layer.name))?
                 }
             };
@@ -1412,11 +1412,10 @@ fn follow(
     leader: Option<&Bound>,
     project: &Project,
     density: usize,
-    listener: &dyn Listener,
 ) -> Result<(PartMesh, Vec<Tie>)> {
     let lead = leader.map(|b| (b.rest(), b.warper.deformer.triangles().to_vec()));
     let lead = lead.as_ref().map(|(rest, triangles)| (rest, triangles));
-    tie(layer, canvas, lead, false, project, density, listener)
+    tie(layer, canvas, lead, false, project, density)
 }
 
 /// `layer` meshed on its own (in its own rectangle of `canvas`), each vertex tied to
@@ -1429,21 +1428,17 @@ fn tie(
     outside_still: bool,
     project: &Project,
     density: usize,
-    listener: &dyn Listener,
 ) -> Result<(PartMesh, Vec<Tie>)> {
-    // Its own mesh: the method's setup with no handle is the identity on it.
-    let mut still = part_project(project, usize::MAX, &[]);
-    still.method = project::Method::C2;
-    // (Meshed alone: a cage is the whole picture's.)
-    still.cage = None;
+    // Its own mesh, as a bound part's is meshed (no handle crowds it), in the mesh's
+    // order: nothing of its own moves it.
     let (part, origin) = own_rectangle(layer, canvas, &[])?;
-    let own = prepare_part_warper(
-        &part.to_rgba8(),
-        &shifted(&still, -origin),
-        density,
-        listener,
-    )?;
-    let rest: Vec<DVec2> = own.deformer.rest().iter().map(|&p| p + origin).collect();
+    let cuts = shifted(&part_project(project, usize::MAX, &[]), -origin).cuts;
+    let options = mesh::MeshOptions {
+        target_vertices: density,
+        ..mesh::MeshOptions::default()
+    };
+    let (own, _) = crate::mesh_part(&part.to_rgba8(), &options, &cuts)?;
+    let rest: Vec<DVec2> = own.vertices.iter().map(|&p| p + origin).collect();
     let ties = match leader {
         None => vec![Tie::Still; rest.len()],
         Some((rest_of_leader, triangles)) => {
@@ -1462,7 +1457,7 @@ fn tie(
         PartMesh {
             deformed: rest.clone(),
             rest,
-            triangles: own.triangles.clone(),
+            triangles: own.triangles,
         },
         ties,
     ))
@@ -1623,7 +1618,6 @@ impl PartRig {
                     true,
                     project,
                     density,
-                    listener,
                 )
                 .with_context(|| format!("part \"{}\"", layer.name))?,
             };
