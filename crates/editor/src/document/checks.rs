@@ -100,19 +100,24 @@ impl Document {
                     bail!("the parts are bound otherwise than the rig file binds them");
                 }
                 // Each overlap's order is kept at a triangle's rest centroid on the
-                // part it names.
+                // part it names (looked up by the bits of its coordinates, -0 as 0).
+                let key =
+                    |part: Option<usize>, at: [f64; 2]| (part, at.map(|c| (c + 0.0).to_bits()));
+                let places: Vec<_> = (self.project.overlaps.iter())
+                    .flat_map(|o| [o.front, o.back])
+                    .collect();
+                let mut missing: std::collections::HashSet<_> =
+                    places.iter().map(|p| key(p.part, p.at)).collect();
                 let (rest, triangles) = (parts.rest(), parts.triangles());
-                for place in self.project.overlaps.iter().flat_map(|o| [o.front, o.back]) {
-                    let on = (triangles.iter().zip(parts.part_of())).any(|(t, &k)| {
-                        let centroid =
-                            t.iter().map(|&v| rest[v as usize]).sum::<glam::DVec2>() / 3.0;
-                        Some(k as usize) == place.part && centroid.to_array() == place.at
-                    });
-                    if !on {
-                        bail!(
-                            "an overlap's order is kept at {place:?}, on no triangle of that part"
-                        );
+                for (t, &k) in triangles.iter().zip(parts.part_of()) {
+                    if missing.is_empty() {
+                        break;
                     }
+                    let centroid = t.iter().map(|&v| rest[v as usize]).sum::<glam::DVec2>() / 3.0;
+                    missing.remove(&key(Some(k as usize), centroid.to_array()));
+                }
+                if let Some(place) = places.iter().find(|p| missing.contains(&key(p.part, p.at))) {
+                    bail!("an overlap's order is kept at {place:?}, on no triangle of that part");
                 }
             }
             Controls::Handles => {
