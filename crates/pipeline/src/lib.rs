@@ -221,10 +221,11 @@ pub const PART_OUTLINE_SHARE: f64 = 0.25;
 
 /// A layer meshed as a part ([`mesh_picture`], with one difference): its share of the
 /// density is often small, and the exact outline of a smooth edge (0.75 px from the
-/// traced one, each step of the pixel staircase kept) would then take most of it, and
-/// the mesh graded from that fine outline to the coarse inside two to three times the
-/// vertices asked for. Such a part is outlined at [`PART_OUTLINE_TOLERANCE`] px
-/// instead, so the parts share the density as one picture would spend it.
+/// traced one, each step of the pixel staircase kept) would then take most of it,
+/// and the mesh, graded from that fine outline to the coarse inside, two to three
+/// times the vertices asked for. Such a part is outlined at
+/// [`PART_OUTLINE_TOLERANCE`] px instead, so the parts share the density as one
+/// picture would spend it.
 ///
 /// # Errors
 /// As [`mesh_picture`].
