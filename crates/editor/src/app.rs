@@ -625,6 +625,7 @@ pub(crate) fn without_virtuals(project: &project::Project) -> project::Project {
     project::Project {
         virtual_handles: Vec::new(),
         virtual_placed_for: Vec::new(),
+        virtual_copy: Vec::new(),
         ..project.clone()
     }
 }

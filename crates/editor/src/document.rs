@@ -244,6 +244,7 @@ impl Document {
         // Virtual handles live in the rig while editing; they are written out on save.
         project.virtual_handles.clear();
         project.virtual_placed_for.clear();
+        project.virtual_copy.clear();
         Self {
             project,
             image,
@@ -846,10 +847,17 @@ impl Document {
     /// Makes `project` (the document's, with handle `removed` of the partition taken
     /// out) the document's rig file, with that handle's nodes kept as virtual handles.
     fn remove_keeping_nodes(&mut self, mut project: Project, removed: usize) -> Result<()> {
-        let snapshot = self.snapshot();
         let rig = &self.rig;
-        let positions = rig.domain().positions();
-        let left: Vec<[f64; 2]> = (0..rig.nodes().len())
+        let renumber = |h: Option<usize>| match h {
+            Some(h) if h > removed => Some(h - 1),
+            Some(h) if h == removed => None,
+            other => other,
+        };
+        let kept = (rig.placed_virtual_handles().into_iter()).map(|v| VirtualHandle {
+            placed_for: renumber(v.placed_for),
+            ..v
+        });
+        let left = (0..rig.nodes().len())
             .filter(|&k| {
                 rig.owner_handle(k) == Some(removed)
                     && matches!(
@@ -858,21 +866,12 @@ impl Document {
                             | weights_core::NodeKind::BarSample { .. }
                     )
             })
-            .map(|k| positions[rig.nodes()[k].vertex as usize].to_array())
-            .collect();
-        let renumber = |h: Option<usize>| match h {
-            Some(h) if h > removed => Some(h - 1),
-            Some(h) if h == removed => None,
-            other => other,
-        };
-        project.virtual_placed_for = snapshot
-            .virtual_placed_for
-            .iter()
-            .map(|&h| renumber(h))
-            .chain(std::iter::repeat_n(None, left.len()))
-            .collect();
-        project.virtual_handles = snapshot.virtual_handles;
-        project.virtual_handles.extend(left);
+            .map(|k| VirtualHandle {
+                vertex: rig.nodes()[k].vertex,
+                placed_for: None,
+            });
+        let virtuals: Vec<VirtualHandle> = kept.chain(left).collect();
+        pipeline::write_virtual_handles(rig.domain(), &virtuals, &mut project);
         if project.virtual_placed_for.iter().all(Option::is_none) {
             project.virtual_placed_for.clear();
         }
@@ -941,13 +940,8 @@ impl Document {
     /// brings back exactly.
     pub fn snapshot(&self) -> Project {
         let mut project = self.project.clone();
-        let positions = self.rig.domain().positions();
         let placed = self.rig.placed_virtual_handles();
-        project.virtual_handles = placed
-            .iter()
-            .map(|v| positions[v.vertex as usize].to_array())
-            .collect();
-        project.virtual_placed_for = placed.iter().map(|v| v.placed_for).collect();
+        pipeline::write_virtual_handles(self.rig.domain(), &placed, &mut project);
         project
     }
 
@@ -963,8 +957,12 @@ impl Document {
     }
 
     fn restore_with(&mut self, mut project: Project, exact: bool) -> Result<()> {
-        let virtuals = std::mem::take(&mut project.virtual_handles);
-        let placed_for = std::mem::take(&mut project.virtual_placed_for);
+        let saved_virtuals = Project {
+            virtual_handles: std::mem::take(&mut project.virtual_handles),
+            virtual_placed_for: std::mem::take(&mut project.virtual_placed_for),
+            virtual_copy: std::mem::take(&mut project.virtual_copy),
+            ..Project::default()
+        };
         // Another method or another rest cage draws another mesh; another cage pose
         // moves it.
         let cage_mesh_changed = project.method != self.project.method
@@ -999,8 +997,9 @@ impl Document {
         if new.density != old.density || refinement_changed || cuts_changed {
             let mut with_virtuals = project.clone();
             if exact {
-                with_virtuals.virtual_handles = virtuals;
-                with_virtuals.virtual_placed_for = placed_for;
+                with_virtuals.virtual_handles = saved_virtuals.virtual_handles;
+                with_virtuals.virtual_placed_for = saved_virtuals.virtual_placed_for;
+                with_virtuals.virtual_copy = saved_virtuals.virtual_copy;
             } else if new.density == old.density {
                 // The same lattice: the virtual handles stay where they were (those
                 // placed for a handle that is gone go with it), and Algorithm 1 adds
@@ -1008,22 +1007,14 @@ impl Document {
                 (
                     with_virtuals.virtual_handles,
                     with_virtuals.virtual_placed_for,
+                    with_virtuals.virtual_copy,
                 ) = carried_virtuals(&self.snapshot(), &project);
             }
             self.rig = pipeline::prepare(&self.image, &with_virtuals, None)?.rig;
             self.mesh_version += 1;
         } else if new == old && exact && !same_rest {
             let domain = self.rig.domain();
-            let placed: Vec<VirtualHandle> = virtuals
-                .iter()
-                .enumerate()
-                .filter_map(|(i, &p)| {
-                    Some(VirtualHandle {
-                        vertex: domain.nearest_vertex(DVec2::from(p))?,
-                        placed_for: placed_for.get(i).copied().flatten(),
-                    })
-                })
-                .collect();
+            let placed = pipeline::virtual_handles_on(domain, &saved_virtuals);
             self.rig = Rig::with_overlaid(
                 domain.clone(),
                 handles,
@@ -1296,7 +1287,10 @@ pub(crate) fn locate(
 /// the same picture whose handles are `from`'s with some added or removed: every
 /// virtual handle, except those placed for a handle `to` no longer has, each naming
 /// its handle's index in `to`.
-fn carried_virtuals(from: &Project, to: &Project) -> (Vec<[f64; 2]>, Vec<Option<usize>>) {
+fn carried_virtuals(
+    from: &Project,
+    to: &Project,
+) -> (Vec<[f64; 2]>, Vec<Option<usize>>, Vec<usize>) {
     // Old handle → new index, matching handles of the same rest geometry in order.
     let mut next = 0;
     let index: Vec<Option<usize>> = from
@@ -1310,24 +1304,25 @@ fn carried_virtuals(from: &Project, to: &Project) -> (Vec<[f64; 2]>, Vec<Option<
             found
         })
         .collect();
-    let mut kept = (Vec::new(), Vec::new());
+    let mut kept = (Vec::new(), Vec::new(), Vec::new());
     for (i, &p) in from.virtual_handles.iter().enumerate() {
-        let placed = from.virtual_placed_for.get(i).copied().flatten();
-        match placed {
-            Some(h) => {
-                if let Some(j) = index.get(h).copied().flatten() {
-                    kept.0.push(p);
-                    kept.1.push(Some(j));
-                }
-            }
-            None => {
-                kept.0.push(p);
-                kept.1.push(None);
-            }
-        }
+        let placed = match from.virtual_placed_for.get(i).copied().flatten() {
+            // Placed for a handle: it goes where that handle goes, or with it.
+            Some(h) => match index.get(h).copied().flatten() {
+                Some(j) => Some(j),
+                None => continue,
+            },
+            None => None,
+        };
+        kept.0.push(p);
+        kept.1.push(placed);
+        kept.2.push(from.virtual_copy.get(i).copied().unwrap_or(0));
     }
     if kept.1.iter().all(Option::is_none) {
         kept.1.clear();
+    }
+    if kept.2.iter().all(|&c| c == 0) {
+        kept.2.clear();
     }
     kept
 }

@@ -590,17 +590,7 @@ pub(crate) fn rig_on_domain(
             p[1]
         );
     }
-    let virtual_handles: Vec<VirtualHandle> = project
-        .virtual_handles
-        .iter()
-        .enumerate()
-        .filter_map(|(i, &p)| {
-            Some(VirtualHandle {
-                vertex: domain.nearest_vertex(DVec2::from(p))?,
-                placed_for: project.virtual_placed_for.get(i).copied().flatten(),
-            })
-        })
-        .collect();
+    let virtual_handles = virtual_handles_on(&domain, project);
     Ok(Rig::with_overlaid(
         domain,
         handles,
@@ -609,6 +599,49 @@ pub(crate) fn rig_on_domain(
         rig_options(project)?,
         progress,
     )?)
+}
+
+/// `project`'s saved virtual handles on `domain`: each on the vertex at its place
+/// (the nearest), the copy [`Project::virtual_copy`] names where a cut doubled it (the
+/// first where the mesh has no such copy: a file saved from another mesh, whose
+/// places are taken to the nearest vertex anyway).
+pub fn virtual_handles_on(domain: &Domain, project: &Project) -> Vec<VirtualHandle> {
+    (project.virtual_handles.iter().enumerate())
+        .filter_map(|(i, &p)| {
+            let nearest = domain.nearest_vertex(DVec2::from(p))?;
+            Some(VirtualHandle {
+                vertex: copy_at(domain, nearest, project.virtual_copy.get(i).copied()),
+                placed_for: project.virtual_placed_for.get(i).copied().flatten(),
+            })
+        })
+        .collect()
+}
+
+/// Copy `copy` (0 when `None`) of the vertices at vertex `v`'s place, or `v` where
+/// there is no such copy.
+fn copy_at(domain: &Domain, v: u32, copy: Option<usize>) -> u32 {
+    (domain.coincident(v).get(copy.unwrap_or(0)).copied()).unwrap_or(v)
+}
+
+/// Writes `placed` (virtual handles on `domain`'s vertices) into `project` as a rig
+/// file keeps them: their places, the handle each was placed for, and which of the
+/// vertices at its place each sits on ([`Project::virtual_copy`], left out when every
+/// one is on the first), so that [`virtual_handles_on`] finds the same vertices.
+pub fn write_virtual_handles(domain: &Domain, placed: &[VirtualHandle], project: &mut Project) {
+    let positions = domain.positions();
+    project.virtual_handles = (placed.iter())
+        .map(|v| positions[v.vertex as usize].to_array())
+        .collect();
+    project.virtual_placed_for = placed.iter().map(|v| v.placed_for).collect();
+    project.virtual_copy = (placed.iter())
+        .map(|v| {
+            let there = domain.coincident(v.vertex);
+            there.iter().position(|&u| u == v.vertex).unwrap_or(0)
+        })
+        .collect();
+    if project.virtual_copy.iter().all(|&c| c == 0) {
+        project.virtual_copy.clear();
+    }
 }
 
 /// Builds `project`'s C² rig on a given mesh (`--mesh`): its vertices are used as
@@ -676,6 +709,10 @@ pub fn rig_on_mesh(
     )?;
     let metric = metric(project.metric, provisional.is_convex());
     let domain = Domain::new(mesh.vertices, mesh.triangles, metric)?;
+    // A mesh with vertices at one place (split along a cut): the copy saved.
+    for (i, v) in virtual_handles.iter_mut().enumerate() {
+        v.vertex = copy_at(&domain, v.vertex, project.virtual_copy.get(i).copied());
+    }
     Ok(Rig::with_overlaid(
         domain,
         handles,
@@ -1300,7 +1337,6 @@ mod tests {
             .insert_handle(Handle::point(DVec2::new(446.0, 238.0)))
             .expect("room");
         let placed = rig.placed_virtual_handles();
-        let positions = rig.domain().positions();
         assert!(
             placed.iter().any(|v| v.placed_for == Some(new)),
             "{placed:?}"
@@ -1313,11 +1349,7 @@ mod tests {
             depth: 0,
         };
         project.handles.push(point(DVec2::new(446.0, 238.0)));
-        project.virtual_handles = placed
-            .iter()
-            .map(|v| positions[v.vertex as usize].to_array())
-            .collect();
-        project.virtual_placed_for = placed.iter().map(|v| v.placed_for).collect();
+        write_virtual_handles(rig.domain(), &placed, &mut project);
         let saved = Project::from_json(&project.to_json()).expect("round trip");
         let mut reloaded = prepare(&image, &saved, None).expect("builds").rig;
         let at = |rig: &Rig, v: &VirtualHandle| {

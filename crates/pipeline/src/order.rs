@@ -188,11 +188,21 @@ impl Arranger {
         &self.regions
     }
 
-    /// The regions' orders as a rig file keeps them: the rest centroid of the first
-    /// triangle of each sheet.
+    /// The regions' orders as a rig file keeps them: the rest centroid of one triangle
+    /// of each sheet, one that lies in no other sheet where the sheet has one. (A
+    /// triangle can lie in two regions — the middle of three layers is in front of one
+    /// and behind the other — and a reopened pose, remembering one triangle a sheet,
+    /// would count such a triangle for both regions and could turn one of them over.)
     pub fn overlaps(&self, rest: &[DVec2], triangles: &[[u32; 3]]) -> Vec<OverlapOrder> {
+        let mut sheets_of: std::collections::HashMap<u32, u32> = Default::default();
+        for region in &self.regions {
+            for &t in region.front.iter().chain(&region.back) {
+                *sheets_of.entry(t).or_default() += 1;
+            }
+        }
         let place = |sheet: &[u32]| {
-            sheet.first().map(|&t| {
+            let own = sheet.iter().find(|t| sheets_of.get(t) == Some(&1));
+            own.or(sheet.first()).map(|&t| {
                 let [a, b, c] = triangles[t as usize].map(|v| rest[v as usize]);
                 let at = (a + b + c) / 3.0;
                 Place {
@@ -269,5 +279,39 @@ mod tests {
             order.iter().position(|&o| o == triangles[39])
                 < order.iter().position(|&o| o == triangles[0])
         );
+    }
+
+    #[test]
+    fn a_saved_sheet_is_named_by_a_triangle_of_its_own_region_alone() {
+        // Two regions between the same two sheets, in opposite orders (a tail over the
+        // body here, under it there), sharing triangles 1 and 10: saved by those, a
+        // reopened pose would find region 2's places in region 1's sheets turned over,
+        // count them against region 1's own, and could turn region 1 over.
+        let rig = strip_rig();
+        let (rest, triangles) = (rig.domain().positions(), rig.domain().triangles());
+        let mut arranger = Arranger::new((0..40).collect(), &[], rest, triangles);
+        arranger.regions = vec![
+            depth::Region {
+                front: vec![1, 2, 3],
+                back: vec![10, 11],
+            },
+            depth::Region {
+                front: vec![10, 12],
+                back: vec![1, 4],
+            },
+        ];
+        let at = |t: usize| {
+            let c = triangles[t].map(|v| rest[v as usize]);
+            let at = (c[0] + c[1] + c[2]) / 3.0;
+            [at.x, at.y]
+        };
+        let saved = arranger.overlaps(rest, triangles);
+        let named: Vec<[[f64; 2]; 2]> = saved.iter().map(|o| [o.front.at, o.back.at]).collect();
+        assert_eq!(named, [[at(2), at(11)], [at(12), at(4)]]);
+        // A sheet all of whose triangles lie in another region too: its first.
+        arranger.regions[1].front = vec![10];
+        let saved = arranger.overlaps(rest, triangles);
+        assert_eq!(saved[1].front.at, at(10));
+        assert_eq!(saved[0].back.at, at(11));
     }
 }

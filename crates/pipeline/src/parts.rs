@@ -1668,6 +1668,7 @@ fn part_project(project: &Project, layer: usize, bound: &[usize]) -> Project {
     // places its own (the C² paper's Algorithm 1 on its shape).
     part.virtual_handles.clear();
     part.virtual_placed_for.clear();
+    part.virtual_copy.clear();
     part.animation = None;
     part.canvas = Canvas::Keep;
     // The saved overlap orders name places on the parts drawn together

@@ -196,3 +196,43 @@ fn a_cut_splits_the_inside_of_a_cage() {
         "{joined_left} / {cut_left}"
     );
 }
+
+/// Algorithm 1 may place a virtual handle on either side of a cut, on vertices at one
+/// place: the rig file says which, so a reopened project has the same weights.
+#[test]
+fn virtual_handles_on_either_side_of_a_cut_reopen_on_their_side() {
+    let image = touching();
+    let mut later_copies = 0;
+    for density in [600, 900, 1_500, 2_400] {
+        let project = Project {
+            density: Some(density),
+            degree: 14,
+            fixed_boundary: true,
+            handles: vec![point([20.0, 30.0], [0.0, 0.0])],
+            cuts: across(),
+            ..Project::default()
+        };
+        let rig = pipeline::prepare(&image, &project, None)
+            .expect("builds")
+            .rig;
+        let mut saved = project.clone();
+        pipeline::write_virtual_handles(rig.domain(), &rig.placed_virtual_handles(), &mut saved);
+        later_copies += saved.virtual_copy.iter().filter(|&&c| c > 0).count();
+        let saved = Project::from_json(&saved.to_json()).expect("round trip");
+        let reopened = pipeline::prepare(&image, &saved, None)
+            .expect("reopens")
+            .rig;
+        assert_eq!(
+            reopened.virtual_vertices(),
+            rig.virtual_vertices(),
+            "density {density}"
+        );
+        let weights = |rig: &weights_core::Rig| -> Vec<Vec<(usize, f64)>> {
+            (0..rig.domain().positions().len())
+                .map(|v| rig.weights(v).collect())
+                .collect()
+        };
+        assert!(weights(&reopened) == weights(&rig), "density {density}");
+    }
+    assert!(later_copies > 0, "no virtual handle on a cut's second side");
+}

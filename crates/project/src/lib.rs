@@ -576,6 +576,14 @@ pub struct Project {
     /// from before this field) or as long as `virtual_handles`.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub virtual_placed_for: Vec<Option<usize>>,
+    /// For each of [`Project::virtual_handles`], in the same order, which of the mesh's
+    /// vertices at its place it sits on: 0 the first in the mesh's order, 1 the next. A
+    /// cut doubles the vertices along it, one for each side, and a virtual handle on
+    /// one side weighs otherwise than on the other. Either empty (omitted: every one on
+    /// the first) or as long as `virtual_handles`; a copy the mesh does not have at
+    /// that place (a file saved from another mesh) means the first.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub virtual_copy: Vec<usize>,
     /// The warping method (`"c2"` when absent, so older files load unchanged).
     #[serde(default, skip_serializing_if = "is_c2")]
     pub method: Method,
@@ -906,6 +914,7 @@ impl Default for Project {
             handles: Vec::new(),
             virtual_handles: Vec::new(),
             virtual_placed_for: Vec::new(),
+            virtual_copy: Vec::new(),
             method: Method::C2,
             rigidity: Vec::new(),
             cage: None,
@@ -1147,6 +1156,14 @@ impl Project {
                     self.handles.len()
                 ));
             }
+        }
+        if !self.virtual_copy.is_empty() && self.virtual_copy.len() != self.virtual_handles.len() {
+            return bad(format!(
+                "virtual_copy has {} entries for {} virtual handles (one each, or leave it \
+                 out)",
+                self.virtual_copy.len(),
+                self.virtual_handles.len()
+            ));
         }
         if let Some(i) = (0..self.overlaid.len()).find(|&i| {
             self.overlaid[i] >= self.handles.len()
@@ -1914,7 +1931,25 @@ mod tests {
         };
         let text = with.to_json();
         assert!(text.contains("\"virtual_placed_for\""), "{text}");
+        assert!(!text.contains("virtual_copy"), "{text}");
         assert_eq!(Project::from_json(&text).expect("parses"), with);
+        // Which copy of a vertex doubled by a cut: round-trips, one entry each.
+        let copies = Project {
+            virtual_copy: vec![0, 1],
+            ..with
+        };
+        let text = copies.to_json();
+        assert_eq!(Project::from_json(&text).expect("parses"), copies);
+        let short = text.replace(
+            "\"virtual_copy\": [\n    0,\n    1\n  ]",
+            "\"virtual_copy\": [1]",
+        );
+        assert_ne!(short, text);
+        let err = Project::from_json(&short).expect_err("one entry for two");
+        assert!(
+            err.to_string().contains("virtual_copy has 1 entries"),
+            "{err}"
+        );
     }
 
     #[test]

@@ -475,6 +475,22 @@ impl Domain {
         best.map(|(_, v)| v)
     }
 
+    /// The samples at exactly sample `v`'s place, `v` among them, in index order: more
+    /// than one where the mesh was split along a cut (the vertices on it doubled, one
+    /// for each side).
+    pub fn coincident(&self, v: u32) -> Vec<u32> {
+        let Some(&p) = self.positions.get(v as usize) else {
+            return Vec::new();
+        };
+        let grid = self.vertex_grid();
+        let (x, y) = grid.cell_of(p);
+        let mut out: Vec<u32> = (grid.items(x, y).iter().copied())
+            .filter(|&u| self.positions[u as usize] == p)
+            .collect();
+        out.sort_unstable();
+        out
+    }
+
     /// The samples within `r` of the segment from `a` to `b` (of the point `a` when
     /// `a == b`), in index order; none for a non-finite segment or radius.
     pub fn vertices_near_segment(&self, a: DVec2, b: DVec2, r: f64) -> Vec<u32> {

@@ -204,7 +204,16 @@ impl Document {
         }
         // (Mid-drag on a large mesh the order waits for the drag's end.)
         if !self.depth_deferred && self.draw_order() != fresh.draw_order() {
-            bail!("reopened, the triangles are drawn in another order");
+            let (this, reopened) = (self.overlap_regions(), fresh.overlap_regions());
+            let turned = (this.iter())
+                .filter(|r| (reopened.iter()).any(|q| q.front == r.back && q.back == r.front))
+                .count();
+            bail!(
+                "reopened, the triangles are drawn in another order ({} overlap regions, {} \
+                 reopened; {turned} turned over)",
+                this.len(),
+                reopened.len()
+            );
         }
         Ok(())
     }
