@@ -322,7 +322,7 @@ impl Document {
         {
             return Ok(());
         }
-        self.method = pipeline::beside_rig(&self.project, &self.rig, Some(&self.image))?
+        self.method = pipeline::on_mesh(&self.project, self.rig.domain(), Some(&self.image))?
             .map(|deformer| (self.mesh_version, deformer));
         Ok(())
     }
@@ -342,8 +342,8 @@ impl Document {
             // The parts back to front in the draw order, each in its own order.
             return parts.triangles().to_vec();
         }
-        let depths: Vec<i32> = self.project.handles.iter().map(HandleSpec::depth).collect();
-        pipeline::draw_order(&self.rig, &depths)
+        let order = pipeline::order::predefined_for(&self.project, &self.rig);
+        pipeline::order::as_triangles(&order, self.rig.domain().triangles())
     }
 
     /// The method in use.

@@ -322,13 +322,7 @@ fn every_handle_method_shows_its_own_answer_between_keys() {
         // What the view draws between the keys is the method's answer for the rig
         // posed at that time, set up afresh.
         let shown = doc.deformer().deformed();
-        let fresh = pipeline::on_handles(
-            &animation::posed_at(&project, 0.25),
-            doc.rig().clone(),
-            Some(&doc.image),
-        )
-        .expect("the method")
-        .deformed();
+        let fresh = set_up_afresh(doc, &animation::posed_at(&project, 0.25));
         assert_eq!(shown, fresh, "{label}");
         // Played (live frames, as a drag's) and paused: what shows is again the
         // method's answer set up afresh for the time shown.
@@ -346,14 +340,21 @@ fn every_handle_method_shows_its_own_answer_between_keys() {
             Pose::of(&project).same_controls(&animation::pose_at(&project, time).expect("a pose")),
             "{label}"
         );
-        let fresh = pipeline::on_handles(
-            &animation::posed_at(&project, time),
-            doc.rig().clone(),
-            Some(&doc.image),
-        )
-        .expect("the method")
-        .deformed();
+        let fresh = set_up_afresh(doc, &animation::posed_at(&project, time));
         assert_eq!(doc.deformer().deformed(), fresh, "{label} after playback");
+    }
+}
+
+/// The document's handle method set up afresh on its mesh for `project` (C²: its rig,
+/// following `project`).
+fn set_up_afresh(doc: &editor::Document, project: &project::Project) -> Vec<DVec2> {
+    match pipeline::on_mesh(project, doc.rig().domain(), Some(&doc.image)).expect("the method") {
+        Some(deformer) => deformer.deformed(),
+        None => {
+            let mut rig = doc.rig().clone();
+            pipeline::Deformer::follow(&mut rig, project).expect("C² follows");
+            pipeline::Deformer::deformed(&rig)
+        }
     }
 }
 

@@ -44,8 +44,9 @@ fn switching_methods_keeps_the_pose_and_comes_back_and_undoes() {
     assert!(times.compile_ms > 0.0);
     // The editor's ARAP is the method's own answer for the rig's mesh and handles.
     let project = doc.project();
-    let own = pipeline::on_handles(project, doc.rig().clone(), Some(&doc.image))
+    let own = pipeline::on_mesh(project, doc.rig().domain(), Some(&doc.image))
         .expect("ARAP")
+        .expect("not the rig")
         .deformed();
     assert_eq!(positions(&h), own);
     let arap = shot(&mut h);
@@ -374,8 +375,9 @@ fn mls_is_chosen_dragged_undone_and_exported_as_the_pipeline_draws_it() {
     assert_eq!(method(&h), Method::Mls);
     // The editor's MLS is the method's own answer for the rig's mesh and handles.
     let doc = h.state().document().expect("doc");
-    let own = pipeline::on_handles(doc.project(), doc.rig().clone(), Some(&doc.image))
+    let own = pipeline::on_mesh(doc.project(), doc.rig().domain(), Some(&doc.image))
         .expect("MLS")
+        .expect("not the rig")
         .deformed();
     assert_eq!(positions(&h), own);
     let mls = shot(&mut h);

@@ -30,7 +30,7 @@ use geometry::point_segment_distance;
 use glam::DVec2;
 use project::{Project, RigidityStroke};
 use serde::Serialize;
-use weights_core::{Domain, Handle, Metric, Rig, Similarity};
+use weights_core::{Domain, Handle, Metric, Similarity};
 
 use crate::deformer::{
     Deformer, Follow, Method, Output, Sequence, WeightsListing, json, median, quantile,
@@ -409,20 +409,20 @@ impl ArapRig {
         Ok(rig)
     }
 
-    /// `project`'s ARAP (its handles, rigidity and `"arap"` settings) on `rig`'s mesh:
-    /// on its own mesh of `picture`, which the rig's follows ([`ArapRig::with_own_mesh`]),
-    /// or without a picture on the rig's mesh itself ([`ArapRig::new`]: a mesh given as
-    /// such).
+    /// `project`'s ARAP (its handles, rigidity and `"arap"` settings) on the picture's
+    /// mesh `domain`: on its own mesh of `picture`, which the picture's follows
+    /// ([`ArapRig::with_own_mesh`]), or without a picture on `domain` itself
+    /// ([`ArapRig::new`]: a mesh given as such).
     ///
     /// # Errors
     /// As [`ArapRig::with_own_mesh`].
-    pub fn on_rig(
+    pub fn on_mesh(
         project: &Project,
-        rig: &Rig,
+        domain: &Domain,
         picture: Option<&image::RgbaImage>,
     ) -> Result<Self> {
         let handles = crate::handles(project);
-        let (domain, strokes) = (rig.domain().clone(), &project.rigidity);
+        let (domain, strokes) = (domain.clone(), &project.rigidity);
         let mut arap = match picture {
             Some(picture) => {
                 let options = ArapOptions::for_picture(project, picture);

@@ -27,7 +27,7 @@ pub use layers::{Artwork, Layer, write_ora};
 pub use mesh::Mesh;
 pub use method::{
     Backdrop, Controls, Deformer, Follow, Listener, Method, Output, SkinTable, Skinning,
-    SolveProgress, Source, WeightsListing, beside_rig, on_handles, setup,
+    SolveProgress, Source, WeightsListing, on_mesh, setup,
 };
 pub use order::draw_order;
 pub use parts::{
@@ -529,6 +529,24 @@ fn prepare_meshed(
     progress: &(dyn Fn(weights_core::Progress) + Sync),
     mesher: Mesher,
 ) -> Result<Prepared> {
+    let domain = mesh_for(image, project, density, mesher)?;
+    Ok(Prepared {
+        rig: rig_on_domain(domain, project, progress)?,
+    })
+}
+
+/// [`prepare_meshed`]'s first half: `image` meshed by `mesher` as `project` asks (its
+/// density, the refinement around crowded handles, its cuts), in the shape's metric —
+/// the mesh every handle method sets up on.
+///
+/// # Errors
+/// As [`prepare`], up to the weighting.
+pub(crate) fn mesh_for(
+    image: &RgbaImage,
+    project: &Project,
+    density: Option<usize>,
+    mesher: Mesher,
+) -> Result<Domain> {
     if let Some(density) = density {
         project::validate_density(density)?;
     }
@@ -553,14 +571,11 @@ fn prepare_meshed(
         ..MeshOptions::default()
     };
     let (mesh, convex) = mesher(image, &options, &project.cuts).context("cannot mesh the image")?;
-    let domain = Domain::new(
+    Ok(Domain::new(
         mesh.vertices,
         mesh.triangles,
         metric(project.metric, convex),
-    )?;
-    Ok(Prepared {
-        rig: rig_on_domain(domain, project, progress)?,
-    })
+    )?)
 }
 
 /// [`prepare_with_progress`]'s second half: `project`'s rig built on `domain`, the
@@ -644,20 +659,41 @@ pub fn write_virtual_handles(domain: &Domain, placed: &[VirtualHandle], project:
     }
 }
 
-/// Builds `project`'s C² rig on a given mesh (`--mesh`): its vertices are used as
-/// given, in file order; a handle (or bar sample, or saved virtual handle) that
-/// coincides with a vertex uses it, and one that does not is inserted as a new vertex,
-/// splitting the triangle (or edge) it lies on. Inserted vertices come after the
-/// file's.
+/// Builds `project`'s C² rig on a given mesh (`--mesh`), as [`mesh_with_handles`]
+/// gives it.
 ///
 /// # Errors
-/// Invalid handles, a handle off the mesh, more virtual handles than the mesh has
-/// vertices, a degenerate mesh.
+/// As [`mesh_with_handles`], and what the rig refuses.
 pub fn rig_on_mesh(
     mesh: &Mesh,
     project: &Project,
     progress: &(dyn Fn(weights_core::Progress) + Sync),
 ) -> Result<Rig> {
+    let (domain, virtual_handles) = mesh_with_handles(mesh, project)?;
+    Ok(Rig::with_overlaid(
+        domain,
+        handles(project),
+        &project.overlaid,
+        &virtual_handles,
+        rig_options(project)?,
+        progress,
+    )?)
+}
+
+/// A given mesh (`--mesh`) with `project`'s handles on it: its vertices are used as
+/// given, in file order; a handle (or bar sample, or saved virtual handle) that
+/// coincides with a vertex uses it, and one that does not is inserted as a new vertex,
+/// splitting the triangle (or edge) it lies on. Inserted vertices come after the
+/// file's. Returns the mesh, in the shape's metric, and the saved virtual handles on
+/// it.
+///
+/// # Errors
+/// Invalid handles, a handle off the mesh, more virtual handles than the mesh has
+/// vertices, a degenerate mesh.
+pub(crate) fn mesh_with_handles(
+    mesh: &Mesh,
+    project: &Project,
+) -> Result<(Domain, Vec<VirtualHandle>)> {
     project.validate(None)?;
     let mut mesh = mesh.clone();
     let file_vertices = mesh.vertices.len();
@@ -713,14 +749,7 @@ pub fn rig_on_mesh(
     for (i, v) in virtual_handles.iter_mut().enumerate() {
         v.vertex = copy_at(&domain, v.vertex, project.virtual_copy.get(i).copied());
     }
-    Ok(Rig::with_overlaid(
-        domain,
-        handles,
-        &project.overlaid,
-        &virtual_handles,
-        rig_options(project)?,
-        progress,
-    )?)
+    Ok((domain, virtual_handles))
 }
 
 /// A method set up on a picture, with its mesh's triangles in the order they are
@@ -743,16 +772,38 @@ pub struct Warper {
 }
 
 impl Warper {
-    /// `project`'s handle method on the rig [`prepare`] built from `picture` (see
-    /// [`on_handles`]), with the overlap order of its handles' depths.
-    ///
-    /// # Errors
-    /// What the method refuses.
-    pub fn on_rig(rig: Rig, project: &Project, picture: Option<&RgbaImage>) -> Result<Self> {
+    /// C² on `rig` (as [`prepare`] builds it), drawn in the order of its handles'
+    /// depths over its cells.
+    pub fn on_rig(rig: Rig, project: &Project) -> Self {
         let depths: Vec<i32> = project.handles.iter().map(HandleSpec::depth).collect();
         let predefined = order::predefined_order(&rig, &depths);
-        let deformer = on_handles(project, rig, picture)?;
-        Ok(Self::arranged(deformer, predefined, project))
+        Self::arranged(Box::new(rig), predefined, project)
+    }
+
+    /// `project`'s handle method set up on `domain`, the picture's mesh (`picture`:
+    /// the picture, which ARAP meshes its own way; `None` for a mesh given as such):
+    /// C² weighs it ([`rig_on_domain`]: Algorithm 1 places the virtual handles), ARAP
+    /// and MLS set up on it ([`on_mesh`]), no C² rig made for them.
+    ///
+    /// # Errors
+    /// What the rig build or the method refuses.
+    pub fn on_domain(
+        domain: Domain,
+        project: &Project,
+        picture: Option<&RgbaImage>,
+        listener: &dyn Listener,
+    ) -> Result<Self> {
+        match on_mesh(project, &domain, picture)? {
+            Some(deformer) => {
+                let depths: Vec<i32> = project.handles.iter().map(HandleSpec::depth).collect();
+                let predefined = order::nearest_handle_order(&domain, &handles(project), &depths);
+                Ok(Self::arranged(deformer, predefined, project))
+            }
+            None => {
+                let rig = rig_on_domain(domain, project, &|p| listener.weighting(p))?;
+                Ok(Self::on_rig(rig, project))
+            }
+        }
     }
 
     /// `deformer` with its triangles drawn in the mesh's order (and, with automatic
@@ -953,9 +1004,8 @@ pub(crate) fn prepare_part_warper(
     density: usize,
     listener: &dyn Listener,
 ) -> Result<Warper> {
-    let weighting = |p| listener.weighting(p);
-    let rig = prepare_meshed(image, project, Some(density), &weighting, mesh_part)?.rig;
-    Warper::on_rig(rig, project, Some(image))
+    let domain = mesh_for(image, project, Some(density), mesh_part)?;
+    Warper::on_domain(domain, project, Some(image), listener)
 }
 
 /// Where an output picture lies over the source's pixels: its pixel `(0, 0)` is the

@@ -19,12 +19,12 @@
 //!
 //! To add a method: a variant of [`Method`] (in the `project` crate, with its rig-file
 //! name and its controls), a file here with a type implementing [`Deformer`], and its
-//! line in [`beside_rig`] (a handle method) or [`setup`] (a cage method).
+//! line in [`on_mesh`] (a handle method) or [`setup`] (a cage method).
 
 use anyhow::{Result, bail};
 use image::RgbaImage;
 use project::Project;
-use weights_core::Rig;
+use weights_core::Domain;
 
 use crate::Warper;
 use crate::arap::ArapRig;
@@ -42,59 +42,46 @@ pub use project::{Controls, Method};
 /// # Errors
 /// What meshing, the rig build or the method refuses, each as one sentence.
 pub fn setup(source: Source<'_>, project: &Project, listener: &dyn Listener) -> Result<Warper> {
-    match project.method.controls() {
+    match (project.method.controls(), source) {
         // LBC is the one cage method.
-        Controls::Cage => {
+        (Controls::Cage, source) => {
             let deformer = CageDeformer::set_up(source, project, listener)?;
             Ok(Warper::in_mesh_order(Box::new(deformer), project))
         }
-        Controls::Handles => {
-            let weighting = |p| listener.weighting(p);
-            let rig = match source {
-                Source::Picture { image, density } => {
-                    crate::prepare_with_progress(image, project, density, &weighting)?.rig
-                }
-                Source::Mesh(mesh) => crate::rig_on_mesh(mesh, project, &weighting)?,
-            };
-            Warper::on_rig(rig, project, source.picture())
+        (Controls::Handles, Source::Picture { image, density }) => {
+            let domain = crate::mesh_for(image, project, density, crate::mesh_picture)?;
+            Warper::on_domain(domain, project, Some(image), listener)
+        }
+        // A given mesh: C² keeps the virtual handles inserted into it.
+        (Controls::Handles, Source::Mesh(mesh)) if project.method == Method::C2 => {
+            let rig = crate::rig_on_mesh(mesh, project, &|p| listener.weighting(p))?;
+            Ok(Warper::on_rig(rig, project))
+        }
+        (Controls::Handles, Source::Mesh(mesh)) => {
+            let (domain, _) = crate::mesh_with_handles(mesh, project)?;
+            Warper::on_domain(domain, project, None, listener)
         }
     }
 }
 
-/// Sets up `project`'s handle method on `rig` (the picture's mesh with the rig file's
-/// handles, as [`crate::prepare`] builds it): C² is the rig itself; ARAP meshes
-/// `picture` its own way and the rig's mesh follows (without a picture it solves on
-/// the rig's mesh: a mesh given as such).
-///
-/// # Errors
-/// As [`beside_rig`].
-pub fn on_handles(
-    project: &Project,
-    rig: Rig,
-    picture: Option<&RgbaImage>,
-) -> Result<Box<dyn Deformer>> {
-    Ok(match beside_rig(project, &rig, picture)? {
-        Some(deformer) => deformer,
-        None => Box::new(rig),
-    })
-}
-
-/// **The one place a handle method is chosen.** `project`'s handle method set up beside
-/// `rig` (which the editor keeps for its mesh, its handles and its overlays): `None`
-/// where the rig is the method's deformer itself (C²).
+/// **The one place a handle method is chosen.** `project`'s handle method set up on
+/// `domain`, the picture's mesh with the rig file's handles (`picture`: the picture,
+/// which ARAP meshes its own way, the picture's mesh following; `None` for a mesh given
+/// as such, which ARAP solves on): `None` for C², whose deformer is the rig weighing
+/// that mesh ([`crate::rig_on_domain`]; the editor keeps it for every method).
 ///
 /// # Errors
 /// What the method refuses, and a cage method (set up by [`setup`], or from its solved
 /// coordinates: [`CageDeformer::new`]).
-pub fn beside_rig(
+pub fn on_mesh(
     project: &Project,
-    rig: &Rig,
+    domain: &Domain,
     picture: Option<&RgbaImage>,
 ) -> Result<Option<Box<dyn Deformer>>> {
     Ok(match project.method {
         Method::C2 => None,
-        Method::Arap => Some(Box::new(ArapRig::on_rig(project, rig, picture)?)),
-        Method::Mls => Some(Box::new(MlsRig::on_rig(project, rig)?)),
+        Method::Arap => Some(Box::new(ArapRig::on_mesh(project, domain, picture)?)),
+        Method::Mls => Some(Box::new(MlsRig::on_mesh(project, domain)?)),
         Method::Lbc => bail!("LBC warps by a cage, not by handles"),
     })
 }

@@ -20,7 +20,7 @@ use anyhow::{Context, Result, bail};
 use glam::DVec2;
 use project::{MlsVariant, Project};
 use serde::Serialize;
-use weights_core::{Handle, Rig};
+use weights_core::{Domain, Handle};
 
 use crate::deformer::{
     Deformer, Follow, Method, Output, Sequence, WeightsListing, json, median, quantile,
@@ -76,12 +76,12 @@ fn posed_control(handle: &Handle) -> mls::Control {
 }
 
 impl MlsRig {
-    /// `project`'s MLS (its handles and `"mls"` settings) on `rig`'s mesh.
+    /// `project`'s MLS (its handles and `"mls"` settings) on the picture's mesh
+    /// `domain`.
     ///
     /// # Errors
     /// Handles MLS refuses (non-finite, a bar of no length).
-    pub fn on_rig(project: &Project, rig: &Rig) -> Result<Self> {
-        let domain = rig.domain();
+    pub fn on_mesh(project: &Project, domain: &Domain) -> Result<Self> {
         let (handles, options) = (crate::handles(project), options(project));
         let rest: Arc<[DVec2]> = domain.positions().into();
         let clock = Instant::now();

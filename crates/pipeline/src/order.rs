@@ -17,8 +17,8 @@
 //! it holds, by a point at rest in each sheet.
 
 use glam::DVec2;
-use project::{OverlapOrder, Place};
-use weights_core::Rig;
+use project::{HandleSpec, Method, OverlapOrder, Place, Project};
+use weights_core::{Domain, Handle, Rig};
 
 /// The triangles of `rig`'s mesh in drawing order for the handle depths `depths`
 /// (one per real handle; a missing one is 0): back to front.
@@ -33,9 +33,8 @@ pub fn draw_order(rig: &Rig, depths: &[i32]) -> Vec<[u32; 3]> {
 /// As [`draw_order`], each triangle by its index in the mesh's list.
 pub fn predefined_order(rig: &Rig, depths: &[i32]) -> Vec<u32> {
     let triangles = rig.domain().triangles();
-    let all = 0..triangles.len() as u32;
     if depths.iter().all(|&d| d == 0) {
-        return all.collect();
+        return (0..triangles.len() as u32).collect();
     }
     let node_depth: Vec<i32> = (0..rig.nodes().len())
         .map(|k| {
@@ -44,13 +43,54 @@ pub fn predefined_order(rig: &Rig, depths: &[i32]) -> Vec<u32> {
                 .unwrap_or(0)
         })
         .collect();
-    let vertex_depth = |v: u32| {
+    by_vertex_depth(triangles, |v| {
         rig.cells()
             .get(v as usize)
             .and_then(|&k| node_depth.get(k as usize).copied())
             .unwrap_or(0)
-    };
-    let mut keyed: Vec<(i32, u32)> = all
+    })
+}
+
+/// The predefined order of a handle method other than C², which weighs no cells of its
+/// own: every vertex of `domain` takes the depth of the handle nearest it in the
+/// shape's metric (a point handle at its nearest vertex, a bar at the vertices nearest
+/// points along it a mean edge apart), as a C² rig without virtual handles would give.
+pub fn nearest_handle_order(domain: &Domain, handles: &[Handle], depths: &[i32]) -> Vec<u32> {
+    let triangles = domain.triangles();
+    if depths.iter().all(|&d| d == 0) {
+        return (0..triangles.len() as u32).collect();
+    }
+    let spacing = domain.mean_edge_length().max(f64::MIN_POSITIVE);
+    let mut sources = Vec::new();
+    let mut source_depth = Vec::new();
+    for (h, handle) in handles.iter().enumerate() {
+        let depth = depths.get(h).copied().unwrap_or(0);
+        let points = match handle {
+            Handle::Point { rest, .. } => vec![*rest],
+            Handle::Bar { rest, .. } => weights_core::bar_samples(*rest, spacing)
+                .into_iter()
+                .map(|(_, p)| p)
+                .collect(),
+        };
+        for p in points {
+            if let Some(v) = domain.nearest_vertex(p) {
+                sources.push(v);
+                source_depth.push(depth);
+            }
+        }
+    }
+    let cells = weights_core::nearest_source(domain, sources);
+    by_vertex_depth(triangles, |v| {
+        (cells.get(v as usize))
+            .and_then(|&k| source_depth.get(k as usize).copied())
+            .unwrap_or(0)
+    })
+}
+
+/// The triangles, each taking the greatest depth of its corners, sorted by depth (a
+/// stable sort: equal depths keep the mesh's order).
+fn by_vertex_depth(triangles: &[[u32; 3]], vertex_depth: impl Fn(u32) -> i32) -> Vec<u32> {
+    let mut keyed: Vec<(i32, u32)> = (0..triangles.len() as u32)
         .map(|t| {
             let depth = triangles[t as usize].iter().map(|&v| vertex_depth(v)).max();
             (depth.unwrap_or(0), t)
@@ -58,6 +98,18 @@ pub fn predefined_order(rig: &Rig, depths: &[i32]) -> Vec<u32> {
         .collect();
     keyed.sort_by_key(|&(d, _)| d);
     keyed.into_iter().map(|(_, t)| t).collect()
+}
+
+/// The predefined order of `project`'s handle method on `rig`'s mesh: the C² rig's
+/// cells under C² ([`predefined_order`]), the handles' nearest vertices under the
+/// others ([`nearest_handle_order`]) — what the editor, which keeps a C² rig for every
+/// method, and `render` draw alike.
+pub fn predefined_for(project: &Project, rig: &Rig) -> Vec<u32> {
+    let depths: Vec<i32> = project.handles.iter().map(HandleSpec::depth).collect();
+    match project.method {
+        Method::C2 => predefined_order(rig, &depths),
+        _ => nearest_handle_order(rig.domain(), rig.handles(), &depths),
+    }
 }
 
 /// Automatic depth for one mesh: its predefined order and the overlap regions of the
@@ -188,38 +240,128 @@ impl Arranger {
         &self.regions
     }
 
-    /// The regions' orders as a rig file keeps them: the rest centroid of one triangle
-    /// of each sheet, one that lies in no other sheet where the sheet has one. (A
-    /// triangle can lie in two regions — the middle of three layers is in front of one
-    /// and behind the other — and a reopened pose, remembering one triangle a sheet,
-    /// would count such a triangle for both regions and could turn one of them over.)
+    /// The regions' orders as a rig file keeps them: for each region, the rest
+    /// centroids of a triangle of its front sheet and one of its back sheet — or of
+    /// more such pairs, where one would not decide it. A reopened pose remembers these
+    /// triangles alone, and a region keeps its order there when more of the pairs
+    /// found in its two sheets say so than say the opposite: a triangle can lie in two
+    /// regions (the middle of three layers is in front of one and behind the other),
+    /// so one region's pair can lie in another's sheets turned over. The pairs are
+    /// chosen so that none does, where the sheets allow ([`Arranger::representatives`]).
     pub fn overlaps(&self, rest: &[DVec2], triangles: &[[u32; 3]]) -> Vec<OverlapOrder> {
-        let mut sheets_of: std::collections::HashMap<u32, u32> = Default::default();
-        for region in &self.regions {
-            for &t in region.front.iter().chain(&region.back) {
-                *sheets_of.entry(t).or_default() += 1;
+        let place = |t: u32| {
+            let [a, b, c] = triangles[t as usize].map(|v| rest[v as usize]);
+            let at = (a + b + c) / 3.0;
+            Place {
+                at: [at.x, at.y],
+                part: self.part_of.as_ref().map(|p| p[t as usize] as usize),
             }
-        }
-        let place = |sheet: &[u32]| {
-            let own = sheet.iter().find(|t| sheets_of.get(t) == Some(&1));
-            own.or(sheet.first()).map(|&t| {
-                let [a, b, c] = triangles[t as usize].map(|v| rest[v as usize]);
-                let at = (a + b + c) / 3.0;
-                Place {
-                    at: [at.x, at.y],
-                    part: self.part_of.as_ref().map(|p| p[t as usize] as usize),
-                }
-            })
         };
-        self.regions
-            .iter()
-            .filter_map(|r| {
-                Some(OverlapOrder {
-                    front: place(&r.front)?,
-                    back: place(&r.back)?,
-                })
+        self.representatives()
+            .into_iter()
+            .map(|(front, back)| OverlapOrder {
+                front: place(front),
+                back: place(back),
             })
             .collect()
+    }
+
+    /// Pairs of triangles (front, back) that, remembered alone, give every region its
+    /// order again: for each region first a pair of triangles that lie in fewest other
+    /// sheets and are not another region's two sheets turned over; then, for a region
+    /// whose pairs do not outnumber the pairs found turned over in it, more pairs of
+    /// its own that turn no other region over.
+    fn representatives(&self) -> Vec<(u32, u32)> {
+        /// Candidates tried a sheet, and rounds of additions.
+        const TRIED: usize = 8;
+        const ROUNDS: usize = 16;
+        let regions = &self.regions;
+        // Each triangle's sheets: (region, whether the front one).
+        let mut sheets: std::collections::HashMap<u32, Vec<(usize, bool)>> = Default::default();
+        for (r, region) in regions.iter().enumerate() {
+            for (sheet, front) in [(&region.front, true), (&region.back, false)] {
+                for &t in sheet {
+                    sheets.entry(t).or_default().push((r, front));
+                }
+            }
+        }
+        let of = |t: u32| sheets.get(&t).map_or(&[][..], Vec::as_slice);
+        // What pair (f, b) says of region r, reopened: 1 its order, -1 the opposite.
+        let says = |(f, b): (u32, u32), r: usize| -> i64 {
+            let (f_in, b_in) = (of(f), of(b));
+            let has = |list: &[(usize, bool)], front: bool| list.contains(&(r, front));
+            i64::from(has(f_in, true) && has(b_in, false))
+                - i64::from(has(f_in, false) && has(b_in, true))
+        };
+        let harms = |pair: (u32, u32), own: usize| {
+            of(pair.0)
+                .iter()
+                .any(|&(r, _)| r != own && says(pair, r) < 0)
+        };
+        // Each region's candidates: its sheets' triangles in fewest sheets, the first
+        // few, paired in order of rank.
+        let candidates: Vec<Vec<(u32, u32)>> = regions
+            .iter()
+            .enumerate()
+            .map(|(r, region)| {
+                let ranked = |sheet: &[u32]| {
+                    let mut sheet = sheet.to_vec();
+                    sheet.sort_by_key(|&t| (of(t).len(), t));
+                    sheet.truncate(TRIED);
+                    sheet
+                };
+                let (fronts, backs) = (ranked(&region.front), ranked(&region.back));
+                let mut pairs: Vec<(usize, usize)> = (0..fronts.len())
+                    .flat_map(|i| (0..backs.len()).map(move |j| (i, j)))
+                    .collect();
+                pairs.sort_by_key(|&(i, j)| (i + j, i));
+                pairs
+                    .into_iter()
+                    .map(|(i, j)| (fronts[i], backs[j]))
+                    .filter(|&(f, b)| f != b && says((f, b), r) > 0)
+                    .collect()
+            })
+            .collect();
+        let mut chosen: Vec<(u32, u32)> = Vec::with_capacity(regions.len());
+        let mut next = vec![0usize; regions.len()];
+        // Region r's next candidate that harms no other region (with `any`, the first
+        // left when none is harmless).
+        let mut take = |r: usize, any: bool, chosen: &mut Vec<(u32, u32)>| {
+            let list = &candidates[r];
+            let found = (next[r]..list.len())
+                .find(|&k| !harms(list[k], r))
+                .or_else(|| (any && next[r] < list.len()).then_some(next[r]));
+            if let Some(k) = found {
+                chosen.push(list[k]);
+                next[r] = k + 1;
+            }
+            found.is_some()
+        };
+        for r in 0..regions.len() {
+            take(r, true, &mut chosen);
+        }
+        for _ in 0..ROUNDS {
+            let mut score = vec![0i64; regions.len()];
+            for &pair in &chosen {
+                // (Its front triangle's regions, each once: listed by region.)
+                let mut regions_of: Vec<usize> = of(pair.0).iter().map(|&(r, _)| r).collect();
+                regions_of.dedup();
+                for r in regions_of {
+                    score[r] += says(pair, r);
+                }
+            }
+            let mut added = false;
+            for r in (0..regions.len()).filter(|&r| score[r] <= 0) {
+                if chosen.len() >= project::MAX_OVERLAPS {
+                    break;
+                }
+                added |= take(r, false, &mut chosen);
+            }
+            if !added {
+                break;
+            }
+        }
+        chosen
     }
 }
 
@@ -282,6 +424,61 @@ mod tests {
     }
 
     #[test]
+    fn without_a_rig_each_triangle_takes_the_depth_of_the_handle_nearest_it() {
+        let rig = strip_rig();
+        let (domain, handles) = (rig.domain(), rig.handles());
+        let triangles = domain.triangles();
+        let identity: Vec<u32> = (0..40).collect();
+        assert_eq!(nearest_handle_order(domain, handles, &[0, 0]), identity);
+        let order = nearest_handle_order(domain, handles, &[0, 3]);
+        let mut sorted = order.clone();
+        sorted.sort_unstable();
+        assert_eq!(sorted, identity, "a permutation");
+        // Handle 0 sits at x = 0, handle 1 at x = 20: the triangles wholly left of the
+        // middle (x ≤ 9) keep their order in front of the rest, stably.
+        let left: Vec<u32> = (0..40)
+            .filter(|&t| {
+                (triangles[t as usize].iter()).all(|&v| domain.positions()[v as usize].x <= 9.0)
+            })
+            .collect();
+        assert_eq!(left.len(), 18);
+        assert_eq!(order[..left.len()], left[..]);
+        assert_eq!(order.last(), Some(&39));
+        // A bar counts along its length: one along the bottom edge from x = 12 takes
+        // the triangles from there on, in front.
+        let bar = Handle::bar(DVec2::new(12.0, 0.0), DVec2::new(20.0, 0.0));
+        let order = nearest_handle_order(domain, &[handles[0].clone(), bar], &[0, 3]);
+        let front = order.iter().position(|&t| t == 24).expect("present");
+        let behind = order.iter().position(|&t| t == 10).expect("present");
+        assert!(front > behind);
+        // The same rule for every handle method but C², through the rig file.
+        let project = Project {
+            method: Method::Arap,
+            handles: vec![
+                HandleSpec::Point {
+                    rest: [0.0, 0.0],
+                    translate: [0.0; 2],
+                    rotate: 0.0,
+                    scale: 1.0,
+                    depth: 0,
+                },
+                HandleSpec::Point {
+                    rest: [20.0, 1.0],
+                    translate: [0.0; 2],
+                    rotate: 0.0,
+                    scale: 1.0,
+                    depth: 3,
+                },
+            ],
+            ..Project::default()
+        };
+        assert_eq!(
+            predefined_for(&project, &rig),
+            nearest_handle_order(domain, handles, &[0, 3])
+        );
+    }
+
+    #[test]
     fn a_saved_sheet_is_named_by_a_triangle_of_its_own_region_alone() {
         // Two regions between the same two sheets, in opposite orders (a tail over the
         // body here, under it there), sharing triangles 1 and 10: saved by those, a
@@ -308,10 +505,20 @@ mod tests {
         let saved = arranger.overlaps(rest, triangles);
         let named: Vec<[[f64; 2]; 2]> = saved.iter().map(|o| [o.front.at, o.back.at]).collect();
         assert_eq!(named, [[at(2), at(11)], [at(12), at(4)]]);
-        // A sheet all of whose triangles lie in another region too: its first.
-        arranger.regions[1].front = vec![10];
+        // A region whose one pair lies in another turned over: that other region is
+        // given a second pair of its own, which turns nothing over.
+        arranger.regions = vec![
+            depth::Region {
+                front: vec![1],
+                back: vec![10],
+            },
+            depth::Region {
+                front: vec![10, 12],
+                back: vec![1, 13],
+            },
+        ];
         let saved = arranger.overlaps(rest, triangles);
-        assert_eq!(saved[1].front.at, at(10));
-        assert_eq!(saved[0].back.at, at(11));
+        let named: Vec<[[f64; 2]; 2]> = saved.iter().map(|o| [o.front.at, o.back.at]).collect();
+        assert_eq!(named, [[at(1), at(10)], [at(12), at(13)], [at(12), at(1)]]);
     }
 }

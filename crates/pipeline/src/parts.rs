@@ -408,7 +408,7 @@ impl PartRig {
                     .and_then(|()| {
                         crate::rig_on_domain(domain, &placed, &|p| listener.weighting(p))
                     })
-                    .and_then(|rig| Warper::on_rig(rig, &placed, Some(&picture))),
+                    .map(|rig| Warper::on_rig(rig, &placed)),
                 None => prepare_part_warper(&picture, &placed, density, listener),
             }
             .with_context(|| format!("part \"{}\"", layer.name))?;

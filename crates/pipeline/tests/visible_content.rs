@@ -247,11 +247,8 @@ fn identity_keeps_every_visible_pixel(name: &str, img: &RgbaImage) {
             let prepared = pipeline::prepare(img, &project, Some(density))
                 .unwrap_or_else(|e| panic!("{name} at density {density}: {e:#}"));
             let vertices = prepared.rig.domain().len();
-            let out = pipeline::warp(
-                img,
-                &pipeline::Warper::on_rig(prepared.rig, &project, Some(img)).unwrap(),
-            )
-            .unwrap();
+            let out =
+                pipeline::warp(img, &pipeline::Warper::on_rig(prepared.rig, &project)).unwrap();
             let mut lost = 0;
             let mut first = None;
             for (x, y, p) in img.enumerate_pixels() {

@@ -45,3 +45,4 @@ pub use rig::{
     VirtualHandle, bar_samples, bar_spacing, bar_spacing_overlaid,
 };
 pub use virtual_handles::Placement;
+pub use voronoi::nearest_source;

@@ -166,6 +166,14 @@ fn less(a: (f64, u32), b: (f64, u32)) -> bool {
     a.0 < b.0 || (a.0 == b.0 && a.1 < b.1)
 }
 
+/// Each sample's nearest of the samples `sources` (its index in `sources`) in
+/// `domain`'s metric — the cells a C² rig's nodes have, for any set of samples — or
+/// `u32::MAX` where none reaches (a piece without sources). A sample listed twice is
+/// its first listing's.
+pub fn nearest_source(domain: &Domain, sources: Vec<u32>) -> Vec<u32> {
+    Partition::distances(domain, sources).owner
+}
+
 impl Partition {
     /// The partition of `domain` by nodes on the given samples, built in one pass.
     #[cfg(test)]

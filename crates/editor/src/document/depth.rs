@@ -5,7 +5,7 @@
 
 use glam::DVec2;
 use pipeline::Deformer;
-use pipeline::order::{Arranger, as_triangles, predefined_order};
+use pipeline::order::{Arranger, as_triangles, predefined_for};
 use project::{HandleSpec, OverlapOrder};
 
 use super::Document;
@@ -24,6 +24,8 @@ pub(super) struct Depth {
     cage: bool,
     /// The handles' depths the predefined order came from.
     depths: Vec<i32>,
+    /// The method whose predefined order it is.
+    method: project::Method,
     /// The mesh's triangles (in its own order).
     triangles: Vec<[u32; 3]>,
     /// The mesh's rest positions: parts reordered join their meshes in another order,
@@ -125,11 +127,12 @@ impl Document {
                 && d.wrote == self.project.overlaps
         });
         let joined = part_of.is_some();
+        let method = self.project.method;
         let predefined = |rig| {
             if cage || joined {
                 (0..triangles.len() as u32).collect()
             } else {
-                predefined_order(rig, &depths)
+                predefined_for(&self.project, rig)
             }
         };
         // The same mesh keeps its arranger (its topology, and what it remembers: a
@@ -143,7 +146,8 @@ impl Document {
         let mut arranger = match kept {
             Some(depth) => {
                 let mut arranger = depth.arranger;
-                if depth.depths != depths {
+                // (Another handle method finds each triangle's handle its own way.)
+                if depth.depths != depths || depth.method != method {
                     arranger.set_predefined(predefined(&self.rig));
                 }
                 if new_depths {
@@ -179,6 +183,7 @@ impl Document {
         let depth = Depth {
             cage,
             depths,
+            method,
             mesh: (
                 triangles.as_ptr() as usize,
                 triangles.len(),
