@@ -793,6 +793,10 @@ impl Warper {
         picture: Option<&RgbaImage>,
         listener: &dyn Listener,
     ) -> Result<Self> {
+        if project.method != project::Method::C2 {
+            // What C²'s rig refuses, every handle method refuses.
+            weights_core::check_handles_on(&domain, &handles(project))?;
+        }
         match on_mesh(project, &domain, picture)? {
             Some(deformer) => {
                 let depths: Vec<i32> = project.handles.iter().map(HandleSpec::depth).collect();

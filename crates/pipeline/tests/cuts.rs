@@ -236,3 +236,38 @@ fn virtual_handles_on_either_side_of_a_cut_reopen_on_their_side() {
     }
     assert!(later_copies > 0, "no virtual handle on a cut's second side");
 }
+
+/// ARAP and MLS are set up without a C² rig, and refuse the handles it would: one off
+/// the shape, two at one place.
+#[test]
+fn every_handle_method_refuses_a_handle_off_the_shape_or_two_at_one_place() {
+    for method in [Method::C2, Method::Arap, Method::Mls] {
+        for (handles, says) in [
+            (
+                vec![
+                    point([20.0, 30.0], [0.0, 0.0]),
+                    point([2.0, 2.0], [0.0, 0.0]),
+                ],
+                "outside the shape",
+            ),
+            (
+                vec![
+                    point([20.0, 30.0], [0.0, 0.0]),
+                    point([20.0, 30.0], [5.0, 0.0]),
+                ],
+                "coincide",
+            ),
+        ] {
+            let project = Project {
+                method,
+                handles,
+                ..Project::default()
+            };
+            let error = pipeline::prepare_warper(&touching(), &project, None, &())
+                .err()
+                .map(|e| pipeline::error_line(&e))
+                .unwrap_or_default();
+            assert!(error.contains(says), "{}: {error:?}", method.name());
+        }
+    }
+}

@@ -42,7 +42,7 @@ pub use overlay::similarity_fit;
 pub use rig::{
     BuildTimings, COINCIDENT, Handle, MAX_BAR_PIECES, MAX_HANDLES, MAX_POSE, MAX_SCALE, MIN_SCALE,
     Node, NodeKind, NodeRadii, Phase, Progress, Rig, RigOptions, RigStats, UpdateTimings,
-    VirtualHandle, bar_samples, bar_spacing, bar_spacing_overlaid,
+    VirtualHandle, bar_samples, bar_spacing, bar_spacing_overlaid, check_handles_on,
 };
 pub use virtual_handles::Placement;
 pub use voronoi::nearest_source;

@@ -1736,6 +1736,49 @@ fn segment_of(h: &Handle) -> [DVec2; 2] {
     }
 }
 
+/// Checks `handles` as a rig on `domain` would take them, without building one: at
+/// most [`MAX_HANDLES`], finite, no two at one place ([`COINCIDENT`]), every point on
+/// the shape and every bar wholly on it. What another method set up on the same mesh
+/// refuses alike.
+///
+/// # Errors
+/// The first handle refused, as [`Rig::new`] names it.
+pub fn check_handles_on(domain: &Domain, handles: &[Handle]) -> Result<(), RigError> {
+    if handles.len() > MAX_HANDLES {
+        return Err(RigError::TooManyHandles {
+            count: handles.len(),
+            max: MAX_HANDLES,
+        });
+    }
+    check_handles(handles)?;
+    if let Some((a, b)) = closest_pair(handles)
+        .filter(|p| p.2 < COINCIDENT)
+        .map(|p| (p.0, p.1))
+    {
+        return Err(RigError::Coincident { a, b });
+    }
+    for (handle, h) in handles.iter().enumerate() {
+        let outside = match h {
+            Handle::Point { rest, .. } => domain.locate(*rest).is_none().then_some(*rest),
+            Handle::Bar { rest, .. } => (!domain.contains_segment(rest[0], rest[1])).then(|| {
+                if domain.locate(rest[0]).is_none() {
+                    rest[0]
+                } else {
+                    rest[1]
+                }
+            }),
+        };
+        if let Some(p) = outside {
+            return Err(RigError::OutsideDomain {
+                handle,
+                x: p.x,
+                y: p.y,
+            });
+        }
+    }
+    Ok(())
+}
+
 /// The nodes of the handles (and of the pinned border), each on a sample: a point on
 /// the nearest corner of the triangle containing it, bars split into ⌈L/d⌉ pieces with
 /// d from [`bar_spacing`] (no smaller than the mean edge length).
