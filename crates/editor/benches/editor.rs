@@ -22,7 +22,7 @@ use egui::{Pos2, Vec2};
 use egui_kittest::Harness;
 use glam::DVec2;
 use image::{Rgba, RgbaImage};
-use project::{HandleSpec, Project};
+use project::{HandleSpec, Method, Project};
 
 /// Criterion's default 100 samples take minutes for the slower groups; 20 tell enough.
 fn quick() -> Criterion {
@@ -30,7 +30,19 @@ fn quick() -> Criterion {
 }
 
 fn insert_handle(c: &mut Criterion) {
+    for method in [Method::C2, Method::Arap, Method::Mls] {
+        insert_handle_by(c, method);
+    }
+}
+
+/// Insertion from the click to the GPU under `method` (C²'s under the plain name).
+fn insert_handle_by(c: &mut Criterion, method: Method) {
     let mut app = EditorApp::headless(true);
+    if method != Method::C2 {
+        (app.document_mut().expect("the built-in picture"))
+            .apply(Edit::Method(method))
+            .expect("a handle method");
+    }
     app.update_gpu_frame();
     // Mesh vertices in a fixed pseudo-random order: clicks spread over the picture.
     let vertices = app.document().map_or(0, |d| d.rig().domain().len());
@@ -44,7 +56,11 @@ fn insert_handle(c: &mut Criterion) {
         doc.deformed()[v]
     };
     let (mut refused, mut inserted, mut skipped) = (0, 0, 0);
-    c.bench_function("editor/insert_handle/lizard_20k", |b| {
+    let name = match method {
+        Method::C2 => "editor/insert_handle/lizard_20k".to_owned(),
+        _ => format!("editor/insert_handle/lizard_20k_{}", method.name()),
+    };
+    c.bench_function(&name, |b| {
         b.iter_custom(|iterations| {
             let mut total = Duration::ZERO;
             let mut done = 0;
