@@ -1736,14 +1736,9 @@ fn segment_of(h: &Handle) -> [DVec2; 2] {
     }
 }
 
-/// Checks `handles` as a rig on `domain` would take them, without building one: at
-/// most [`MAX_HANDLES`], finite, no two at one place ([`COINCIDENT`]), every point on
-/// the shape and every bar wholly on it. What another method set up on the same mesh
-/// refuses alike.
-///
-/// # Errors
-/// The first handle refused, as [`Rig::new`] names it.
-pub fn check_handles_on(domain: &Domain, handles: &[Handle]) -> Result<(), RigError> {
+/// Checks the handles apart from any shape: at most [`MAX_HANDLES`], finite, no two at
+/// one place ([`COINCIDENT`]).
+fn check_handle_set(handles: &[Handle]) -> Result<(), RigError> {
     if handles.len() > MAX_HANDLES {
         return Err(RigError::TooManyHandles {
             count: handles.len(),
@@ -1757,16 +1752,34 @@ pub fn check_handles_on(domain: &Domain, handles: &[Handle]) -> Result<(), RigEr
     {
         return Err(RigError::Coincident { a, b });
     }
+    Ok(())
+}
+
+/// Where the bar `rest` leaves `domain`'s shape (an end off it, else the second end),
+/// or `None` when the whole bar lies on it.
+fn bar_off_shape(domain: &Domain, rest: [DVec2; 2]) -> Option<DVec2> {
+    (!domain.contains_segment(rest[0], rest[1])).then(|| {
+        if domain.locate(rest[0]).is_none() {
+            rest[0]
+        } else {
+            rest[1]
+        }
+    })
+}
+
+/// Checks `handles` as a rig on `domain` would take them, without building one: at
+/// most [`MAX_HANDLES`], finite, no two at one place ([`COINCIDENT`]), every point on
+/// the shape and every bar wholly on it. What another method set up on the same mesh
+/// refuses alike.
+///
+/// # Errors
+/// The first handle refused, as [`Rig::new`] names it.
+pub fn check_handles_on(domain: &Domain, handles: &[Handle]) -> Result<(), RigError> {
+    check_handle_set(handles)?;
     for (handle, h) in handles.iter().enumerate() {
         let outside = match h {
             Handle::Point { rest, .. } => domain.locate(*rest).is_none().then_some(*rest),
-            Handle::Bar { rest, .. } => (!domain.contains_segment(rest[0], rest[1])).then(|| {
-                if domain.locate(rest[0]).is_none() {
-                    rest[0]
-                } else {
-                    rest[1]
-                }
-            }),
+            Handle::Bar { rest, .. } => bar_off_shape(domain, *rest),
         };
         if let Some(p) = outside {
             return Err(RigError::OutsideDomain {
@@ -1794,19 +1807,7 @@ fn real_nodes(
     options: &RigOptions,
     resolution: f64,
 ) -> Result<(Vec<Node>, Vec<Node>), RigError> {
-    if handles.len() > MAX_HANDLES {
-        return Err(RigError::TooManyHandles {
-            count: handles.len(),
-            max: MAX_HANDLES,
-        });
-    }
-    check_handles(handles)?;
-    if let Some((a, b)) = closest_pair(handles)
-        .filter(|p| p.2 < COINCIDENT)
-        .map(|p| (p.0, p.1))
-    {
-        return Err(RigError::Coincident { a, b });
-    }
+    check_handle_set(handles)?;
     let snap = |i: usize, p: DVec2| -> Result<u32, RigError> {
         let (t, bary) = domain.locate(p).ok_or(RigError::OutsideDomain {
             handle: i,
@@ -1847,12 +1848,7 @@ fn real_nodes(
             }),
             Handle::Bar { rest, .. } => {
                 // The whole bar must lie on the shape, not only its samples.
-                if !domain.contains_segment(rest[0], rest[1]) {
-                    let p = if domain.locate(rest[0]).is_none() {
-                        rest[0]
-                    } else {
-                        rest[1]
-                    };
+                if let Some(p) = bar_off_shape(domain, rest) {
                     return Err(RigError::OutsideDomain {
                         handle: i,
                         x: p.x,
