@@ -207,8 +207,12 @@ fn visit_nodes(frame: &Frame, weight: &Weight, mut visit: impl FnMut(f64, f64)) 
         let mut a = lo;
         while a < hi {
             let b = if hi <= 2.5 * a { hi } else { 2.0 * a };
-            // Cut [a, b] geometrically into `parts` pieces.
-            let ratio = (b / a).powf(1.0 / parts as f64);
+            // Cut [a, b] geometrically into `parts` pieces (one: [a, b] itself).
+            let ratio = if parts > 1 {
+                (b / a).powf(1.0 / parts as f64)
+            } else {
+                1.0
+            };
             let mut u0 = a;
             for part in 0..parts {
                 let u1 = if part + 1 == parts { b } else { u0 * ratio };
