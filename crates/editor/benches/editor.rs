@@ -45,7 +45,7 @@ fn insert_handle_by(c: &mut Criterion, method: Method) {
     }
     app.update_gpu_frame();
     // Mesh vertices in a fixed pseudo-random order: clicks spread over the picture.
-    let vertices = app.document().map_or(0, |d| d.rig().domain().len());
+    let vertices = app.document().map_or(0, |d| d.mesh().len());
     let mut state = 0x9e37_79b9_7f4a_7c15u64;
     let mut next_click = |app: &mut EditorApp| {
         state = state
@@ -69,7 +69,7 @@ fn insert_handle_by(c: &mut Criterion, method: Method) {
                 // A click beside another handle refines the mesh there and rebuilds (a
                 // rare case, timed apart): the common insertion is timed here.
                 let crowded = app.document().is_some_and(|d| {
-                    let room = 2.0 * d.rig().domain().mean_edge_length();
+                    let room = 2.0 * d.mesh().mean_edge_length();
                     d.project()
                         .handles
                         .iter()

@@ -389,7 +389,7 @@ impl EditorApp {
         };
         if heavy
             && let Some(doc) = &self.doc
-            && doc.rig().domain().len() > self.large_mesh
+            && doc.mesh().len() > self.large_mesh
         {
             let label = match edit {
                 Edit::Method(method) => format!("Setting up {}", method.label()),
@@ -525,9 +525,7 @@ impl EditorApp {
             return;
         }
         let new_settings = crate::document::Settings::of(target) != doc.settings();
-        if new_settings
-            || (doc.rig().domain().len() > self.large_mesh && doc.rebuilds_for(target, true))
-        {
+        if new_settings || (doc.mesh().len() > self.large_mesh && doc.rebuilds_for(target, true)) {
             // A rebuild for other parameters, or of a large rig: on the worker, on a
             // copy.
             let target = target.clone();

@@ -274,7 +274,7 @@ impl Brush {
                     (weights, triangles)
                 }
                 None => {
-                    let domain = doc.rig().domain();
+                    let domain = doc.mesh();
                     let weights = pipeline::arap::rigidity_weights(domain, strokes);
                     (weights, domain.triangles())
                 }

@@ -222,10 +222,7 @@ impl EditorApp {
             if self.tool == Tool::Cage {
                 self.set_tool(Tool::Puppet);
             }
-            let cut_out = self
-                .doc
-                .as_ref()
-                .is_some_and(|d| !d.rig().domain().is_convex());
+            let cut_out = self.doc.as_ref().is_some_and(|d| !d.mesh().is_convex());
             if method == Method::Mls && cut_out && !self.mls_warned {
                 // Once a document: the one surprise MLS has in store on a cut-out.
                 self.mls_warned = true;

@@ -322,7 +322,7 @@ impl Document {
         {
             return Ok(());
         }
-        self.method = pipeline::on_mesh(&self.project, self.rig.domain(), Some(&self.image))?
+        self.method = pipeline::on_mesh(&self.project, self.mesh(), Some(&self.image))?
             .map(|deformer| (self.mesh_version, deformer));
         Ok(())
     }
@@ -343,7 +343,7 @@ impl Document {
             return parts.triangles().to_vec();
         }
         let order = pipeline::order::predefined_for(&self.project, &self.rig);
-        pipeline::order::as_triangles(&order, self.rig.domain().triangles())
+        pipeline::order::as_triangles(&order, self.mesh().triangles())
     }
 
     /// The method in use.
@@ -509,9 +509,15 @@ impl Document {
         &self.project
     }
 
-    /// The weighted rig.
+    /// The weighted rig (C²'s weights, virtual handles, cells and dual graph).
     pub fn rig(&self) -> &Rig {
         &self.rig
+    }
+
+    /// The picture's mesh at rest, which every handle method is set up on and the view
+    /// draws (what asks for the mesh alone asks here, not for the C² rig that holds it).
+    pub fn mesh(&self) -> &Domain {
+        self.rig.domain()
     }
 
     /// The weighting parameters.
@@ -1100,7 +1106,7 @@ impl Document {
         let deformed = self.deformed.as_ref().map(|(_, d)| d.as_slice())?;
         let (rest, triangles) = match (self.parts(), &on_top) {
             (Some(parts), Some(order)) => (parts.rest(), order.as_slice()),
-            _ => (self.rig.domain().positions(), self.rig.domain().triangles()),
+            _ => (self.mesh().positions(), self.mesh().triangles()),
         };
         let ([a, b, c], [u, v, w]) = locate(deformed, triangles, p)?;
         let [pa, pb, pc] = [a, b, c].map(|v| deformed[v as usize]);

@@ -278,7 +278,7 @@ impl FrameBuilder {
         let shown = doc.shown(in_hand, self.seen.warping);
         let (samples, what) = match shown {
             Shown::Parts(parts) => (parts.rest().len(), "the parts"),
-            Shown::Picture(_) => (doc.rig().domain().len(), "the rig"),
+            Shown::Picture(_) => (doc.mesh().len(), "the rig"),
             Shown::Cage(Some(cage)) => (cage.rest().len(), "the cage's mesh"),
             Shown::Cage(None) => (0, "no mesh (a cage being drawn)"),
         };

@@ -348,7 +348,7 @@ fn every_handle_method_shows_its_own_answer_between_keys() {
 /// The document's handle method set up afresh on its mesh for `project` (C²: its rig,
 /// following `project`).
 fn set_up_afresh(doc: &editor::Document, project: &project::Project) -> Vec<DVec2> {
-    match pipeline::on_mesh(project, doc.rig().domain(), Some(&doc.image)).expect("the method") {
+    match pipeline::on_mesh(project, doc.mesh(), Some(&doc.image)).expect("the method") {
         Some(deformer) => deformer.deformed(),
         None => {
             let mut rig = doc.rig().clone();

@@ -44,7 +44,7 @@ fn switching_methods_keeps_the_pose_and_comes_back_and_undoes() {
     assert!(times.compile_ms > 0.0);
     // The editor's ARAP is the method's own answer for the rig's mesh and handles.
     let project = doc.project();
-    let own = pipeline::on_mesh(project, doc.rig().domain(), Some(&doc.image))
+    let own = pipeline::on_mesh(project, doc.mesh(), Some(&doc.image))
         .expect("ARAP")
         .expect("not the rig")
         .deformed();
@@ -122,7 +122,7 @@ fn a_drag_under_arap_moves_the_handle_and_keeps_the_compiled_system() {
         "a translation drag recompiles nothing"
     );
     // The handle's vertex sits exactly where the handle's translation puts it.
-    let domain = doc.rig().domain();
+    let domain = doc.mesh();
     let v = domain
         .nearest_vertex(DVec2::new(440.0, 238.0))
         .expect("a vertex") as usize;
@@ -207,7 +207,7 @@ fn arap_with_no_handles_one_handle_and_paint_under_c2() {
     click_label(&mut h, "ARAP");
     click_label(&mut h, "Clear all handles");
     let doc = h.state().document().expect("doc");
-    let rest = doc.rig().domain().positions().to_vec();
+    let rest = doc.mesh().positions().to_vec();
     let at_rest = positions(&h);
     let worst = at_rest
         .iter()
@@ -350,10 +350,10 @@ fn painted_rigidity_survives_a_new_density() {
         h.run();
     }
     let doc = h.state().document().expect("doc");
-    assert!(doc.rig().domain().len() < 4000);
+    assert!(doc.mesh().len() < 4000);
     assert_eq!(doc.project().rigidity.len(), 1);
     // The overlay shows the triangles painted on the new mesh.
-    let domain = doc.rig().domain();
+    let domain = doc.mesh();
     let fresh: Vec<[u32; 3]> = pipeline::arap::rigidity_weights(domain, &doc.project().rigidity)
         .iter()
         .zip(domain.triangles())
@@ -375,7 +375,7 @@ fn mls_is_chosen_dragged_undone_and_exported_as_the_pipeline_draws_it() {
     assert_eq!(method(&h), Method::Mls);
     // The editor's MLS is the method's own answer for the rig's mesh and handles.
     let doc = h.state().document().expect("doc");
-    let own = pipeline::on_mesh(doc.project(), doc.rig().domain(), Some(&doc.image))
+    let own = pipeline::on_mesh(doc.project(), doc.mesh(), Some(&doc.image))
         .expect("MLS")
         .expect("not the rig")
         .deformed();
@@ -396,7 +396,7 @@ fn mls_is_chosen_dragged_undone_and_exported_as_the_pipeline_draws_it() {
         "moved by {moved}"
     );
     let doc = h.state().document().expect("doc");
-    let domain = doc.rig().domain();
+    let domain = doc.mesh();
     let v = domain
         .nearest_vertex(DVec2::new(440.0, 238.0))
         .expect("a vertex") as usize;

@@ -914,8 +914,8 @@ fn walk(seed: u64, actions: usize) {
                                 geometry::segment_distance(gone, e)
                             })
                             .fold(f64::INFINITY, f64::min);
-                    let rest = doc.rig().domain().positions().to_vec();
-                    let edge = doc.rig().domain().mean_edge_length();
+                    let rest = doc.mesh().positions().to_vec();
+                    let edge = doc.mesh().mean_edge_length();
                     let (mut moved, mut own) = (0.0f64, 0.0f64);
                     for ((a, b), p) in shown.iter().zip(doc.deformed()).zip(&rest) {
                         let from = geometry::point_segment_distance(*p, gone[0], gone[1]);

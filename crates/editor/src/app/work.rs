@@ -329,7 +329,7 @@ impl EditorApp {
             .as_ref()
             .is_none_or(|old| old.settings().density != doc.settings().density);
         let short = remeshed
-            .then(|| pipeline::density_shortfall(doc.rig().domain(), doc.settings().density))
+            .then(|| pipeline::density_shortfall(doc.mesh(), doc.settings().density))
             .flatten();
         self.doc = Some(doc);
         if self.selected.is_some_and(|s| s >= handles) {

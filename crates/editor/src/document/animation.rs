@@ -93,7 +93,7 @@ impl Document {
     pub fn forward(&mut self, p: DVec2) -> Option<DVec2> {
         self.deformed();
         let deformed = self.deformed.as_ref().map(|(_, d)| d.as_slice())?;
-        let domain = self.rig.domain();
+        let domain = self.mesh();
         let ([a, b, c], [u, v, w]) = super::locate(domain.positions(), domain.triangles(), p)?;
         let at = |v: u32| deformed.get(v as usize).copied();
         Some(at(a)? * u + at(b)? * v + at(c)? * w)

@@ -121,7 +121,7 @@ impl Document {
                 }
             }
             Controls::Handles => {
-                if *mesh != self.mesh_version || deformer.rest() != self.rig.domain().positions() {
+                if *mesh != self.mesh_version || deformer.rest() != self.mesh().positions() {
                     bail!("the {} deformer was set up on another mesh", method.name());
                 }
             }
@@ -173,7 +173,7 @@ impl Document {
         // coordinates): the reopened document finds this one's for its cage, if the
         // saved cage, τ and density are the same.
         fresh.keep_solutions_of(self)?;
-        let (a, b) = (self.rig.domain(), fresh.rig.domain());
+        let (a, b) = (self.mesh(), fresh.mesh());
         if a.positions() != b.positions() || a.triangles() != b.triangles() {
             bail!(
                 "reopened, the picture meshes to {} vertices and {} triangles, not {} and {}",

@@ -73,7 +73,7 @@ fn pose_edits_keep_weights_and_insertions_update_them() {
     // The handle's node sits on the vertex nearest its rest position and goes where
     // the handle's similarity about (10, 10) takes it.
     let vertex = doc.rig().nodes()[0].vertex as usize;
-    let rest = doc.rig().domain().positions()[vertex];
+    let rest = doc.mesh().positions()[vertex];
     let expected = weights_core::Similarity {
         translation: DVec2::new(5.0, 0.0),
         rotation: 0.2,
@@ -241,7 +241,7 @@ fn under_arap_a_pin_placed_in_a_bent_pose_holds_the_picture_where_it_is() {
     );
     doc.apply(Edit::ResetPose).expect("reset");
     assert!(doc.project().holds.is_empty());
-    let rest = doc.rig().domain().positions().to_vec();
+    let rest = doc.mesh().positions().to_vec();
     let off = rest
         .iter()
         .zip(doc.deformed())
@@ -268,7 +268,7 @@ fn a_new_handle_fits_the_pose_around_it_not_one_triangle() {
         .rig()
         .nodes()
         .iter()
-        .map(|n| doc.rig().domain().positions()[n.vertex as usize].distance(rest))
+        .map(|n| doc.mesh().positions()[n.vertex as usize].distance(rest))
         .fold(f64::INFINITY, f64::min);
     // Shear the deformed picture directly (the cache the fit reads).
     let shear: Vec<DVec2> = doc
@@ -318,7 +318,7 @@ fn settings_rebuild_and_influence_partitions_unity() {
     assert_eq!(doc.project().placement, Placement::Symmetric);
     settings.density = 1000;
     doc.apply(Edit::Settings(settings)).expect("re-mesh");
-    assert!(doc.rig().domain().len() < 1500);
+    assert!(doc.mesh().len() < 1500);
     let a = doc.influence(0);
     let b = doc.influence(1);
     for (x, y) in a.iter().zip(&b) {
@@ -527,7 +527,7 @@ fn a_project_of_several_pictures_opens_as_their_layers_and_saves_them_all() {
 #[test]
 fn handles_half_a_pixel_apart_are_placed_and_reopen_the_same() {
     let mut doc = Document::built_in().expect("the lizard");
-    let before = doc.rig().domain().len();
+    let before = doc.mesh().len();
     // Beside the leg's pin (190, 470): 1 px, then 0.5 px from it, at rest and posed.
     for (x, y) in [(191.0, 470.0), (190.0, 470.5)] {
         doc.apply(Edit::Add(point(x, y)))
@@ -535,14 +535,11 @@ fn handles_half_a_pixel_apart_are_placed_and_reopen_the_same() {
         doc.check_reopens()
             .expect("reopens to the same mesh and rig");
     }
-    assert!(
-        doc.rig().domain().len() > before,
-        "the mesh was refined there"
-    );
+    assert!(doc.mesh().len() > before, "the mesh was refined there");
     let deformed = doc.deformed().to_vec();
     assert!(deformed.iter().all(|p| p.is_finite()));
     // Each handle has its own sample, at its exact place.
-    let positions = doc.rig().domain().positions();
+    let positions = doc.mesh().positions();
     for h in &doc.project().handles[7..] {
         let HandleSpec::Point { rest, .. } = h else {
             unreachable!()
@@ -558,7 +555,7 @@ fn handles_half_a_pixel_apart_are_placed_and_reopen_the_same() {
     // virtual handles stay.
     doc.apply(Edit::Remove(8)).expect("remove");
     doc.apply(Edit::Remove(7)).expect("remove");
-    assert_eq!(doc.rig().domain().len(), before);
+    assert_eq!(doc.mesh().len(), before);
     doc.check_reopens().expect("reopens");
     // Coincident handles are refused, saying so.
     let error = doc
@@ -1307,8 +1304,8 @@ fn bar_removed_among_dragged_handles() -> (f64, f64) {
     };
     let mut doc = Document::new(image, None, project).expect("opens");
     let shown = doc.deformed().to_vec();
-    let rest = doc.rig().domain().positions().to_vec();
-    let edge = doc.rig().domain().mean_edge_length();
+    let rest = doc.mesh().positions().to_vec();
+    let edge = doc.mesh().mean_edge_length();
     let next = (doc.project().handles.iter())
         .filter_map(|h| match *h {
             HandleSpec::Point { rest, .. } => Some(DVec2::from(rest)),

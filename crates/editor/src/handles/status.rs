@@ -42,10 +42,10 @@ impl HandleTool {
         let at = host.viewport().to_image(pointer);
         let doc = host.document_mut().filter(|d| d.parts().is_none())?;
         let (rest, _, _) = doc.unwarp(at)?;
-        let vertex = doc.rig().domain().nearest_vertex(rest)? as usize;
+        let vertex = doc.mesh().nearest_vertex(rest)? as usize;
         if matches!(doc.deformer().output(), Output::Positions(_)) {
             let method = doc.method().label();
-            let from = doc.rig().domain().positions()[vertex];
+            let from = doc.mesh().positions()[vertex];
             let to = *doc.deformed().get(vertex)?;
             return Some(format!(
                 "vertex {vertex} at ({:.1}, {:.1})\n{method} moves it to ({:.1}, {:.1})",
