@@ -106,7 +106,7 @@ fn drag_frame(c: &mut Criterion) {
     let mut settings = doc.settings();
     settings.density = 200_000;
     doc.apply(Edit::Settings(settings)).expect("200k vertices");
-    let vertices = doc.rig().stats().samples;
+    let vertices = doc.rig().expect("a C² rig").stats().samples;
     let mut h = Harness::builder()
         .with_size(Vec2::new(1280.0, 820.0))
         .build_eframe(move |_cc| EditorApp::with_document(doc));

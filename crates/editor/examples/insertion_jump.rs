@@ -106,11 +106,11 @@ fn insertion_jumps(doc: &mut Document, insertions: usize) -> (Vec<Jump>, Vec<Jum
     };
     while (points.len() < insertions || bars.len() < insertions) && tries < 50 * insertions {
         tries += 1;
-        let n = doc.rig().domain().len();
+        let n = doc.mesh().len();
         let v = (rng.next() % n as u64) as usize;
         let w = (rng.next() % n as u64) as usize;
         let deformed = doc.deformed().to_vec();
-        let rest = doc.rig().domain().positions().to_vec();
+        let rest = doc.mesh().positions().to_vec();
         let snapshot = doc.snapshot();
         let bar = points.len() >= insertions;
         let added = if bar {
@@ -138,8 +138,8 @@ fn insertion_jumps(doc: &mut Document, insertions: usize) -> (Vec<Jump>, Vec<Jum
         // at the old mesh's points, where the method itself takes them.)
         let after = {
             let after = doc.deformed().to_vec();
-            let rig = doc.rig();
-            let same_mesh = rig.domain().positions() == rest.as_slice();
+            let mesh = doc.mesh();
+            let same_mesh = mesh.positions() == rest.as_slice();
             rest.iter()
                 .enumerate()
                 .map(|(i, p)| {
@@ -148,34 +148,41 @@ fn insertion_jumps(doc: &mut Document, insertions: usize) -> (Vec<Jump>, Vec<Jum
                     } else if let Some(at) = arap_map(doc, *p) {
                         at
                     } else {
-                        rig.deform_point(&after, *p).unwrap_or(*p)
+                        through(mesh, &after, *p).unwrap_or(*p)
                     }
                 })
                 .collect::<Vec<_>>()
         };
-        let rig = doc.rig();
-        let nodes: Vec<usize> = (0..rig.nodes().len())
-            .filter(|&k| {
-                rig.owner_handle(k) == Some(new)
-                    && rig.nodes()[k].kind != weights_core::NodeKind::Virtual
-            })
-            .collect();
-        // Its own place: its Voronoi cell in the partition, or for a handle laid over
-        // the weights (placed in a posed state) the disc of half its support, inside
-        // its cell as the paper would have drawn it.
-        let positions = rig.domain().positions();
-        let own_disc: Vec<(DVec2, f64)> = nodes
-            .iter()
-            .map(|&k| {
+        // Under C², the new handle's own nodes: their discs of half the support, and
+        // their Voronoi cells (ARAP and MLS weigh by no cells).
+        let (own_disc, own_cells, cells, same_mesh) = match doc.rig() {
+            Some(rig) => {
+                let nodes: Vec<usize> = (0..rig.nodes().len())
+                    .filter(|&k| {
+                        rig.owner_handle(k) == Some(new)
+                            && rig.nodes()[k].kind != weights_core::NodeKind::Virtual
+                    })
+                    .collect();
+                let positions = rig.domain().positions();
+                let own_disc: Vec<(DVec2, f64)> = nodes
+                    .iter()
+                    .map(|&k| {
+                        (
+                            positions[rig.nodes()[k].vertex as usize],
+                            rig.radii(k).support / 2.0,
+                        )
+                    })
+                    .collect();
+                let own_cells: Vec<u32> = nodes.iter().map(|&k| k as u32).collect();
                 (
-                    positions[rig.nodes()[k].vertex as usize],
-                    rig.radii(k).support / 2.0,
+                    own_disc,
+                    own_cells,
+                    rig.cells().to_vec(),
+                    positions == rest.as_slice(),
                 )
-            })
-            .collect();
-        let own_cells: Vec<u32> = nodes.iter().map(|&k| k as u32).collect();
-        let same_mesh = positions == rest.as_slice();
-        let cells = rig.cells().to_vec();
+            }
+            None => (Vec::new(), Vec::new(), Vec::new(), false),
+        };
         let own = |i: usize| {
             (same_mesh && own_cells.contains(&cells[i]))
                 || own_disc.iter().any(|(c, r)| rest[i].distance(*c) < *r)
@@ -210,7 +217,7 @@ fn removal_jumps(doc: &mut Document) -> Vec<Jump> {
             continue;
         }
         let after = doc.deformed().to_vec();
-        let rest = doc.rig().domain().positions().to_vec();
+        let rest = doc.mesh().positions().to_vec();
         let j = jump(
             &before,
             &after,
@@ -311,7 +318,7 @@ fn document(name: &str) -> anyhow::Result<Document> {
         f64::from(w).hypot(f64::from(h))
     };
     let mut rng = Rng(0x51_7cc1_b727_220a);
-    let rest = doc.rig().domain().positions().to_vec();
+    let rest = doc.mesh().positions().to_vec();
     let mut placed: Vec<DVec2> = Vec::new();
     while placed.len() < 7 {
         let p = rest[(rng.next() % rest.len() as u64) as usize];
@@ -364,4 +371,14 @@ fn main() -> anyhow::Result<()> {
     summary("bars inserted", &bars, c2);
     summary("handles removed", &removals, false);
     Ok(())
+}
+
+/// Where `deformed` (a pose of `mesh`) takes the point `p` at rest: through the rest
+/// triangle holding it.
+fn through(mesh: &weights_core::Domain, deformed: &[DVec2], p: DVec2) -> Option<DVec2> {
+    let (t, bary) = mesh.locate(p)?;
+    let corners = mesh.triangles()[t];
+    (0..3)
+        .map(|i| deformed.get(corners[i] as usize).map(|&q| q * bary[i]))
+        .sum()
 }

@@ -158,7 +158,8 @@ pub struct Document {
     /// What the picture file holds that is drawn otherwise than it asks (layers whose
     /// blend mode is drawn as normal), one line each; said when it is opened.
     pub picture_notes: Vec<String>,
-    rig: Rig,
+    /// The picture's mesh, and C²'s weights of it where the method uses them.
+    base: Base,
     /// Bumped whenever the nodes or weights change (the GPU mesh must be re-uploaded).
     pub weights_version: u64,
     /// Bumped whenever a node transform changes.
@@ -171,8 +172,7 @@ pub struct Document {
     /// Bumped when the picture is meshed anew.
     mesh_version: u64,
     /// With a handle method other than C² chosen: its deformer, and the mesh version
-    /// it was set up on ([`pipeline::beside_rig`]). The C² rig stays beside it: it
-    /// holds the mesh and the handles, and its heat maps.
+    /// it was set up on ([`pipeline::on_mesh`]).
     method: Option<(u64, Box<dyn Deformer>)>,
     /// Solved cages, the most recent last (at most [`SOLUTIONS_KEPT`]).
     solutions: Vec<(CageKey, Arc<CageCoordinates>)>,
@@ -185,6 +185,57 @@ pub struct Document {
     /// Whether a live pose was left unarranged (a large mesh): the drag's end
     /// arranges it.
     depth_deferred: bool,
+}
+
+/// The picture's mesh, and C²'s weights of it where they are used.
+#[derive(Clone)]
+enum Base {
+    /// The C² rig, which holds the mesh: under C², and under a cage (the handles stay,
+    /// for going back to them).
+    Rig(Box<Rig>),
+    /// The mesh alone, under a method that sets up on it (ARAP, MLS) and weighs
+    /// nothing of C²'s; `virtuals` keeps the C² rig's virtual handles (the rig file's
+    /// `virtual_*` fields alone), carried through the edits as a save carries them, so
+    /// that going back to C² builds the rig a reopen would build.
+    Mesh {
+        mesh: Box<Domain>,
+        virtuals: Box<Project>,
+    },
+}
+
+impl Base {
+    /// `project`'s on `image`: its rig, or under ARAP and MLS its mesh alone.
+    fn of(image: &RgbaImage, project: &Project) -> Result<Self> {
+        if project.method.sets_up_on_the_mesh() {
+            let mesh = pipeline::mesh_picture_for(image, project)?;
+            weights_core::check_handles_on(&mesh, &pipeline::handles(project))?;
+            Ok(Base::Mesh {
+                mesh: Box::new(mesh),
+                virtuals: Box::new(virtuals_of(project)),
+            })
+        } else {
+            Ok(Base::Rig(Box::new(
+                pipeline::prepare(image, project, None)?.rig,
+            )))
+        }
+    }
+
+    fn mesh(&self) -> &Domain {
+        match self {
+            Base::Rig(rig) => rig.domain(),
+            Base::Mesh { mesh, .. } => mesh,
+        }
+    }
+}
+
+/// `project`'s virtual handles alone (its `virtual_*` fields).
+fn virtuals_of(project: &Project) -> Project {
+    Project {
+        virtual_handles: project.virtual_handles.clone(),
+        virtual_placed_for: project.virtual_placed_for.clone(),
+        virtual_copy: project.virtual_copy.clone(),
+        ..Project::default()
+    }
 }
 
 impl Document {
@@ -235,11 +286,11 @@ impl Document {
         // mesh and rig, on the other core.
         let parts_layers = (layers.as_deref())
             .filter(|_| project.parts.is_some() && project.method.controls() == Controls::Handles);
-        let (prepared, parts) = rayon::join(
-            || pipeline::prepare(&image, &project, None),
+        let (base, parts) = rayon::join(
+            || Base::of(&image, &project),
             || parts_layers.map(|layers| PartsDeformer::new(layers, &project, None, &())),
         );
-        let prepared = prepared?;
+        let base = base?;
         let method = (parts.transpose()?).map(|parts| (1, Box::new(parts) as Box<dyn Deformer>));
         // Virtual handles live in the rig while editing; they are written out on save.
         project.virtual_handles.clear();
@@ -254,7 +305,7 @@ impl Document {
             image_paths: Vec::new(),
             project_path: None,
             picture_notes: Vec::new(),
-            rig: prepared.rig,
+            base,
             weights_version: 1,
             pose_version: 1,
             last_update_ms: ms(clock),
@@ -342,7 +393,7 @@ impl Document {
             // The parts back to front in the draw order, each in its own order.
             return parts.triangles().to_vec();
         }
-        let order = pipeline::order::predefined_for(&self.project, &self.rig);
+        let order = self.predefined_order();
         pipeline::order::as_triangles(&order, self.mesh().triangles())
     }
 
@@ -351,11 +402,30 @@ impl Document {
         self.project.method
     }
 
-    /// The handle method's deformer: the C² rig itself, or the one set up beside it.
+    /// The handle method's deformer: the C² rig itself, or the one set up on the mesh.
     pub fn deformer(&self) -> &dyn Deformer {
-        match &self.method {
-            Some((_, deformer)) => deformer.as_ref(),
-            None => &self.rig,
+        match (&self.method, &self.base) {
+            (Some((_, deformer)), _) => deformer.as_ref(),
+            (None, Base::Rig(rig)) => rig.as_ref(),
+            // A bare mesh always has its method set up beside it (set up before the
+            // mesh is taken, in `Document::restore_bare`).
+            (None, Base::Mesh { .. }) => unreachable!("a bare mesh without its method"),
+        }
+    }
+
+    /// The handles' predefined drawing order on the picture's mesh (triangle indices):
+    /// by C²'s cells under C², by the handle nearest each vertex otherwise.
+    pub(crate) fn predefined_order(&self) -> Vec<u32> {
+        let depths: Vec<i32> = self.project.handles.iter().map(HandleSpec::depth).collect();
+        match &self.base {
+            Base::Rig(rig) if self.project.method == Method::C2 => {
+                pipeline::order::predefined_order(rig, &depths)
+            }
+            _ => pipeline::order::nearest_handle_order(
+                self.mesh(),
+                &pipeline::handles(&self.project),
+                &depths,
+            ),
         }
     }
 
@@ -509,15 +579,20 @@ impl Document {
         &self.project
     }
 
-    /// The weighted rig (C²'s weights, virtual handles, cells and dual graph).
-    pub fn rig(&self) -> &Rig {
-        &self.rig
+    /// The C² rig (its weights, virtual handles, cells and dual graph), kept under C²
+    /// and under a cage (for going back to the handles); `None` under ARAP and MLS,
+    /// which set up on the mesh alone.
+    pub fn rig(&self) -> Option<&Rig> {
+        match &self.base {
+            Base::Rig(rig) => Some(rig),
+            Base::Mesh { .. } => None,
+        }
     }
 
     /// The picture's mesh at rest, which every handle method is set up on and the view
     /// draws (what asks for the mesh alone asks here, not for the C² rig that holds it).
     pub fn mesh(&self) -> &Domain {
-        self.rig.domain()
+        self.base.mesh()
     }
 
     /// The weighting parameters.
@@ -853,7 +928,10 @@ impl Document {
     /// Makes `project` (the document's, with handle `removed` of the partition taken
     /// out) the document's rig file, with that handle's nodes kept as virtual handles.
     fn remove_keeping_nodes(&mut self, mut project: Project, removed: usize) -> Result<()> {
-        let rig = &self.rig;
+        let Base::Rig(rig) = &self.base else {
+            // No C² rig to keep them in: the virtual handles placed for it go with it.
+            return self.restore(project);
+        };
         let renumber = |h: Option<usize>| match h {
             Some(h) if h > removed => Some(h - 1),
             Some(h) if h == removed => None,
@@ -946,8 +1024,21 @@ impl Document {
     /// brings back exactly.
     pub fn snapshot(&self) -> Project {
         let mut project = self.project.clone();
-        let placed = self.rig.placed_virtual_handles();
-        pipeline::write_virtual_handles(self.rig.domain(), &placed, &mut project);
+        match &self.base {
+            Base::Rig(rig) => {
+                let placed = rig.placed_virtual_handles();
+                pipeline::write_virtual_handles(rig.domain(), &placed, &mut project);
+            }
+            Base::Mesh { virtuals, .. } => {
+                project
+                    .virtual_handles
+                    .clone_from(&virtuals.virtual_handles);
+                project
+                    .virtual_placed_for
+                    .clone_from(&virtuals.virtual_placed_for);
+                project.virtual_copy.clone_from(&virtuals.virtual_copy);
+            }
+        }
         project
     }
 
@@ -969,6 +1060,20 @@ impl Document {
             virtual_copy: std::mem::take(&mut project.virtual_copy),
             ..Project::default()
         };
+        if project.method.sets_up_on_the_mesh() {
+            return self.restore_bare(project, saved_virtuals, exact);
+        }
+        if let Base::Mesh { mesh, .. } = &self.base {
+            // Back to C² (or to a cage) from a method that keeps the mesh alone: the
+            // rig built on it from the handles and virtual handles kept, as a reopen
+            // of the rig file saved now would build it; then on as from C².
+            let mut with = self.snapshot();
+            with.method = Method::C2;
+            let mesh = pipeline::with_metric(Domain::clone(mesh), &with)?;
+            let rig = pipeline::rig_on_domain(mesh, &with, &|_| {})?;
+            self.base = Base::Rig(Box::new(rig));
+            self.weights_version += 1;
+        }
         // Another method or another rest cage draws another mesh; another cage pose
         // moves it.
         let cage_mesh_changed = project.method != self.project.method
@@ -1016,21 +1121,23 @@ impl Document {
                     with_virtuals.virtual_copy,
                 ) = carried_virtuals(&self.snapshot(), &project);
             }
-            self.rig = pipeline::prepare(&self.image, &with_virtuals, None)?.rig;
+            self.base = Base::Rig(Box::new(
+                pipeline::prepare(&self.image, &with_virtuals, None)?.rig,
+            ));
             self.mesh_version += 1;
         } else if new == old && exact && !same_rest {
-            let domain = self.rig.domain();
+            let domain = self.mesh();
             let placed = pipeline::virtual_handles_on(domain, &saved_virtuals);
-            self.rig = Rig::with_overlaid(
+            self.base = Base::Rig(Box::new(Rig::with_overlaid(
                 domain.clone(),
                 handles,
                 &project.overlaid,
                 &placed,
                 pipeline::rig_options(&project)?,
                 &|_| {},
-            )?;
+            )?));
         } else if new != old {
-            let domain = self.rig.domain();
+            let domain = self.mesh();
             let metric = pipeline::metric(new.metric, domain.is_convex());
             let domain = if metric == domain.metric() {
                 domain.clone()
@@ -1041,18 +1148,20 @@ impl Document {
                     metric,
                 )?
             };
-            self.rig = Rig::with_overlaid(
+            self.base = Base::Rig(Box::new(Rig::with_overlaid(
                 domain,
                 handles,
                 &project.overlaid,
                 &[],
                 pipeline::rig_options(&project)?,
                 &|_| {},
-            )?;
+            )?));
         } else {
-            if project.handles != self.project.handles || project.overlaid != self.project.overlaid
+            if (project.handles != self.project.handles
+                || project.overlaid != self.project.overlaid)
+                && let Base::Rig(rig) = &mut self.base
             {
-                self.rig.set_handles_overlaid(handles, &project.overlaid)?;
+                rig.set_handles_overlaid(handles, &project.overlaid)?;
             }
             if same_rest {
                 self.project = project;
@@ -1068,6 +1177,98 @@ impl Document {
 
         self.project = project;
         self.weights_version += 1;
+        self.pose_version += 1;
+        self.sync_method()?;
+        self.last_update_ms = ms(clock);
+        Ok(())
+    }
+
+    /// [`Document::restore_with`] under a method that sets up on the mesh alone (ARAP,
+    /// MLS): the mesh anew where the density, the crowding of handles or the cuts ask
+    /// for another (the rule [`pipeline::prepare`] meshes by), the handles checked as
+    /// C²'s rig checks them, the virtual handles kept for going back to C² carried as
+    /// a rig would carry them; a method new to the mesh is set up before anything
+    /// changes.
+    fn restore_bare(
+        &mut self,
+        project: Project,
+        saved_virtuals: Project,
+        exact: bool,
+    ) -> Result<()> {
+        let clock = Instant::now();
+        let (old, new) = (self.settings(), Settings::of(&project));
+        let same_rest = project.handles.len() == self.project.handles.len()
+            && project
+                .handles
+                .iter()
+                .zip(&self.project.handles)
+                .all(|(a, b)| same_rest(a, b));
+        let depths_changed = project.handles.iter().map(HandleSpec::depth).ne(self
+            .project
+            .handles
+            .iter()
+            .map(HandleSpec::depth));
+        let (w, h) = self.image.dimensions();
+        let refined =
+            |p: &Project| pipeline::crowding::refinement(p, w, h, Settings::of(p).density);
+        let remesh = new.density != old.density
+            || project.cuts != self.project.cuts
+            || (!same_rest && refined(&project) != refined(&self.project));
+        let virtuals = if exact {
+            saved_virtuals
+        } else if new.density != old.density {
+            // Another lattice: Algorithm 1 places them afresh when C² comes back.
+            Project::default()
+        } else {
+            let (virtual_handles, virtual_placed_for, virtual_copy) =
+                carried_virtuals(&self.snapshot(), &project);
+            Project {
+                virtual_handles,
+                virtual_placed_for,
+                virtual_copy,
+                ..Project::default()
+            }
+        };
+        let new_mesh = if remesh {
+            Some(pipeline::mesh_picture_for(&self.image, &project)?)
+        } else if matches!(self.base, Base::Rig(_)) || new.metric != old.metric {
+            Some(pipeline::with_metric(self.mesh().clone(), &project)?)
+        } else {
+            None
+        };
+        let mesh = new_mesh.as_ref().unwrap_or(self.mesh());
+        weights_core::check_handles_on(mesh, &pipeline::handles(&project))?;
+        let parts = self.layers.is_some() && project.parts.is_some();
+        let fresh = if !parts && (new_mesh.is_some() || self.method.is_none()) {
+            pipeline::on_mesh(&project, mesh, Some(&self.image))?
+        } else {
+            None
+        };
+        let method_changed = project.method != self.project.method;
+        match new_mesh {
+            Some(mesh) => {
+                self.base = Base::Mesh {
+                    mesh: Box::new(mesh),
+                    virtuals: Box::new(virtuals),
+                }
+            }
+            None => {
+                if let Base::Mesh { virtuals: kept, .. } = &mut self.base {
+                    **kept = virtuals;
+                }
+            }
+        }
+        if remesh {
+            self.mesh_version += 1;
+        }
+        if let Some(deformer) = fresh {
+            self.method = Some((self.mesh_version, deformer));
+        }
+        if !(same_rest && !depths_changed && !remesh && !method_changed) {
+            // Another mesh, other handles or another order: uploaded anew.
+            self.weights_version += 1;
+        }
+        self.project = project;
         self.pose_version += 1;
         self.sync_method()?;
         self.last_update_ms = ms(clock);
@@ -1146,7 +1347,12 @@ impl Document {
             .deformed
             .as_ref()
             .map_or(&[][..], |(_, d)| d.as_slice());
-        let rig = &self.rig;
+        let Some(rig) = self.rig() else {
+            // No C² weights to fit by: the similarity of the triangle under `at`.
+            return self
+                .unwarp(at)
+                .map_or((0.0, 1.0), |(_, angle, scale)| (angle, scale));
+        };
         let positions = rig.domain().positions();
         let reach = rig
             .nodes()
@@ -1179,12 +1385,15 @@ impl Document {
         )
     }
 
-    /// Where node `k` is in the current pose.
-    pub fn node_position(&self, k: usize) -> DVec2 {
-        let vertex = self.rig.nodes()[k].vertex as usize;
-        self.rig
-            .node_transform(k)
-            .transform_point2(self.rig.domain().positions()[vertex])
+    /// Where node `k` of the C² rig is in the current pose (`None` without a rig, or
+    /// no such node).
+    pub fn node_position(&self, k: usize) -> Option<DVec2> {
+        let rig = self.rig()?;
+        let vertex = rig.nodes().get(k)?.vertex as usize;
+        Some(
+            rig.node_transform(k)
+                .transform_point2(rig.domain().positions()[vertex]),
+        )
     }
 
     /// The share of handle `handle` in every sample's position: its own nodes'
@@ -1195,7 +1404,8 @@ impl Document {
             None => vec![0.0; rig.domain().len()],
         };
         self.per_part(0.0, handle, of_part)
-            .unwrap_or_else(|| influence_of(&self.rig, handle))
+            .or_else(|| self.rig().map(|rig| influence_of(rig, handle)))
+            .unwrap_or_default()
     }
 
     /// Each vertex's Voronoi cell, as the mesh vertex of its node (distinct for every
@@ -1213,7 +1423,8 @@ impl Document {
             keys
         };
         self.per_part(None, 0, of_part)
-            .unwrap_or_else(|| cells(&self.rig, 0))
+            .or_else(|| self.rig().map(|rig| cells(rig, 0)))
+            .unwrap_or_default()
     }
 
     /// Drawn as parts, for each vertex of the parts' mesh: what `of_part` gives for

@@ -115,7 +115,7 @@ impl FrameBuilder {
             self.update_mesh(doc, shown);
         }
         if mesh_changed || doc.pose_version != self.seen.pose {
-            self.update_pose(doc, shown);
+            self.update_pose(shown);
         }
         self.update_overlays(doc, shown, view);
         self.seen.weights = weights;
@@ -153,7 +153,7 @@ impl FrameBuilder {
                 source_size: size,
                 ..MeshData::default()
             },
-            Shown::Picture(_) => skinned_mesh(doc.rig(), doc.draw_order(), size),
+            Shown::Picture(deformer) => skinned_mesh(deformer, doc.draw_order(), size),
         };
         let version = self.bump();
         self.frame.mesh = Versioned {
@@ -194,7 +194,7 @@ impl FrameBuilder {
     }
 
     /// The node transforms, and the positions a method solves for.
-    fn update_pose(&mut self, doc: &Document, shown: Shown) {
+    fn update_pose(&mut self, shown: Shown) {
         let positions = |deformer: &dyn Deformer| match deformer.output() {
             Output::Positions(p) => p.iter().map(|p| p.as_vec2()).collect(),
             Output::Skinned(_) => Vec::new(),
@@ -203,7 +203,7 @@ impl FrameBuilder {
             Shown::Parts(parts) => (Vec::new(), positions(parts)),
             Shown::Cage(Some(cage)) => (transforms(cage), Vec::new()),
             Shown::Cage(None) => (Vec::new(), Vec::new()),
-            Shown::Picture(deformer) => (doc.rig().node_affines(), positions(deformer)),
+            Shown::Picture(deformer) => (transforms(deformer), positions(deformer)),
         };
         let version = self.bump();
         self.frame.pose = Versioned {
@@ -260,7 +260,11 @@ impl FrameBuilder {
             && matches!(shown, Shown::Picture(_))
             && self.dual_graph.0 != mesh_version
         {
-            self.dual_graph = (mesh_version, Arc::new(doc.rig().dual_graph()));
+            let graph = doc
+                .rig()
+                .map(weights_core::Rig::dual_graph)
+                .unwrap_or_default();
+            self.dual_graph = (mesh_version, Arc::new(graph));
         }
     }
 

@@ -351,7 +351,7 @@ fn set_up_afresh(doc: &editor::Document, project: &project::Project) -> Vec<DVec
     match pipeline::on_mesh(project, doc.mesh(), Some(&doc.image)).expect("the method") {
         Some(deformer) => deformer.deformed(),
         None => {
-            let mut rig = doc.rig().clone();
+            let mut rig = doc.rig().expect("a C² rig").clone();
             pipeline::Deformer::follow(&mut rig, project).expect("C² follows");
             pipeline::Deformer::deformed(&rig)
         }

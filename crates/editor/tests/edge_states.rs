@@ -113,8 +113,11 @@ fn deleting_a_handle_mid_drag_ends_the_drag() {
 #[test]
 fn undo_across_a_density_change_re_meshes_on_the_worker() {
     let mut h = editor_with(Box::new(NoDesktop), false);
-    let vertices =
-        |h: &Harness<'_, EditorApp>| h.state().document().map_or(0, |d| d.rig().stats().samples);
+    let vertices = |h: &Harness<'_, EditorApp>| {
+        h.state()
+            .document()
+            .map_or(0, |d| d.rig().expect("a C² rig").stats().samples)
+    };
     let before = vertices(&h);
     let mut settings = h.state().document().expect("a document").settings();
     // (Fine enough that a re-mesh takes the worker more than one frame.)
@@ -169,14 +172,25 @@ fn rebuilding_a_large_rig_runs_on_the_worker() {
     // Undoing a removal rebuilds with the old virtual handles: on the worker too when
     // the rig is large (treat the built-in 20k-vertex rig as large).
     h.state_mut().large_mesh = 1000;
-    let before = h.state().document().expect("doc").rig().virtual_vertices();
+    let before = h
+        .state()
+        .document()
+        .expect("doc")
+        .rig()
+        .expect("a C² rig")
+        .virtual_vertices();
     assert!(h.state_mut().edit(Edit::Remove(0)));
     h.state_mut().undo();
     assert!(h.state().is_busy());
     settle(&mut h);
     assert_eq!(handles(&h).len(), 7);
     assert_eq!(
-        h.state().document().expect("doc").rig().virtual_vertices(),
+        h.state()
+            .document()
+            .expect("doc")
+            .rig()
+            .expect("a C² rig")
+            .virtual_vertices(),
         before
     );
     h.state().sanity_check().expect("sane");
@@ -283,7 +297,10 @@ fn without_a_desktop_dialog_the_built_in_one_saves_exports_and_opens() {
 fn a_running_job_can_be_cancelled() {
     let mut h = editor_with(Box::new(NoDesktop), false);
     let before = handles(&h);
-    let vertices = h.state().document().map(|d| d.rig().stats().samples);
+    let vertices = h
+        .state()
+        .document()
+        .map(|d| d.rig().expect("a C² rig").stats().samples);
     let mut settings = h.state().document().expect("a document").settings();
     settings.density = 400_000;
     assert!(h.state_mut().edit(Edit::Settings(settings)));
@@ -295,7 +312,9 @@ fn a_running_job_can_be_cancelled() {
     assert!(!h.state().is_busy());
     h.run();
     assert_eq!(
-        h.state().document().map(|d| d.rig().stats().samples),
+        h.state()
+            .document()
+            .map(|d| d.rig().expect("a C² rig").stats().samples),
         vertices
     );
     assert_eq!(handles(&h), before);

@@ -25,7 +25,7 @@ fn the_editor_opens_on_the_built_in_picture() {
     let mut h = editor(dir.path());
     let doc = h.state().document().expect("the built-in picture");
     assert_eq!(doc.project().handles.len(), 7);
-    assert!(doc.rig().stats().samples > 10_000);
+    assert!(doc.rig().expect("a C² rig").stats().samples > 10_000);
     h.get_by_label("Select");
     h.get_by_label("Show mesh");
     // Hovering the picture shows the weights there.
@@ -265,8 +265,11 @@ fn escape_closes_the_windows_over_the_canvas() {
 fn re_meshing_runs_in_the_background_and_undoes() {
     let dir = tempfile::tempdir().expect("temp dir");
     let mut h = editor(dir.path());
-    let vertices =
-        |h: &Harness<'_, EditorApp>| h.state().document().map_or(0, |d| d.rig().stats().samples);
+    let vertices = |h: &Harness<'_, EditorApp>| {
+        h.state()
+            .document()
+            .map_or(0, |d| d.rig().expect("a C² rig").stats().samples)
+    };
     let before = vertices(&h);
     let mut settings = h.state().document().expect("a document").settings();
     settings.density = 5000;
@@ -659,13 +662,17 @@ fn a_density_the_shape_cannot_hold_says_why() {
 fn the_cut_tool_splits_the_mesh_along_a_stroke_in_one_undo_step() {
     let dir = tempfile::tempdir().expect("temp dir");
     let mut h = editor(dir.path());
-    let vertices =
-        |h: &Harness<'_, EditorApp>| h.state().document().map_or(0, |d| d.rig().stats().samples);
+    let vertices = |h: &Harness<'_, EditorApp>| {
+        h.state()
+            .document()
+            .map_or(0, |d| d.rig().expect("a C² rig").stats().samples)
+    };
     // Vertices that share their place with another: a cut's two sides.
     let doubled = |h: &Harness<'_, EditorApp>| {
         let doc = h.state().document().expect("a document");
         let mut places: Vec<(u64, u64)> = doc
             .rig()
+            .expect("a C² rig")
             .domain()
             .positions()
             .iter()

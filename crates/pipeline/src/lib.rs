@@ -535,6 +535,32 @@ fn prepare_meshed(
     })
 }
 
+/// The picture's mesh for `project` as [`prepare`] makes it, without the rig: what
+/// ARAP and MLS set up on.
+///
+/// # Errors
+/// As [`prepare`], up to the weighting.
+pub fn mesh_picture_for(image: &RgbaImage, project: &Project) -> Result<Domain> {
+    mesh_for(image, project, None, mesh_picture)
+}
+
+/// `domain` in the metric `project` asks for (its `metric`, `"auto"` by the shape's
+/// convexity), as [`prepare`] would mesh it.
+///
+/// # Errors
+/// A degenerate mesh.
+pub fn with_metric(domain: Domain, project: &Project) -> Result<Domain> {
+    let metric = metric(project.metric, domain.is_convex());
+    if metric == domain.metric() {
+        return Ok(domain);
+    }
+    Ok(Domain::new(
+        domain.positions().to_vec(),
+        domain.triangles().to_vec(),
+        metric,
+    )?)
+}
+
 /// [`prepare_meshed`]'s first half: `image` meshed by `mesher` as `project` asks (its
 /// density, the refinement around crowded handles, its cuts), in the shape's metric —
 /// the mesh every handle method sets up on.
@@ -584,7 +610,7 @@ pub(crate) fn mesh_for(
 ///
 /// # Errors
 /// As [`prepare`], past meshing.
-pub(crate) fn rig_on_domain(
+pub fn rig_on_domain(
     domain: Domain,
     project: &Project,
     progress: &(dyn Fn(weights_core::Progress) + Sync),

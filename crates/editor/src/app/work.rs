@@ -191,7 +191,7 @@ impl EditorApp {
                 is_project,
                 document: Ok(doc),
             } => {
-                let stats = doc.rig().stats();
+                let samples = doc.mesh().len();
                 let what = match (is_project, paths.len()) {
                     (true, _) => "project".to_owned(),
                     (false, 1) => "image".to_owned(),
@@ -224,7 +224,7 @@ impl EditorApp {
                 self.info(format!(
                     "opened {what} {} ({} mesh vertices){notes}",
                     named(&paths),
-                    stats.samples
+                    samples
                 ));
                 if unsolved {
                     let why = problem.unwrap_or_else(|| {
@@ -321,7 +321,7 @@ impl EditorApp {
         if let Err(e) = kept {
             self.error(&e.context("the solved cage does not fit the rebuilt picture"));
         }
-        let stats = doc.rig().stats();
+        let samples = doc.mesh().len();
         let ms = doc.last_update_ms;
         let handles = doc.project().handles.len();
         let remeshed = self
@@ -345,7 +345,7 @@ impl EditorApp {
         self.info(format!(
             "{}{what}: {} vertices, weights in {ms:.0} ms{}",
             history.unwrap_or_default(),
-            stats.samples,
+            samples,
             short.unwrap_or_default()
         ));
         self.sync_tool_after_history(was);

@@ -25,16 +25,28 @@ impl Document {
         if !self.project.virtual_handles.is_empty() {
             bail!("virtual handles belong to the rig while editing, not to the rig file");
         }
+        if self.project.method.sets_up_on_the_mesh() == self.rig().is_some() {
+            bail!(
+                "{} with{} a C² rig",
+                self.project.method.label(),
+                if self.rig().is_some() { "" } else { "out" }
+            );
+        }
+        let Some(rig) = self.rig() else {
+            // The mesh alone: what the method set up on it is checked below.
+            self.method_sanity_check()?;
+            return self.cage_sanity_check();
+        };
         let expected = pipeline::handles(&self.project);
-        if self.rig.handles() != expected.as_slice() {
+        if rig.handles() != expected.as_slice() {
             bail!(
                 "the rig's {} handles are not the rig file's {}",
-                self.rig.handles().len(),
+                rig.handles().len(),
                 expected.len()
             );
         }
-        let samples = self.rig.domain().len();
-        let nodes = self.rig.nodes();
+        let samples = rig.domain().len();
+        let nodes = rig.nodes();
         if let Some(node) = nodes.iter().find(|n| n.vertex as usize >= samples) {
             bail!("a node sits on sample {} of {samples}", node.vertex);
         }
@@ -43,7 +55,7 @@ impl Document {
         for v in (0..samples).step_by(stride) {
             let mut sum = 0.0;
             let mut any = false;
-            for (k, w) in self.rig.weights(v) {
+            for (k, w) in rig.weights(v) {
                 if k >= nodes.len() || !w.is_finite() || w < 0.0 {
                     bail!("sample {v} has weight {w} on node {k} of {}", nodes.len());
                 }
@@ -54,7 +66,7 @@ impl Document {
                 bail!("the weights of sample {v} sum to {sum}");
             }
         }
-        if let Some(v) = self.rig.deform().iter().position(|p| !p.is_finite()) {
+        if let Some(v) = rig.deform().iter().position(|p| !p.is_finite()) {
             bail!("sample {v} deforms to a non-finite point");
         }
         self.method_sanity_check()?;
@@ -71,7 +83,9 @@ impl Document {
         let Some((mesh, deformer)) = &self.method else {
             // The rig is the deformer (C²), or the cage is not solved yet.
             let ok = match method.controls() {
-                Controls::Handles => Deformer::method(&self.rig) == method,
+                Controls::Handles => self
+                    .rig()
+                    .is_some_and(|rig| Deformer::method(rig) == method),
                 Controls::Cage => self.cage_solution().is_none(),
             };
             if !ok {
@@ -183,19 +197,29 @@ impl Document {
                 a.triangles().len()
             );
         }
-        if self.rig.handles() != fresh.rig.handles() {
-            bail!("reopened, the rig has other handles");
+        match (self.rig(), fresh.rig()) {
+            (Some(rig), Some(again)) => {
+                if rig.handles() != again.handles() {
+                    bail!("reopened, the rig has other handles");
+                }
+                if rig.virtual_vertices() != again.virtual_vertices() {
+                    bail!(
+                        "reopened, the rig has {} virtual handles, not {}",
+                        again.virtual_vertices().len(),
+                        rig.virtual_vertices().len()
+                    );
+                }
+                rig.same_weights_as(again)
+                    .map_err(|e| anyhow::anyhow!("reopened, the weights differ: {e}"))?;
+            }
+            (None, None) => {
+                // The mesh alone: the virtual handles kept for C² are saved as kept.
+                if self.snapshot().virtual_handles != fresh.snapshot().virtual_handles {
+                    bail!("reopened, the virtual handles kept for C² differ");
+                }
+            }
+            _ => bail!("reopened, one has a C² rig and the other not"),
         }
-        if self.rig.virtual_vertices() != fresh.rig.virtual_vertices() {
-            bail!(
-                "reopened, the rig has {} virtual handles, not {}",
-                fresh.rig.virtual_vertices().len(),
-                self.rig.virtual_vertices().len()
-            );
-        }
-        self.rig
-            .same_weights_as(&fresh.rig)
-            .map_err(|e| anyhow::anyhow!("reopened, the weights differ: {e}"))?;
         if self.deformer().deformed() != fresh.deformer().deformed() {
             bail!(
                 "reopened, {} puts the vertices elsewhere",

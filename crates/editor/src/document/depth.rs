@@ -5,7 +5,7 @@
 
 use glam::DVec2;
 use pipeline::Deformer;
-use pipeline::order::{Arranger, as_triangles, predefined_for};
+use pipeline::order::{Arranger, as_triangles};
 use project::{HandleSpec, OverlapOrder};
 
 use super::Document;
@@ -128,11 +128,11 @@ impl Document {
         });
         let joined = part_of.is_some();
         let method = self.project.method;
-        let predefined = |rig| {
+        let predefined = || {
             if cage || joined {
                 (0..triangles.len() as u32).collect()
             } else {
-                predefined_for(&self.project, rig)
+                self.predefined_order()
             }
         };
         // The same mesh keeps its arranger (its topology, and what it remembers: a
@@ -148,7 +148,7 @@ impl Document {
                 let mut arranger = depth.arranger;
                 // (Another handle method finds each triangle's handle its own way.)
                 if depth.depths != depths || depth.method != method {
-                    arranger.set_predefined(predefined(&self.rig));
+                    arranger.set_predefined(predefined());
                 }
                 if new_depths {
                     arranger.restart(&[], deformer.rest(), triangles);
@@ -165,13 +165,13 @@ impl Document {
                 };
                 match part_of {
                     Some(part_of) => Arranger::with_parts(
-                        predefined(&self.rig),
+                        predefined(),
                         saved,
                         deformer.rest(),
                         triangles,
                         part_of,
                     ),
-                    None => Arranger::new(predefined(&self.rig), saved, deformer.rest(), triangles),
+                    None => Arranger::new(predefined(), saved, deformer.rest(), triangles),
                 }
             }
         };

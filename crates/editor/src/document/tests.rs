@@ -47,7 +47,7 @@ fn a_rejected_edit_changes_nothing() {
     assert!(doc.apply(Edit::Add(bar)).is_err(), "zero-length bar");
     assert_eq!(doc.project(), &before);
     assert_eq!(doc.weights_version, version);
-    assert_eq!(doc.rig().handles().len(), 2);
+    assert_eq!(doc.rig().expect("a C² rig").handles().len(), 2);
 }
 
 /// Handle 0 of [`document`] posed.
@@ -72,7 +72,7 @@ fn pose_edits_keep_weights_and_insertions_update_them() {
     assert_eq!(doc.weights_version, w, "a pose leaves the weights");
     // The handle's node sits on the vertex nearest its rest position and goes where
     // the handle's similarity about (10, 10) takes it.
-    let vertex = doc.rig().nodes()[0].vertex as usize;
+    let vertex = doc.rig().expect("a C² rig").nodes()[0].vertex as usize;
     let rest = doc.mesh().positions()[vertex];
     let expected = weights_core::Similarity {
         translation: DVec2::new(5.0, 0.0),
@@ -80,18 +80,18 @@ fn pose_edits_keep_weights_and_insertions_update_them() {
         scale: 1.1,
     }
     .apply(DVec2::new(10.0, 10.0), rest);
-    let at = doc.node_position(0);
+    let at = doc.node_position(0).expect("node 0");
     assert!((at - expected).length() < 1e-9, "{at} vs {expected}");
     doc.apply(Edit::Add(point(30.0, 40.0))).expect("insert");
     assert!(doc.weights_version > w);
-    assert_eq!(doc.rig().handles().len(), 3);
+    assert_eq!(doc.rig().expect("a C² rig").handles().len(), 3);
     doc.apply(Edit::ResetPose).expect("reset");
-    let at = doc.node_position(0);
+    let at = doc.node_position(0).expect("node 0");
     assert!((at - rest).length() < 1e-9);
     doc.apply(Edit::Clear).expect("clear");
     assert!(doc.project().handles.is_empty());
     assert_eq!(
-        doc.rig().stats().virtual_nodes,
+        doc.rig().expect("a C² rig").stats().virtual_nodes,
         0,
         "no virtual handles without handles"
     );
@@ -266,6 +266,7 @@ fn a_new_handle_fits_the_pose_around_it_not_one_triangle() {
     let rest = DVec2::new(32.0, 24.0);
     let reach = doc
         .rig()
+        .expect("a C² rig")
         .nodes()
         .iter()
         .map(|n| doc.mesh().positions()[n.vertex as usize].distance(rest))
@@ -273,6 +274,7 @@ fn a_new_handle_fits_the_pose_around_it_not_one_triangle() {
     // Shear the deformed picture directly (the cache the fit reads).
     let shear: Vec<DVec2> = doc
         .rig()
+        .expect("a C² rig")
         .domain()
         .positions()
         .iter()
@@ -293,7 +295,8 @@ fn unwarp_inverts_the_pose() {
     let rest = DVec2::new(20.0, 15.0);
     let now = doc
         .rig()
-        .deform_point(&doc.rig().deform(), rest)
+        .expect("a C² rig")
+        .deform_point(&doc.rig().expect("a C² rig").deform(), rest)
         .expect("inside");
     let (back, _, scale) = doc.unwarp(now).expect("on the picture");
     assert!((back - rest).length() < 1e-6, "{back} vs {rest}");
@@ -308,11 +311,11 @@ fn settings_rebuild_and_influence_partitions_unity() {
     settings.alpha = 0.5;
     settings.metric = MetricChoice::Intrinsic;
     doc.apply(Edit::Settings(settings)).expect("rebuild");
-    assert_eq!(doc.rig().options().alpha, 0.5);
+    assert_eq!(doc.rig().expect("a C² rig").options().alpha, 0.5);
     settings.placement = Placement::Symmetric;
     doc.apply(Edit::Settings(settings)).expect("rebuild");
     assert_eq!(
-        doc.rig().options().placement,
+        doc.rig().expect("a C² rig").options().placement,
         weights_core::Placement::Symmetric
     );
     assert_eq!(doc.project().placement, Placement::Symmetric);
@@ -330,16 +333,16 @@ fn settings_rebuild_and_influence_partitions_unity() {
 fn undo_to_a_snapshot_restores_the_virtual_handles() {
     let mut doc = document();
     let before = doc.snapshot();
-    let virtuals = doc.rig().virtual_vertices();
+    let virtuals = doc.rig().expect("a C² rig").virtual_vertices();
     doc.apply(Edit::Add(point(14.0, 14.0)))
         .expect("a close handle");
     assert_ne!(
-        doc.rig().virtual_vertices(),
+        doc.rig().expect("a C² rig").virtual_vertices(),
         virtuals,
         "virtual handles added"
     );
     doc.undo_to(before.clone()).expect("undo");
-    assert_eq!(doc.rig().virtual_vertices(), virtuals);
+    assert_eq!(doc.rig().expect("a C² rig").virtual_vertices(), virtuals);
     assert_eq!(doc.snapshot(), before);
 }
 
@@ -348,7 +351,7 @@ fn undo_to_a_snapshot_restores_the_virtual_handles() {
 #[test]
 fn removal_after_redo_or_reload_takes_the_virtual_handles_along() {
     let mut doc = document();
-    let before = doc.rig().virtual_vertices();
+    let before = doc.rig().expect("a C² rig").virtual_vertices();
     let undo = doc.snapshot();
     doc.apply(Edit::Add(point(14.0, 14.0)))
         .expect("a close handle");
@@ -368,7 +371,7 @@ fn removal_after_redo_or_reload_takes_the_virtual_handles_along() {
     for doc in [&mut doc, &mut reloaded] {
         doc.apply(Edit::Remove(2)).expect("remove");
         assert_eq!(
-            doc.rig().virtual_vertices(),
+            doc.rig().expect("a C² rig").virtual_vertices(),
             before,
             "the removed handle's virtual handles go with it"
         );
@@ -669,12 +672,15 @@ fn under_c2_a_pin_placed_in_a_posed_state_is_overlaid_and_moves_no_key() {
     );
     // Removing a pin of the partition in a posed state leaves its node behind as a
     // virtual handle: the same nodes, the overlaid pins renumbered.
-    let nodes = doc.rig().nodes().len();
-    let virtuals = doc.rig().stats().virtual_nodes;
+    let nodes = doc.rig().expect("a C² rig").nodes().len();
+    let virtuals = doc.rig().expect("a C² rig").stats().virtual_nodes;
     doc.apply(Edit::Remove(0)).expect("remove");
     assert_eq!(doc.project().overlaid, [2, 3]);
-    assert_eq!(doc.rig().nodes().len(), nodes);
-    assert_eq!(doc.rig().stats().virtual_nodes, virtuals + 1);
+    assert_eq!(doc.rig().expect("a C² rig").nodes().len(), nodes);
+    assert_eq!(
+        doc.rig().expect("a C² rig").stats().virtual_nodes,
+        virtuals + 1
+    );
     doc.check_reopens().expect("reopens as shown");
     // Removing the last pin of the partition lets the overlaid ones join it.
     doc.apply(Edit::Remove(0)).expect("remove");
@@ -1341,4 +1347,51 @@ fn a_bar_removed_in_a_pose_lets_its_points_follow_the_others_and_the_far_picture
     // Built afresh (the monkey's history placed other virtual handles: 9.9 px there,
     // its own points 17.8 px), within the 5 px (3.1 px).
     assert!(far <= 5.0, "far {far} px");
+}
+
+#[test]
+fn arap_and_mls_keep_the_mesh_alone_and_c2_comes_back_as_it_was_or_as_a_reopen_builds_it() {
+    let mut doc = Document::built_in().expect("the built-in picture");
+    // A handle inserted: Algorithm 1 places virtual handles for it, incrementally.
+    doc.apply(Edit::Add(point(300.0, 300.0))).expect("inserted");
+    let before = doc.rig().expect("a C² rig").clone();
+    let mesh = doc.mesh().positions().to_vec();
+    for method in [Method::Arap, Method::Mls] {
+        doc.apply(Edit::Method(method)).expect("switched");
+        assert!(doc.rig().is_none(), "{}: no C² rig", method.name());
+        assert_eq!(doc.deformer().method(), method);
+        assert_eq!(doc.mesh().positions(), mesh.as_slice());
+        doc.sanity_check().expect("sane");
+        doc.check_reopens().expect("reopens alike");
+        // Back to C²: the very rig it left.
+        doc.apply(Edit::Method(Method::C2)).expect("back");
+        let rig = doc.rig().expect("a C² rig again");
+        assert_eq!(rig.virtual_vertices(), before.virtual_vertices());
+        rig.same_weights_as(&before).expect("the same weights");
+        doc.sanity_check().expect("sane");
+    }
+    // Handles added and removed under ARAP, a handle refused off the shape: back
+    // under C², the rig a reopen of the file saved then builds.
+    doc.apply(Edit::Method(Method::Arap)).expect("switched");
+    assert!(
+        doc.apply(Edit::Add(point(5.0, 5.0))).is_err(),
+        "off the shape"
+    );
+    doc.apply(Edit::Add(point(350.0, 260.0)))
+        .expect("inserted under ARAP");
+    let last = doc.project().handles.len() - 1;
+    doc.apply(Edit::Remove(last - 1))
+        .expect("removed under ARAP");
+    doc.sanity_check().expect("sane");
+    doc.check_reopens().expect("reopens alike");
+    let saved = doc.project_for_saving(None);
+    doc.apply(Edit::Method(Method::C2)).expect("back");
+    let mut reopened = saved.clone();
+    reopened.method = Method::C2;
+    let fresh = Document::new((*doc.image).clone(), None, reopened).expect("reopens");
+    let (rig, again) = (doc.rig().expect("C²"), fresh.rig().expect("C²"));
+    assert_eq!(rig.virtual_vertices(), again.virtual_vertices());
+    rig.same_weights_as(again)
+        .expect("the weights a reopen gives");
+    doc.sanity_check().expect("sane");
 }

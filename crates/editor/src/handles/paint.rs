@@ -57,31 +57,29 @@ impl HandleTool {
 /// graph when asked for.
 fn paint_overlays(host: &dyn Host, painter: &Painter, turning: Option<usize>) {
     let Some(doc) = host.document() else { return };
-    let rig = doc.rig();
     let v = host.viewport();
     let show = host.shows();
     let selected = host.selected();
     // (Drawn as parts, each part places virtual handles of its own: the whole
     // picture's are not what warps it.)
-    let c2 = doc.method().uses_virtual_handles() && doc.parts().is_none();
-    if show.dual_graph && c2 {
+    let rig = doc
+        .rig()
+        .filter(|_| doc.method().uses_virtual_handles() && doc.parts().is_none());
+    if let Some(rig) = rig.filter(|_| show.dual_graph) {
         for &(a, b) in host.dual_graph() {
             let (a, b) = (a as usize, b as usize);
-            if a < rig.nodes().len() && b < rig.nodes().len() {
-                painter.line_segment(
-                    [
-                        v.to_screen(doc.node_position(a)),
-                        v.to_screen(doc.node_position(b)),
-                    ],
-                    Stroke::new(1.5, DUAL),
-                );
+            if let (Some(a), Some(b)) = (doc.node_position(a), doc.node_position(b)) {
+                painter.line_segment([v.to_screen(a), v.to_screen(b)], Stroke::new(1.5, DUAL));
             }
         }
+        let _ = rig;
     }
-    if show.virtual_handles && c2 {
+    if let Some(rig) = rig.filter(|_| show.virtual_handles) {
         for (k, node) in rig.nodes().iter().enumerate() {
-            if matches!(node.kind, NodeKind::Virtual) {
-                let c = v.to_screen(doc.node_position(k));
+            if matches!(node.kind, NodeKind::Virtual)
+                && let Some(at) = doc.node_position(k)
+            {
+                let c = v.to_screen(at);
                 let r = 4.5;
                 painter.add(Shape::convex_polygon(
                     vec![

@@ -52,7 +52,7 @@ impl HandleTool {
                 from.x, from.y, to.x, to.y
             ));
         }
-        let rig = doc.rig();
+        let rig = doc.rig()?;
         let mut weights: Vec<(usize, f64)> = rig.weights(vertex).collect();
         weights.sort_by(|a, b| b.1.total_cmp(&a.1));
         let mut text = format!(
@@ -85,8 +85,7 @@ impl HandleTool {
                 field(format!("{} handles", doc.project().handles.len())),
                 field(format!("parts set up in {:.1} ms", parts.setup_ms())),
             ]
-        } else {
-            let stats = doc.rig().stats();
+        } else if let Some(stats) = doc.rig().map(weights_core::Rig::stats) {
             vec![
                 field(format!("{} vertices", stats.samples)),
                 field(format!(
@@ -94,6 +93,13 @@ impl HandleTool {
                     stats.real_handles, stats.handle_nodes, stats.virtual_nodes
                 )),
                 field(format!("weights updated in {:.1} ms", doc.last_update_ms)),
+            ]
+        } else {
+            // ARAP or MLS on the mesh alone.
+            vec![
+                field(format!("{} vertices", doc.mesh().len())),
+                field(format!("{} handles", doc.project().handles.len())),
+                field(format!("updated in {:.1} ms", doc.last_update_ms)),
             ]
         };
         if let Some(times) = doc.arap().map(ArapRig::times) {
