@@ -1214,20 +1214,24 @@ impl Document {
         let remesh = new.density != old.density
             || project.cuts != self.project.cuts
             || (!same_rest && refined(&project) != refined(&self.project));
+        // The virtual handles kept for C²: `None` keeps them as they are (a pose, every
+        // drag frame).
         let virtuals = if exact {
-            saved_virtuals
+            Some(saved_virtuals)
         } else if new.density != old.density {
             // Another lattice: Algorithm 1 places them afresh when C² comes back.
-            Project::default()
-        } else {
+            Some(Project::default())
+        } else if !same_rest || matches!(self.base, Base::Rig(_)) {
             let (virtual_handles, virtual_placed_for, virtual_copy) =
                 carried_virtuals(&self.snapshot(), &project);
-            Project {
+            Some(Project {
                 virtual_handles,
                 virtual_placed_for,
                 virtual_copy,
                 ..Project::default()
-            }
+            })
+        } else {
+            None
         };
         let new_mesh = if remesh {
             Some(pipeline::mesh_picture_for(&self.image, &project)?)
@@ -1245,18 +1249,20 @@ impl Document {
             None
         };
         let method_changed = project.method != self.project.method;
-        match new_mesh {
-            Some(mesh) => {
+        match (new_mesh, &mut self.base) {
+            (Some(mesh), _) => {
+                let virtuals = virtuals.unwrap_or_else(|| virtuals_of(&self.snapshot()));
                 self.base = Base::Mesh {
                     mesh: Box::new(mesh),
                     virtuals: Box::new(virtuals),
                 }
             }
-            None => {
-                if let Base::Mesh { virtuals: kept, .. } = &mut self.base {
+            (None, Base::Mesh { virtuals: kept, .. }) => {
+                if let Some(virtuals) = virtuals {
                     **kept = virtuals;
                 }
             }
+            (None, Base::Rig(_)) => {}
         }
         if remesh {
             self.mesh_version += 1;
