@@ -26,6 +26,9 @@ pub(super) struct Depth {
     depths: Vec<i32>,
     /// The method whose predefined order it is.
     method: project::Method,
+    /// The weights version it was made at: the C² rig's cells, which the predefined
+    /// order follows, change with the handles and the weighting parameters.
+    weights: u64,
     /// The mesh's triangles (in its own order).
     triangles: Vec<[u32; 3]>,
     /// The mesh's rest positions: parts reordered join their meshes in another order,
@@ -146,8 +149,12 @@ impl Document {
         let mut arranger = match kept {
             Some(depth) => {
                 let mut arranger = depth.arranger;
-                // (Another handle method finds each triangle's handle its own way.)
-                if depth.depths != depths || depth.method != method {
+                // (Another handle method finds each triangle's handle its own way; new
+                // weights are new cells.)
+                if depth.depths != depths
+                    || depth.method != method
+                    || depth.weights != self.weights_version
+                {
                     arranger.set_predefined(predefined());
                 }
                 if new_depths {
@@ -184,6 +191,7 @@ impl Document {
             cage,
             depths,
             method,
+            weights: self.weights_version,
             mesh: (
                 triangles.as_ptr() as usize,
                 triangles.len(),

@@ -1395,3 +1395,27 @@ fn arap_and_mls_keep_the_mesh_alone_and_c2_comes_back_as_it_was_or_as_a_reopen_b
         .expect("the weights a reopen gives");
     doc.sanity_check().expect("sane");
 }
+
+#[test]
+fn new_weights_draw_the_handles_depths_by_the_new_cells_as_a_reopen_does() {
+    let mut doc = Document::built_in().expect("the built-in picture");
+    // A handle in front: the triangles of its C² cell are drawn after the others.
+    let deeper = doc.project().handles[4].with_depth(1);
+    doc.apply(Edit::Pose(4, deeper)).expect("a depth");
+    doc.arrange_deferred();
+    let order_before = doc.draw_order();
+    // Other weights on the same mesh: other cells, so another order.
+    let mut settings = doc.settings();
+    settings.metric = MetricChoice::Euclidean;
+    doc.apply(Edit::Settings(settings)).expect("rebuilt");
+    // (A large mesh is arranged on the frame after an edit.)
+    doc.arrange_deferred();
+    let fresh =
+        Document::new((*doc.image).clone(), None, doc.project_for_saving(None)).expect("reopens");
+    assert_ne!(fresh.draw_order(), order_before, "the cells moved");
+    assert!(
+        doc.draw_order() == fresh.draw_order(),
+        "drawn as a reopen draws it"
+    );
+    doc.check_reopens().expect("reopens alike");
+}
