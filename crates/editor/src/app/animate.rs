@@ -481,7 +481,8 @@ impl EditorApp {
 
     /// The timeline's part of [`EditorApp::sanity_check`]: a finite time, and with keys
     /// the pose shown is theirs at that time whenever nothing previews another (no
-    /// playback between frames, take, drag, perform tool or job).
+    /// playback between frames, take, drag of handles or cage vertices, perform tool or
+    /// job).
     pub(crate) fn timeline_sanity_check(&self, doc: &Document) -> Result<()> {
         let time = self.timeline.time;
         if !(time.is_finite() && time >= 0.0) {
@@ -491,6 +492,7 @@ impl EditorApp {
             || self.timeline.is_taking()
             || self.timeline.key_drag.is_some()
             || self.handles.dragging()
+            || self.cage.gesture_under_way()
             || self.perform.dragging()
             || self.tool == Tool::Perform
             || self.is_busy();
