@@ -228,6 +228,17 @@ impl Base {
     }
 }
 
+/// What going from the rig file to another changes, as far as the work it takes goes.
+struct Change {
+    /// Every handle keeps its kind and rest geometry (a pose, at most).
+    same_rest: bool,
+    /// A handle's depth changed (another drawing order).
+    depths: bool,
+    /// The picture is meshed anew: another density, other cuts, or handles that crowd
+    /// together otherwise.
+    remesh: bool,
+}
+
 /// `project`'s virtual handles alone (its `virtual_*` fields).
 fn virtuals_of(project: &Project) -> Project {
     Project {
@@ -1082,30 +1093,10 @@ impl Document {
         let old = self.settings();
         let new = Settings::of(&project);
         let handles = pipeline::handles(&project);
-        let same_rest = project.handles.len() == self.project.handles.len()
-            && project.overlaid == self.project.overlaid
-            && project
-                .handles
-                .iter()
-                .zip(&self.project.handles)
-                .all(|(a, b)| same_rest(a, b));
-        let depths_changed = project.handles.iter().map(HandleSpec::depth).ne(self
-            .project
-            .handles
-            .iter()
-            .map(HandleSpec::depth));
-        // Handles that crowd together refine the mesh around them (the C² paper's
-        // up-sampling): another set of crowded handles is another mesh.
-        let (w, h) = self.image.dimensions();
-        let refined =
-            |p: &Project| pipeline::crowding::refinement(p, w, h, Settings::of(p).density);
-        // (A function of the handles' rest places and the density: a pose, every drag
-        // frame, leaves it as it is.)
-        let refinement_changed = (!same_rest || new.density != old.density)
-            && refined(&project) != refined(&self.project);
-        // A cut splits the mesh along it.
-        let cuts_changed = project.cuts != self.project.cuts;
-        if new.density != old.density || refinement_changed || cuts_changed {
+        let change = self.change_to(&project);
+        let same_rest = change.same_rest && project.overlaid == self.project.overlaid;
+        let depths_changed = change.depths;
+        if change.remesh {
             let mut with_virtuals = project.clone();
             if exact {
                 with_virtuals.virtual_handles = saved_virtuals.virtual_handles;
@@ -1183,6 +1174,38 @@ impl Document {
         Ok(())
     }
 
+    /// How `project` differs from the rig file in what decides the work of going to
+    /// it (see [`Change`]).
+    fn change_to(&self, project: &Project) -> Change {
+        let same_rest = project.handles.len() == self.project.handles.len()
+            && project
+                .handles
+                .iter()
+                .zip(&self.project.handles)
+                .all(|(a, b)| same_rest(a, b));
+        let depths = project.handles.iter().map(HandleSpec::depth).ne(self
+            .project
+            .handles
+            .iter()
+            .map(HandleSpec::depth));
+        // Handles that crowd together refine the mesh around them (the C² paper's
+        // up-sampling): another set of crowded handles is another mesh. (A function of
+        // the handles' rest places and the density: a pose, every drag frame, leaves it
+        // as it is.) A cut splits the mesh along it.
+        let (w, h) = self.image.dimensions();
+        let refined =
+            |p: &Project| pipeline::crowding::refinement(p, w, h, Settings::of(p).density);
+        let density = Settings::of(project).density != self.settings().density;
+        let remesh = density
+            || project.cuts != self.project.cuts
+            || (!same_rest && refined(project) != refined(&self.project));
+        Change {
+            same_rest,
+            depths,
+            remesh,
+        }
+    }
+
     /// [`Document::restore_with`] under a method that sets up on the mesh alone (ARAP,
     /// MLS): the mesh anew where the density, the crowding of handles or the cuts ask
     /// for another (the rule [`pipeline::prepare`] meshes by), the handles checked as
@@ -1197,23 +1220,11 @@ impl Document {
     ) -> Result<()> {
         let clock = Instant::now();
         let (old, new) = (self.settings(), Settings::of(&project));
-        let same_rest = project.handles.len() == self.project.handles.len()
-            && project
-                .handles
-                .iter()
-                .zip(&self.project.handles)
-                .all(|(a, b)| same_rest(a, b));
-        let depths_changed = project.handles.iter().map(HandleSpec::depth).ne(self
-            .project
-            .handles
-            .iter()
-            .map(HandleSpec::depth));
-        let (w, h) = self.image.dimensions();
-        let refined =
-            |p: &Project| pipeline::crowding::refinement(p, w, h, Settings::of(p).density);
-        let remesh = new.density != old.density
-            || project.cuts != self.project.cuts
-            || (!same_rest && refined(&project) != refined(&self.project));
+        let Change {
+            same_rest,
+            depths: depths_changed,
+            remesh,
+        } = self.change_to(&project);
         // The virtual handles kept for C²: `None` keeps them as they are (a pose, every
         // drag frame).
         let virtuals = if exact {
