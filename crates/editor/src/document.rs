@@ -185,6 +185,10 @@ pub struct Document {
     /// Whether a live pose was left unarranged (a large mesh): the drag's end
     /// arranges it.
     depth_deferred: bool,
+    /// The parts set up for an edit being made, when working that out set them up
+    /// already (a pin placed on a part that followed another): taken when the
+    /// deformer is brought in line with the edit.
+    primed: Option<Box<PartsDeformer>>,
 }
 
 /// The picture's mesh, and C²'s weights of it where they are used.
@@ -328,6 +332,7 @@ impl Document {
             order_version: 1,
             live: false,
             depth_deferred: false,
+            primed: None,
         }
         .with_method()
     }
@@ -366,6 +371,13 @@ impl Document {
                     return Ok(());
                 }
                 previous = deformer.as_any().downcast_ref::<PartsDeformer>();
+            }
+            // Set up already where a pin placed made parts carry a shape.
+            if let Some(mut primed) = self.primed.take()
+                && primed.follow(&self.project)? == Follow::Followed
+            {
+                self.method = Some((self.mesh_version, primed));
+                return Ok(());
             }
             // The parts whose own setup is the same are kept (a pin added sets up the
             // parts it binds).
@@ -659,6 +671,7 @@ impl Document {
     /// What the rig rejects: a handle off the shape, coincident handles, a zero-length
     /// bar, non-finite values, a missing handle; or a re-mesh that fails.
     pub fn apply(&mut self, edit: Edit) -> Result<()> {
+        self.primed = None;
         let mut project = self.project.clone();
         match edit {
             Edit::Add(handle) => self.push_handle(&mut project, handle, None)?,
@@ -682,6 +695,7 @@ impl Document {
                     .any(|i| i != index && !project.overlaid.contains(&i));
                 let posed = project.is_posed();
                 project.remove_handle(index);
+                self.drop_shapes_of_unbound(&mut project)?;
                 if !overlaid && posed && partition_left {
                     // In a posed state a handle of the partition leaves its nodes
                     // behind as virtual handles: the cells and weights stay as they
@@ -712,9 +726,13 @@ impl Document {
                 for h in &mut project.handles {
                     *h = h.at_rest();
                 }
-                // At rest, nothing is held away from it; without keys, every handle
-                // joins the paper's weights again.
+                // At rest, nothing is held away from it, and no part carries a shape
+                // from following; without keys, every handle joins the paper's weights
+                // again.
                 project.holds.clear();
+                if let Some(spec) = &mut project.parts {
+                    spec.carried.clear();
+                }
                 if project
                     .animation
                     .as_ref()
@@ -836,7 +854,35 @@ impl Document {
         if let Some(layers) = self.layers.as_ref().filter(|_| project.parts.is_some()) {
             pipeline::parts::bindings(layers, &project)?;
         }
+        self.drop_shapes_of_unbound(&mut project)?;
         self.restore(project)
+    }
+
+    /// Drops the shapes carried by parts that no handle binds any more (a part shown
+    /// that follows again; a hidden part keeps its shape for when it is shown).
+    fn drop_shapes_of_unbound(&self, project: &mut Project) -> Result<()> {
+        let Some(layers) = self.layers.as_deref() else {
+            return Ok(());
+        };
+        if project.parts.as_ref().is_none_or(|p| p.carried.is_empty()) {
+            return Ok(());
+        }
+        let bindings = pipeline::parts::bindings(layers, project)?;
+        if let Some(spec) = &mut project.parts {
+            let bound = |k: usize| bindings.get(k).is_some_and(|b| !b.is_empty());
+            let shown = |k: usize| {
+                layers
+                    .layers
+                    .get(k)
+                    .is_some_and(|l| spec.shows(k, l.visible))
+            };
+            let kept = (spec.carried.iter())
+                .filter(|c| bound(c.part) || !shown(c.part))
+                .cloned()
+                .collect();
+            spec.carried = kept;
+        }
+        Ok(())
     }
 
     /// Appends `handle` to `project` (the document's, being edited) with what goes with
@@ -876,6 +922,13 @@ impl Document {
             _ => self.deformer().holds(project, index),
         };
         project.holds.extend(holds);
+        // A part it binds that followed another until now keeps the shape following
+        // gave it; the parts set up for it are posed from when the edit is made.
+        self.primed = match (self.parts(), self.layers.as_deref()) {
+            (Some(parts), Some(layers)) => parts.carry(layers, project, index, None)?,
+            _ => None,
+        }
+        .map(Box::new);
         Ok(())
     }
 

@@ -27,10 +27,11 @@ use std::sync::Arc;
 
 use anyhow::{Context, Result, bail};
 use glam::{DVec2, Vec2};
-use project::{Canvas, Controls, HandleSpec, Hold, Project};
+use project::{Canvas, CarriedShape, Controls, HandleSpec, Hold, Project};
 use render::Picture;
 use weights_core::{Domain, Metric};
 
+use crate::carried::Carried;
 use crate::deformer::{Deformer, Follow, Method, Output, WeightsListing, json, median, quantile};
 use crate::{DEFAULT_DENSITY, Frame, Listener, Warper, blank, placed, prepare_part_warper};
 
@@ -201,6 +202,9 @@ struct Bound {
     own: Project,
     /// What its mesh was made from: a setup that asks for the same mesh keeps it.
     mesh: MeshKey,
+    /// The shape it carries from following another part, if it does
+    /// ([`crate::carried`]).
+    carried: Option<Carried>,
 }
 
 /// What a part's mesh depends on: the rectangle of the canvas it is meshed on (its
@@ -240,11 +244,35 @@ impl Bound {
             .collect()
     }
 
-    /// Where the warp takes them, on the canvas.
+    /// Where the warp takes them, on the canvas (with the shape the part carries).
     fn deformed(&self) -> Vec<DVec2> {
+        let mut moved = self.placed();
+        if let Some(carried) = &self.carried {
+            let triangles = self.warper.deformer.triangles();
+            carried.apply(self.warper.deformer.rest(), triangles, &mut moved);
+        }
+        moved
+    }
+
+    /// Where its method alone takes them, on the canvas.
+    fn placed(&self) -> Vec<DVec2> {
         let mut moved = self.warper.deformer.deformed();
         moved.iter_mut().for_each(|p| *p += self.origin);
         moved
+    }
+
+    /// This part carrying the shape `record` (none: carrying none), on its mesh.
+    ///
+    /// # Errors
+    /// A record whose triangles are not a mesh.
+    fn carrying(self: Arc<Self>, record: Option<&CarriedShape>) -> Result<Arc<Self>> {
+        if self.carried.as_ref().map(|c| &c.record) == record {
+            return Ok(self);
+        }
+        let carried = record.map(|r| Carried::on(r, &self.rest())).transpose()?;
+        let mut bound = Arc::unwrap_or_clone(self);
+        bound.carried = carried;
+        Ok(Arc::new(bound))
     }
 
     /// Follows `project` (canvas pixels), this part's own.
@@ -376,9 +404,14 @@ impl PartRig {
                 }
                 _ => None,
             });
+            // The shape it carries from following, if it does.
+            let carried = spec.carried.iter().find(|c| c.part == k);
+            let carrying = |b: Arc<Bound>| {
+                (b.carrying(carried)).with_context(|| format!("part \"{}\"", layer.name))
+            };
             if let Some(b) = same {
                 kept[k] = true;
-                parts.push(Part::Bound(b));
+                parts.push(Part::Bound(carrying(b)?));
                 continue;
             }
             let probes: Vec<DVec2> = bound
@@ -412,13 +445,14 @@ impl PartRig {
                 None => prepare_part_warper(&picture, &placed, density, listener),
             }
             .with_context(|| format!("part \"{}\"", layer.name))?;
-            parts.push(Part::Bound(Arc::new(Bound {
+            parts.push(Part::Bound(carrying(Arc::new(Bound {
                 warper,
                 origin,
                 density,
                 own: part,
                 mesh,
-            })));
+                carried: None,
+            }))?));
         }
         // The parts no handle binds follow the bound part beneath them (in the draw
         // order) they overlap most.
@@ -516,6 +550,75 @@ impl PartRig {
             }
         }
         Ok(holds)
+    }
+
+    /// What handle `index` of `project` (just placed, in the pose shown, on `artwork`
+    /// these parts were set up on, with what it holds already in `project`) makes the
+    /// parts carry: each part it binds that followed another until now keeps the shape
+    /// following gave it ([`crate::carried`]), so that it does not jump to what its own
+    /// method gives it. Returns the shapes (none when the pin binds no follower) and
+    /// the parts set up for `project` with them, to be posed from.
+    ///
+    /// # Errors
+    /// As [`PartRig::update`].
+    pub fn carry(
+        &self,
+        artwork: &layers::Artwork,
+        project: &Project,
+        index: usize,
+        density: Option<usize>,
+    ) -> Result<Option<(Vec<CarriedShape>, Self)>> {
+        let followers: Vec<usize> = (bindings(artwork, project)?.iter().enumerate())
+            .filter(|(k, bound)| {
+                bound.contains(&index)
+                    && matches!(
+                        self.parts.get(*k),
+                        Some(Part::Follows {
+                            leader: Some(_),
+                            ..
+                        })
+                    )
+            })
+            .map(|(k, _)| k)
+            .collect();
+        if followers.is_empty() || !project.is_posed() {
+            return Ok(None);
+        }
+        let mut rig = self.update(artwork, project, density, &())?;
+        let mut shapes = Vec::new();
+        for k in followers {
+            let (Part::Follows { mesh, .. }, Part::Bound(bound)) = (&self.parts[k], &rig.parts[k])
+            else {
+                continue;
+            };
+            // Where following showed each vertex of the part's new mesh.
+            let followed =
+                Domain::new(mesh.rest.clone(), mesh.triangles.clone(), Metric::Euclidean)
+                    .map_err(|e| anyhow::anyhow!("part {k}: {e}"))?;
+            let rest = bound.rest();
+            let shown: Vec<DVec2> = (rest.iter())
+                .map(|&p| match followed.locate(p) {
+                    Some((t, b)) => {
+                        let [i, j, l] = followed.triangles()[t].map(|v| v as usize);
+                        mesh.deformed[i] * b[0] + mesh.deformed[j] * b[1] + mesh.deformed[l] * b[2]
+                    }
+                    None => followed
+                        .nearest_vertex(p)
+                        .map_or(p, |v| p + mesh.deformed[v as usize] - mesh.rest[v as usize]),
+                })
+                .collect();
+            let triangles = bound.warper.deformer.triangles();
+            let record = Carried::record(k, &rest, triangles, &bound.placed(), &shown);
+            if (record.offset.iter()).all(|d| DVec2::from(*d).length() < 1e-9) {
+                // Following left it where its method puts it (at rest): nothing to carry.
+                continue;
+            }
+            let carrying = Arc::clone(bound).carrying(Some(&record))?;
+            rig.parts[k] = Part::Bound(carrying);
+            shapes.push(record);
+        }
+        rig.move_followers();
+        Ok(Some((shapes, rig)))
     }
 
     /// Poses every part as `project` (the rig file set up, in another pose) has it.
@@ -1046,6 +1149,33 @@ impl PartsDeformer {
             self.joined.triangles = triangles;
         }
         Ok(())
+    }
+
+    /// [`PartRig::carry`] for these parts: the shapes that handle `index` of
+    /// `project` (just placed in the pose shown, with what it holds) makes the parts
+    /// it binds carry are added to `project`'s parts, and the parts set up for it
+    /// returned; `None` (`project` untouched) where it binds no part that follows
+    /// another.
+    ///
+    /// # Errors
+    /// As [`PartsDeformer::update`].
+    pub fn carry(
+        &self,
+        artwork: &layers::Artwork,
+        project: &mut Project,
+        index: usize,
+        density: Option<usize>,
+    ) -> Result<Option<Self>> {
+        let Some((shapes, rig)) = self.rig.carry(artwork, project, index, density)? else {
+            return Ok(None);
+        };
+        if let Some(spec) = &mut project.parts {
+            spec.carried
+                .retain(|c| shapes.iter().all(|s| s.part != c.part));
+            spec.carried.extend(shapes);
+            spec.carried.sort_by_key(|c| c.part);
+        }
+        Self::with_rig(artwork, project, |_| Ok(rig), &()).map(Some)
     }
 
     /// The packed texture and where the joined mesh samples it.

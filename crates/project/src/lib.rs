@@ -661,7 +661,35 @@ pub struct PartsSpec {
     /// `bindings`). What already binds a locked part keeps moving it.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub locked: Vec<usize>,
+    /// The shapes parts carry from following another part (see [`CarriedShape`]),
+    /// one a part at most.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub carried: Vec<CarriedShape>,
 }
+
+/// The shape a part carries from the time it followed another: a part that no handle
+/// bound follows the part beneath it, and when a pin first binds it in a posed state it
+/// keeps the shape following gave it instead of jumping to what its own method gives
+/// it. The shape is an offset of each of its mesh's vertices from where its own method
+/// put that vertex then, in the method's local frame there (the closest similarity to
+/// the warp around the vertex, its rotation and scale undone), so that it turns and
+/// scales with the part as the part's handles move it. Between the vertices listed
+/// (the part's own mesh then), the offset is interpolated linearly over `triangles`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CarriedShape {
+    /// The part (its layer's index).
+    pub part: usize,
+    /// The vertices' rest positions, image pixels.
+    pub rest: Vec<[f64; 2]>,
+    /// Each vertex's offset, in pixels of the local frame.
+    pub offset: Vec<[f64; 2]>,
+    /// The mesh's triangles (indices into `rest`), over which offsets are interpolated.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// The most vertices a [`CarriedShape`] may list.
+pub const MAX_CARRIED_POINTS: usize = 1_000_000;
 
 /// A handle bound to chosen parts only (`{"handle": 3, "parts": [2]}`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -742,6 +770,12 @@ impl PartsSpec {
                 ));
             }
         }
+        if let Some((i, c)) = (self.carried.iter().enumerate()).find(|(_, c)| c.part >= layers) {
+            return bad(format!(
+                "parts.carried[{i}] is layer {}'s; the picture has {layers}",
+                c.part
+            ));
+        }
         Ok(())
     }
 
@@ -808,6 +842,61 @@ impl PartsSpec {
                      {MAX_PARTS}, ascending, each once"
                 ));
             }
+        }
+        if self.carried.len() > MAX_PARTS {
+            return bad(format!(
+                "parts.carried has {} shapes; at most one a part",
+                self.carried.len()
+            ));
+        }
+        for (i, c) in self.carried.iter().enumerate() {
+            c.validate()
+                .map_err(|m| ProjectError::Invalid(format!("parts.carried[{i}]: {m}")))?;
+            if self.carried[..i].iter().any(|o| o.part == c.part) {
+                return bad(format!(
+                    "parts.carried[{i}]: layer {} carries two shapes",
+                    c.part
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+impl CarriedShape {
+    /// Checks the lists: the same length for `rest` and `offset`, triangles of three
+    /// distinct listed vertices, finite coordinates within bounds.
+    fn validate(&self) -> Result<(), String> {
+        let n = self.rest.len();
+        if self.part >= MAX_PARTS {
+            return Err(format!("part must be a layer's index, below {MAX_PARTS}"));
+        }
+        if self.offset.len() != n || n > MAX_CARRIED_POINTS {
+            return Err(format!(
+                "rest and offset must list the same vertices (at most {MAX_CARRIED_POINTS}), \
+                 got {n} and {}",
+                self.offset.len()
+            ));
+        }
+        if self.triangles.is_empty() || self.triangles.len() > 3 * MAX_CARRIED_POINTS {
+            return Err(format!(
+                "triangles must list at least one and at most {} triangles",
+                3 * MAX_CARRIED_POINTS
+            ));
+        }
+        if let Some(t) = self.triangles.iter().find(|t| {
+            t.iter().any(|&v| v as usize >= n) || t[0] == t[1] || t[1] == t[2] || t[0] == t[2]
+        }) {
+            return Err(format!(
+                "triangle {t:?} must name three distinct vertices of the {n} listed"
+            ));
+        }
+        if (self.rest.iter().chain(&self.offset).flatten())
+            .any(|x| !x.is_finite() || x.abs() > MAX_POSE)
+        {
+            return Err(format!(
+                "coordinates must be finite numbers within ±{MAX_POSE:e} pixels"
+            ));
         }
         Ok(())
     }

@@ -957,6 +957,152 @@ fn under_arap_a_pin_placed_in_a_pose_on_parts_holds_its_own_parts_too() {
     assert!(own.iter().all(|&d| d <= 0.01), "{own:?}");
 }
 
+/// The sample character drawn as parts under `method`, its front leg's pins removed
+/// (so the leg follows the body) and the body's hip bar turned by 0.5 rad: the
+/// document, the leg's and the body's layer indices.
+fn puppet_with_a_follower(dir: &Path, method: Method) -> (Document, usize, usize) {
+    let mut doc = puppet(dir);
+    doc.apply(Edit::Parts(Some(project::PartsSpec::default())))
+        .expect("parts");
+    if method != doc.project().method {
+        doc.apply(Edit::Method(method)).expect("method");
+    }
+    let layer = |doc: &Document, name: &str| {
+        (doc.layers.as_ref().expect("layers").layers.iter())
+            .position(|l| l.name == name)
+            .expect("the sample's layer")
+    };
+    let (leg, body) = (layer(&doc, "leg (front)"), layer(&doc, "body"));
+    for h in (0..doc.project().handles.len()).rev() {
+        if bound_to(&doc, h).contains(&leg) {
+            doc.apply(Edit::Remove(h)).expect("removed");
+        }
+    }
+    let set = doc.parts().expect("parts").rig().set();
+    assert_eq!(set.followed[leg], Some(body), "the leg follows the body");
+    let bar = (doc.project().handles.iter())
+        .position(|h| matches!(h, HandleSpec::Bar { .. }))
+        .expect("the hip bar");
+    let HandleSpec::Bar { rest, depth, .. } = doc.project().handles[bar].clone() else {
+        unreachable!("a bar");
+    };
+    let (top, end) = (DVec2::from(rest[0]), DVec2::from(rest[1]));
+    let turned = top + DVec2::from_angle(0.5).rotate(end - top);
+    doc.apply(Edit::Pose(
+        bar,
+        HandleSpec::Bar {
+            rest,
+            pose: Some([rest[0], turned.to_array()]),
+            depth,
+        },
+    ))
+    .expect("the hips swung");
+    (doc, leg, body)
+}
+
+/// Each vertex of `doc`'s parts where it is shown, by its part and rest position.
+fn shown_by_part(doc: &Document) -> std::collections::HashMap<(u32, [u64; 2]), DVec2> {
+    let parts = doc.parts().expect("parts");
+    let (rest, moved) = (parts.rest(), parts.deformed());
+    (0..rest.len() as u32)
+        .filter_map(|v| {
+            let part = parts.part_of_vertex(v)?;
+            let at = rest[v as usize];
+            Some(((part, [at.x.to_bits(), at.y.to_bits()]), moved[v as usize]))
+        })
+        .collect()
+}
+
+#[test]
+fn a_pin_placed_in_a_pose_on_a_part_that_follows_moves_nothing() {
+    for method in [Method::C2, Method::Arap, Method::Mls] {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let (mut doc, leg, body) = puppet_with_a_follower(dir.path(), method);
+        let before = shown_by_part(&doc);
+        // The knee, where following shows it.
+        let knee = DVec2::new(272.0, 575.0);
+        let parts = doc.parts().expect("parts");
+        let (rest, moved) = (parts.rest(), parts.deformed());
+        let v = (0..rest.len())
+            .filter(|&v| parts.part_of_vertex(v as u32) == Some(leg as u32))
+            .min_by(|&a, &b| rest[a].distance(knee).total_cmp(&rest[b].distance(knee)))
+            .expect("the leg's vertices");
+        let at = moved[v];
+        assert!(at.distance(rest[v]) > 20.0, "the knee followed the hips");
+        let (rest, angle, scale) = doc.unwarp(at).expect("on the leg");
+        doc.apply(Edit::Add(HandleSpec::Point {
+            rest: rest.to_array(),
+            translate: (at - rest).to_array(),
+            rotate: angle,
+            scale,
+            depth: 0,
+        }))
+        .expect("pinned");
+        let pin = doc.project().handles.len() - 1;
+        assert_eq!(bound_to(&doc, pin), [leg], "{method:?}");
+        let carried = (doc.project().parts.as_ref()).map(|p| p.carried.clone());
+        assert!(
+            carried.is_some_and(|c| c.len() == 1 && c[0].part == leg),
+            "{method:?}: the leg carries its followed shape"
+        );
+        // Nothing moved, on the leg or elsewhere.
+        let after = shown_by_part(&doc);
+        let mut worst: f64 = 0.0;
+        for (key, p) in &after {
+            if let Some(q) = before.get(key) {
+                worst = worst.max(p.distance(*q));
+            }
+        }
+        let on_leg = |k: &&(u32, [u64; 2])| k.0 == leg as u32;
+        let leg_kept = (after.keys().filter(on_leg)).filter(|k| before.contains_key(k));
+        assert!(
+            leg_kept.count() == before.keys().filter(on_leg).count()
+                && after.keys().all(|k| before.contains_key(k)),
+            "{method:?}: every vertex kept, the leg's too"
+        );
+        assert!(worst < 1e-6, "{method:?}: a vertex moved {worst} px");
+        doc.check_reopens().expect("reopens with the carried shape");
+        // The pin drags the leg, which keeps its shape as it goes.
+        let HandleSpec::Point { translate, .. } = doc.project().handles[pin] else {
+            unreachable!("a point");
+        };
+        let dragged = HandleSpec::Point {
+            rest: rest.to_array(),
+            translate: [translate[0] + 20.0, translate[1] + 10.0],
+            rotate: angle,
+            scale,
+            depth: 0,
+        };
+        doc.apply(Edit::Pose(pin, dragged)).expect("dragged");
+        let moved = shown_by_part(&doc);
+        let near = (after.keys())
+            .filter(|k| {
+                k.0 == leg as u32
+                    && DVec2::from_array(k.1.map(f64::from_bits)).distance(rest) < 10.0
+            })
+            .map(|k| moved[k].distance(after[k] + DVec2::new(20.0, 10.0)))
+            .fold(0.0f64, f64::max);
+        assert!(
+            near < 2.0,
+            "{method:?}: around the pin the leg went with it ({near} px off)"
+        );
+        let body_still = (after.keys())
+            .filter(|k| k.0 == body as u32)
+            .all(|k| moved[k] == after[k]);
+        assert!(body_still, "{method:?}: the body stays");
+        doc.check_reopens().expect("reopens dragged");
+        // Removed, the leg follows again and carries nothing.
+        doc.apply(Edit::Remove(pin)).expect("removed");
+        assert!(
+            (doc.project().parts.as_ref()).is_some_and(|p| p.carried.is_empty()),
+            "{method:?}"
+        );
+        let set = doc.parts().expect("parts").rig().set();
+        assert_eq!(set.followed[leg], Some(body));
+        doc.check_reopens().expect("reopens following");
+    }
+}
+
 #[test]
 fn a_pin_placed_beside_another_on_parts_refines_that_part_as_a_reopen_does() {
     let dir = tempfile::tempdir().expect("temp dir");
