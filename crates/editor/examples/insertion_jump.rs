@@ -10,7 +10,8 @@
 //! cell too: the figure the paper's insertion is measured by).
 //!
 //! `cargo run --release -p editor --example insertion_jump -- [c2|arap|mls] [lizard|giraffe|spider] [INSERTIONS]`
-//! (`HOLDS=off`: ARAP's new pins hold nothing, as before they did)
+//! (`HOLDS=off`: ARAP's new pins hold nothing, as before they did; `SOLVER=two-step`:
+//! ARAP's two steps alone)
 
 use glam::DVec2;
 use project::{HandleSpec, Method, Project};
@@ -363,6 +364,15 @@ fn main() -> anyhow::Result<()> {
     let insertions: usize = args.get(2).and_then(|n| n.parse().ok()).unwrap_or(24);
     let mut doc = document(picture)?;
     doc.apply(Edit::Method(method))?;
+    if std::env::var("SOLVER").is_ok_and(|v| v == "two-step") {
+        // ARAP's two steps alone (the paper's).
+        let mut project = doc.project().clone();
+        project.arap = Some(project::ArapSettings {
+            solver: Some(project::ArapSolver::TwoStep),
+            ..project.arap.unwrap_or_default()
+        });
+        doc.restore(project)?;
+    }
     let (points, bars) = insertion_jumps(&mut doc, insertions);
     let removals = removal_jumps(&mut doc);
     let c2 = method == Method::C2;

@@ -188,7 +188,7 @@ pub struct Document {
     /// The parts set up for an edit being made, when working that out set them up
     /// already (a pin placed on a part that followed another): taken when the
     /// deformer is brought in line with the edit.
-    primed: Option<Box<PartsDeformer>>,
+    primed: Option<Box<dyn Deformer>>,
 }
 
 /// The picture's mesh, and C²'s weights of it where they are used.
@@ -241,6 +241,14 @@ struct Change {
     /// The picture is meshed anew: another density, other cuts, or handles that crowd
     /// together otherwise.
     remesh: bool,
+}
+
+/// A handle's rest geometry as a segment (a point's: of no length).
+fn rest_segment(handle: &HandleSpec) -> [DVec2; 2] {
+    match *handle {
+        HandleSpec::Point { rest, .. } => [DVec2::from(rest); 2],
+        HandleSpec::Bar { rest, .. } => rest.map(DVec2::from),
+    }
 }
 
 /// `project`'s virtual handles alone (its `virtual_*` fields).
@@ -359,6 +367,14 @@ impl Document {
         if self.project.method.controls() == Controls::Cage {
             return self.sync_cage();
         }
+        // Set up already where working out an edit did (a shape carried).
+        if let Some(mut primed) = self.primed.take()
+            && primed.method() == self.project.method
+            && primed.follow(&self.project)? == Follow::Followed
+        {
+            self.method = Some((self.mesh_version, primed));
+            return Ok(());
+        }
         if let Some(layers) = self.layers.clone().filter(|_| self.project.parts.is_some()) {
             // Drawn as parts: each part set up by the method with its own handles,
             // the parts joined into the mesh shown.
@@ -371,13 +387,6 @@ impl Document {
                     return Ok(());
                 }
                 previous = deformer.as_any().downcast_ref::<PartsDeformer>();
-            }
-            // Set up already where a pin placed made parts carry a shape.
-            if let Some(mut primed) = self.primed.take()
-                && primed.follow(&self.project)? == Follow::Followed
-            {
-                self.method = Some((self.mesh_version, primed));
-                return Ok(());
             }
             // The parts whose own setup is the same are kept (a pin added sets up the
             // parts it binds).
@@ -694,8 +703,16 @@ impl Document {
                 let partition_left = (0..project.handles.len())
                     .any(|i| i != index && !project.overlaid.contains(&i));
                 let posed = project.is_posed();
+                let removed = project.handles[index].clone();
                 project.remove_handle(index);
                 self.drop_shapes_of_unbound(&mut project)?;
+                if posed {
+                    // Under ARAP and MLS, what it moved relaxes and the picture away
+                    // from it stays where it was.
+                    let others: Vec<_> = project.handles.iter().map(rest_segment).collect();
+                    let away = pipeline::carried::away_from(rest_segment(&removed), &others);
+                    self.carry_shape(&mut project, &away)?;
+                }
                 if !overlaid && posed && partition_left {
                     // In a posed state a handle of the partition leaves its nodes
                     // behind as virtual handles: the cells and weights stay as they
@@ -730,9 +747,7 @@ impl Document {
                 // from following; without keys, every handle joins the paper's weights
                 // again.
                 project.holds.clear();
-                if let Some(spec) = &mut project.parts {
-                    spec.carried.clear();
-                }
+                project.carried.clear();
                 if project
                     .animation
                     .as_ref()
@@ -750,7 +765,13 @@ impl Document {
                     method.name().to_uppercase()
                 )
             }
-            Edit::Method(method) => project.method = method,
+            Edit::Method(method) => {
+                if method != project.method {
+                    // The picture's shape is carried on its method's warp.
+                    project.carried.retain(|c| c.part.is_some());
+                }
+                project.method = method;
+            }
             Edit::Rigidity(strokes) => {
                 // New paint on a locked part is refused; erasing (what is left of
                 // strokes already there) is not.
@@ -830,6 +851,7 @@ impl Document {
                 // before: the parts' mesh is another.
                 if parts.is_some() != project.parts.is_some() {
                     project.overlaps.clear();
+                    project.carried.clear();
                 }
                 project.parts = parts;
                 project
@@ -864,24 +886,21 @@ impl Document {
         let Some(layers) = self.layers.as_deref() else {
             return Ok(());
         };
-        if project.parts.as_ref().is_none_or(|p| p.carried.is_empty()) {
+        let Some(spec) = project.parts.clone() else {
+            return Ok(());
+        };
+        if project.carried.iter().all(|c| c.part.is_none()) {
             return Ok(());
         }
         let bindings = pipeline::parts::bindings(layers, project)?;
-        if let Some(spec) = &mut project.parts {
-            let bound = |k: usize| bindings.get(k).is_some_and(|b| !b.is_empty());
-            let shown = |k: usize| {
-                layers
-                    .layers
-                    .get(k)
-                    .is_some_and(|l| spec.shows(k, l.visible))
-            };
-            let kept = (spec.carried.iter())
-                .filter(|c| bound(c.part) || !shown(c.part))
-                .cloned()
-                .collect();
-            spec.carried = kept;
-        }
+        let bound = |k: usize| bindings.get(k).is_some_and(|b| !b.is_empty());
+        let shown = |k: usize| {
+            layers
+                .layers
+                .get(k)
+                .is_some_and(|l| spec.shows(k, l.visible))
+        };
+        (project.carried).retain(|c| c.part.is_none_or(|k| bound(k) || !shown(k)));
         Ok(())
     }
 
@@ -928,7 +947,59 @@ impl Document {
             (Some(parts), Some(layers)) => parts.carry(layers, project, index, None)?,
             _ => None,
         }
-        .map(Box::new);
+        .map(|parts| Box::new(parts) as Box<dyn Deformer>);
+        if posed && project.method == Method::Mls {
+            // MLS cannot hold the picture where it is (a new handle is a new term in
+            // every point's fit): the picture carries what it would lose.
+            self.carry_shape(project, &|_| 1.0)?;
+        }
+        Ok(())
+    }
+
+    /// Under ARAP and MLS on one picture in a posed state, the shape that keeps the
+    /// picture shown where `keep` says (1: where it is, 0: where the method now puts
+    /// it) once `project` (the edit being made) is followed: written to `project`'s
+    /// `carried`. Where the edit meshes the picture anew (handles crowding together),
+    /// the new mesh is shown where the old one showed the picture; otherwise the
+    /// method that followed the edit is kept, to be taken when the edit is made.
+    fn carry_shape(&mut self, project: &mut Project, keep: &dyn Fn(DVec2) -> f64) -> Result<()> {
+        if self.parts().is_some()
+            || !project.method.sets_up_on_the_mesh()
+            || project.method != self.project.method
+        {
+            return Ok(());
+        }
+        let Some((_, method)) = &self.method else {
+            return Ok(());
+        };
+        let shown = method.deformed();
+        let mut without = project.clone();
+        without.carried.retain(|c| c.part.is_some());
+        let remesh = self.change_to(project).remesh;
+        let (trial, before) = if remesh {
+            // Meshed anew (as restoring the edit will mesh it): set up there.
+            let mesh = pipeline::mesh_picture_for(&self.image, &without)?;
+            let before = pipeline::carried::resample(self.mesh(), &shown, mesh.positions());
+            let Some(trial) = pipeline::on_mesh(&without, &mesh, Some(&self.image))? else {
+                return Ok(());
+            };
+            (trial, before)
+        } else {
+            let mut trial = method.clone_box();
+            if trial.follow(&without)? == Follow::NeedsSetup {
+                return Ok(());
+            }
+            (trial, shown)
+        };
+        let old = pipeline::carried::picture_shape(&self.project);
+        let shape = pipeline::carried::keep(trial.as_ref(), &before, old, keep)?;
+        project.carried = without.carried;
+        project.carried.extend(shape);
+        project.carried.sort_by_key(|c| c.part);
+        if !remesh {
+            // The method as the edit leaves it, on the same mesh.
+            self.primed = Some(trial);
+        }
         Ok(())
     }
 

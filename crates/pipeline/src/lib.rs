@@ -5,7 +5,7 @@ pub mod animate;
 pub mod arap;
 mod c2;
 pub mod cage;
-mod carried;
+pub mod carried;
 pub mod crowding;
 pub mod deformer;
 pub mod method;

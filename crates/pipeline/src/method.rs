@@ -29,6 +29,7 @@ use weights_core::Domain;
 use crate::Warper;
 use crate::arap::ArapRig;
 use crate::cage::CageDeformer;
+use crate::carried::Carrying;
 pub use crate::deformer::{
     Backdrop, Deformer, Follow, Listener, Output, SkinTable, Skinning, SolveProgress, Source,
     WeightsListing,
@@ -78,10 +79,12 @@ pub fn on_mesh(
     domain: &Domain,
     picture: Option<&RgbaImage>,
 ) -> Result<Option<Box<dyn Deformer>>> {
-    Ok(match project.method {
-        Method::C2 => None,
-        Method::Arap => Some(Box::new(ArapRig::on_mesh(project, domain, picture)?)),
-        Method::Mls => Some(Box::new(MlsRig::on_mesh(project, domain)?)),
+    let method: Box<dyn Deformer> = match project.method {
+        Method::C2 => return Ok(None),
+        Method::Arap => Box::new(ArapRig::on_mesh(project, domain, picture)?),
+        Method::Mls => Box::new(MlsRig::on_mesh(project, domain)?),
         Method::Lbc => bail!("LBC warps by a cage, not by handles"),
-    })
+    };
+    // Drawn with the shape the picture carries, if it carries one.
+    Ok(Some(Box::new(Carrying::new(method, project)?)))
 }

@@ -265,8 +265,8 @@ impl Bound {
     ///
     /// # Errors
     /// A record whose triangles are not a mesh.
-    fn carrying(self: Arc<Self>, record: Option<&CarriedShape>) -> Result<Arc<Self>> {
-        if self.carried.as_ref().map(|c| &c.record) == record {
+    fn carrying(self: Arc<Self>, record: Option<&Arc<CarriedShape>>) -> Result<Arc<Self>> {
+        if crate::carried::same_shape(self.carried.as_ref(), record) {
             return Ok(self);
         }
         let carried = record.map(|r| Carried::on(r, &self.rest())).transpose()?;
@@ -405,7 +405,7 @@ impl PartRig {
                 _ => None,
             });
             // The shape it carries from following, if it does.
-            let carried = spec.carried.iter().find(|c| c.part == k);
+            let carried = project.carried.iter().find(|c| c.part == Some(k));
             let carrying = |b: Arc<Bound>| {
                 (b.carrying(carried)).with_context(|| format!("part \"{}\"", layer.name))
             };
@@ -567,7 +567,7 @@ impl PartRig {
         project: &Project,
         index: usize,
         density: Option<usize>,
-    ) -> Result<Option<(Vec<CarriedShape>, Self)>> {
+    ) -> Result<Option<(Vec<Arc<CarriedShape>>, Self)>> {
         let followers: Vec<usize> = (bindings(artwork, project)?.iter().enumerate())
             .filter(|(k, bound)| {
                 bound.contains(&index)
@@ -608,11 +608,12 @@ impl PartRig {
                 })
                 .collect();
             let triangles = bound.warper.deformer.triangles();
-            let record = Carried::record(k, &rest, triangles, &bound.placed(), &shown);
+            let record = Carried::record(Some(k), &rest, triangles, &bound.placed(), &shown);
             if (record.offset.iter()).all(|d| DVec2::from(*d).length() < 1e-9) {
                 // Following left it where its method puts it (at rest): nothing to carry.
                 continue;
             }
+            let record = Arc::new(record);
             let carrying = Arc::clone(bound).carrying(Some(&record))?;
             rig.parts[k] = Part::Bound(carrying);
             shapes.push(record);
@@ -1032,9 +1033,10 @@ pub struct PartsDeformer {
     joined: Joined,
     /// The layers' names, for what is listed by part.
     names: Vec<String>,
-    /// What the parts were set up for: the method, the parts' spec and each handle's
-    /// rest, so that [`Deformer::follow`] tells a pose from a new setup.
-    setup: (Method, Option<project::PartsSpec>, Vec<HandleSpec>),
+    /// What the parts were set up for: the method, the parts' spec, each handle's
+    /// rest and the shapes the parts carry, so that [`Deformer::follow`] tells a pose
+    /// from a new setup.
+    setup: Setup,
     /// How long setting the parts up took, ms.
     setup_ms: f64,
 }
@@ -1169,12 +1171,9 @@ impl PartsDeformer {
         let Some((shapes, rig)) = self.rig.carry(artwork, project, index, density)? else {
             return Ok(None);
         };
-        if let Some(spec) = &mut project.parts {
-            spec.carried
-                .retain(|c| shapes.iter().all(|s| s.part != c.part));
-            spec.carried.extend(shapes);
-            spec.carried.sort_by_key(|c| c.part);
-        }
+        (project.carried).retain(|c| shapes.iter().all(|s| s.part != c.part));
+        project.carried.extend(shapes);
+        project.carried.sort_by_key(|c| c.part);
         Self::with_rig(artwork, project, |_| Ok(rig), &()).map(Some)
     }
 
@@ -1231,16 +1230,29 @@ fn same_but_poses(a: &Project, b: &Project) -> bool {
 }
 
 /// What a part setup depends on beyond the pose: the method, the parts' spec, the
-/// handles at rest.
-fn setup_of(project: &Project) -> (Method, Option<project::PartsSpec>, Vec<HandleSpec>) {
+/// handles at rest, the shapes the parts carry.
+fn setup_of(project: &Project) -> Setup {
     let at_rest = project.handles.iter().map(HandleSpec::at_rest);
     // (Locking a part changes what new handles bind, not what moves the parts.)
     let spec = (project.parts.clone()).map(|spec| project::PartsSpec {
         locked: Vec::new(),
         ..spec
     });
-    (project.method, spec, at_rest.collect())
+    (
+        project.method,
+        spec,
+        at_rest.collect(),
+        project.carried.clone(),
+    )
 }
+
+/// [`setup_of`]'s answer.
+type Setup = (
+    Method,
+    Option<project::PartsSpec>,
+    Vec<HandleSpec>,
+    Vec<Arc<CarriedShape>>,
+);
 
 impl Deformer for PartsDeformer {
     fn method(&self) -> Method {
@@ -1804,8 +1816,10 @@ fn part_project(project: &Project, layer: usize, bound: &[usize]) -> Project {
     // The saved overlap orders name places on the parts drawn together
     // ([`composite`]), not on one part's own mesh.
     part.overlaps.clear();
-    // A part is one picture: the parts' order, visibility and bindings are the whole's.
+    // A part is one picture: the parts' order, visibility and bindings are the whole's,
+    // and the shape it carries is drawn over its method's warp (`Bound::carried`).
     part.parts = None;
+    part.carried.clear();
     // A cage kept while handles move the parts is the whole canvas's (a cage moves
     // the parts through `PartRig::caged`, not through a part's own rig file).
     part.cage = None;

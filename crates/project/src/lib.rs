@@ -21,6 +21,8 @@ use serde::{Deserialize, Serialize};
 mod names;
 pub mod animation;
 
+use std::sync::Arc;
+
 pub use animation::{Animation, HandlePose, Interpolation, Key, Pose, SpatialKey};
 
 /// The largest pose coordinate (pixels) or rotation (radians) a handle may have (the
@@ -613,6 +615,10 @@ pub struct Project {
     /// was when it was placed, so that placing it moved nothing. See [`Hold`].
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub holds: Vec<Hold>,
+    /// The shapes the picture or its parts carry (see [`CarriedShape`]), one each at
+    /// most.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub carried: Vec<Arc<CarriedShape>>,
     /// Handles placed in a posed state (indices into `handles`, ascending), which the
     /// C² weights lay over the weights they were placed on instead of re-partitioning
     /// the shape, so that placing one moves nothing away from it.
@@ -661,31 +667,32 @@ pub struct PartsSpec {
     /// `bindings`). What already binds a locked part keeps moving it.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub locked: Vec<usize>,
-    /// The shapes parts carry from following another part (see [`CarriedShape`]),
-    /// one a part at most.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub carried: Vec<CarriedShape>,
 }
 
-/// The shape a part carries from the time it followed another: a part that no handle
-/// bound follows the part beneath it, and when a pin first binds it in a posed state it
-/// keeps the shape following gave it instead of jumping to what its own method gives
-/// it. The shape is an offset of each of its mesh's vertices from where its own method
-/// put that vertex then, in the method's local frame there (the closest similarity to
-/// the warp around the vertex, its rotation and scale undone), so that it turns and
-/// scales with the part as the part's handles move it. Between the vertices listed
-/// (the part's own mesh then), the offset is interpolated linearly over `triangles`.
+/// A shape the picture (or a part of it) carries, kept so that an edit in a posed
+/// state moves nothing: an offset of each of its mesh's vertices from where its
+/// method puts it, in the method's local frame there (the closest similarity to the
+/// warp around the vertex, its rotation and scale undone), so that it turns and
+/// scales with the picture as the handles move it. The vertices are listed by their
+/// rest positions (the mesh it was made on, which a file meshes again alike); on
+/// another mesh, a vertex between them takes the offset interpolated linearly over
+/// their Delaunay triangles, and one off them its nearest listed vertex's. Offsets are
+/// kept to 10⁻⁷ px.
+///
+/// Drawn as parts, a part that followed another keeps the shape following gave it
+/// when a pin first binds it in a pose. On one picture, under ARAP and MLS, a handle
+/// removed in a pose leaves the picture away from it where it was, and under MLS a
+/// handle placed in a pose moves nothing.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CarriedShape {
-    /// The part (its layer's index).
-    pub part: usize,
+    /// Drawn as parts: the part (its layer's index); `None`: the picture as one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub part: Option<usize>,
     /// The vertices' rest positions, image pixels.
     pub rest: Vec<[f64; 2]>,
     /// Each vertex's offset, in pixels of the local frame.
     pub offset: Vec<[f64; 2]>,
-    /// The mesh's triangles (indices into `rest`), over which offsets are interpolated.
-    pub triangles: Vec<[u32; 3]>,
 }
 
 /// The most vertices a [`CarriedShape`] may list.
@@ -770,12 +777,6 @@ impl PartsSpec {
                 ));
             }
         }
-        if let Some((i, c)) = (self.carried.iter().enumerate()).find(|(_, c)| c.part >= layers) {
-            return bad(format!(
-                "parts.carried[{i}] is layer {}'s; the picture has {layers}",
-                c.part
-            ));
-        }
         Ok(())
     }
 
@@ -843,32 +844,16 @@ impl PartsSpec {
                 ));
             }
         }
-        if self.carried.len() > MAX_PARTS {
-            return bad(format!(
-                "parts.carried has {} shapes; at most one a part",
-                self.carried.len()
-            ));
-        }
-        for (i, c) in self.carried.iter().enumerate() {
-            c.validate()
-                .map_err(|m| ProjectError::Invalid(format!("parts.carried[{i}]: {m}")))?;
-            if self.carried[..i].iter().any(|o| o.part == c.part) {
-                return bad(format!(
-                    "parts.carried[{i}]: layer {} carries two shapes",
-                    c.part
-                ));
-            }
-        }
         Ok(())
     }
 }
 
 impl CarriedShape {
-    /// Checks the lists: the same length for `rest` and `offset`, triangles of three
-    /// distinct listed vertices, finite coordinates within bounds.
+    /// Checks the lists: the same length for `rest` and `offset`, finite coordinates
+    /// within bounds.
     fn validate(&self) -> Result<(), String> {
         let n = self.rest.len();
-        if self.part >= MAX_PARTS {
+        if self.part.is_some_and(|k| k >= MAX_PARTS) {
             return Err(format!("part must be a layer's index, below {MAX_PARTS}"));
         }
         if self.offset.len() != n || n > MAX_CARRIED_POINTS {
@@ -876,19 +861,6 @@ impl CarriedShape {
                 "rest and offset must list the same vertices (at most {MAX_CARRIED_POINTS}), \
                  got {n} and {}",
                 self.offset.len()
-            ));
-        }
-        if self.triangles.is_empty() || self.triangles.len() > 3 * MAX_CARRIED_POINTS {
-            return Err(format!(
-                "triangles must list at least one and at most {} triangles",
-                3 * MAX_CARRIED_POINTS
-            ));
-        }
-        if let Some(t) = self.triangles.iter().find(|t| {
-            t.iter().any(|&v| v as usize >= n) || t[0] == t[1] || t[1] == t[2] || t[0] == t[2]
-        }) {
-            return Err(format!(
-                "triangle {t:?} must name three distinct vertices of the {n} listed"
             ));
         }
         if (self.rest.iter().chain(&self.offset).flatten())
@@ -899,6 +871,65 @@ impl CarriedShape {
             ));
         }
         Ok(())
+    }
+}
+
+/// `value` as indented JSON (two spaces a level), with each list of numbers, and each
+/// list of such lists, on one line (`[320.0, 200.0]`): a point reads as one, and the
+/// long lists of points (a carried shape's) take a line each rather than a line a
+/// number.
+fn write_json(value: &serde_json::Value, depth: usize, out: &mut String) {
+    use serde_json::Value;
+    let numbers = |v: &Value| v.as_array().is_some_and(|a| a.iter().all(Value::is_number));
+    let indent = |depth: usize, out: &mut String| out.extend(std::iter::repeat_n("  ", depth));
+    match value {
+        Value::Array(items) if items.is_empty() => out.push_str("[]"),
+        Value::Array(items) if items.iter().all(|v| v.is_number() || numbers(v)) => {
+            out.push('[');
+            for (i, item) in items.iter().enumerate() {
+                if i > 0 {
+                    out.push_str(", ");
+                }
+                match item {
+                    Value::Array(inner) => {
+                        out.push('[');
+                        for (j, x) in inner.iter().enumerate() {
+                            if j > 0 {
+                                out.push_str(", ");
+                            }
+                            out.push_str(&x.to_string());
+                        }
+                        out.push(']');
+                    }
+                    x => out.push_str(&x.to_string()),
+                }
+            }
+            out.push(']');
+        }
+        Value::Array(items) => {
+            out.push_str("[\n");
+            for (i, item) in items.iter().enumerate() {
+                indent(depth + 1, out);
+                write_json(item, depth + 1, out);
+                out.push_str(if i + 1 < items.len() { ",\n" } else { "\n" });
+            }
+            indent(depth, out);
+            out.push(']');
+        }
+        Value::Object(fields) if fields.is_empty() => out.push_str("{}"),
+        Value::Object(fields) => {
+            out.push_str("{\n");
+            for (i, (key, item)) in fields.iter().enumerate() {
+                indent(depth + 1, out);
+                out.push_str(&Value::String(key.clone()).to_string());
+                out.push_str(": ");
+                write_json(item, depth + 1, out);
+                out.push_str(if i + 1 < fields.len() { ",\n" } else { "\n" });
+            }
+            indent(depth, out);
+            out.push('}');
+        }
+        scalar => out.push_str(&scalar.to_string()),
     }
 }
 
@@ -1013,6 +1044,7 @@ impl Default for Project {
             canvas: Canvas::Keep,
             animation: None,
             holds: Vec::new(),
+            carried: Vec::new(),
             overlaid: Vec::new(),
             cuts: Vec::new(),
             auto_depth: true,
@@ -1205,7 +1237,10 @@ impl Project {
 
     /// The project as pretty-printed JSON (numbers round-trip exactly).
     pub fn to_json(&self) -> String {
-        let mut s = serde_json::to_string_pretty(self).unwrap_or_default();
+        let mut s = String::new();
+        if let Ok(value) = serde_json::to_value(self) {
+            write_json(&value, 0, &mut s);
+        }
         s.push('\n');
         s
     }
@@ -1360,6 +1395,19 @@ impl Project {
             {
                 return bad(format!(
                     "holds[{i}]: coordinates must be finite numbers within ±{MAX_POSE:e} pixels"
+                ));
+            }
+        }
+        for (i, c) in self.carried.iter().enumerate() {
+            c.validate()
+                .map_err(|m| ProjectError::Invalid(format!("carried[{i}]: {m}")))?;
+            if self.carried[..i].iter().any(|o| o.part == c.part) {
+                return bad(format!(
+                    "carried[{i}]: {} carries two shapes",
+                    match c.part {
+                        Some(k) => format!("layer {k}"),
+                        None => "the picture".to_owned(),
+                    }
                 ));
             }
         }
@@ -2029,16 +2077,63 @@ mod tests {
         };
         let text = copies.to_json();
         assert_eq!(Project::from_json(&text).expect("parses"), copies);
-        let short = text.replace(
-            "\"virtual_copy\": [\n    0,\n    1\n  ]",
-            "\"virtual_copy\": [1]",
-        );
+        let short = text.replace("\"virtual_copy\": [0, 1]", "\"virtual_copy\": [1]");
         assert_ne!(short, text);
         let err = Project::from_json(&short).expect_err("one entry for two");
         assert!(
             err.to_string().contains("virtual_copy has 1 entries"),
             "{err}"
         );
+    }
+
+    #[test]
+    fn a_rig_file_writes_each_point_on_one_line_and_reads_back_the_same() {
+        let text = r#"{"version":1,"handles":[{"type":"point","rest":[1,2.5],"translate":[3,4]},
+          {"type":"bar","rest":[[1,2],[30,40]]}],
+          "carried":[{"rest":[[1,2],[3,4]],"offset":[[0.1234567,-2],[0,0]]},
+                     {"part":2,"rest":[[5,6]],"offset":[[1,1]]}]}"#;
+        let project = Project::from_json(text).expect("a rig file");
+        let written = project.to_json();
+        assert!(written.contains(r#""rest": [1.0, 2.5],"#), "{written}");
+        assert!(
+            written.contains(r#""rest": [[1.0, 2.0], [30.0, 40.0]]"#),
+            "{written}"
+        );
+        assert!(written.contains(r#""offset": [[0.1234567, -2.0], [0.0, 0.0]]"#));
+        assert!(written.contains("\n  \"handles\": [\n    {\n"), "{written}");
+        assert_eq!(Project::from_json(&written).expect("reads back"), project);
+    }
+
+    #[test]
+    fn carried_shapes_are_checked() {
+        let with = |carried: &str| {
+            Project::from_json(&format!(
+                r#"{{"version":1,"handles":[{{"type":"point","rest":[1,2]}}],"carried":{carried}}}"#
+            ))
+        };
+        for (carried, says) in [
+            (r#"[{"rest":[[1,2]],"offset":[]}]"#, "the same vertices"),
+            (
+                r#"[{"rest":[[1,2]],"offset":[[1e300,0]]}]"#,
+                "finite numbers",
+            ),
+            (
+                r#"[{"rest":[[1,2]],"offset":[[0,0]]},{"rest":[[1,2]],"offset":[[0,0]]}]"#,
+                "the picture carries two shapes",
+            ),
+            (
+                r#"[{"part":1000,"rest":[[1,2]],"offset":[[0,0]]}]"#,
+                "below 1000",
+            ),
+            (
+                r#"[{"rest":[[1,2]],"offset":[[0,0]],"triangles":[]}]"#,
+                "unknown field",
+            ),
+        ] {
+            let error = with(carried).expect_err(carried);
+            assert!(error.to_string().contains(says), "{carried}: {error}");
+        }
+        assert!(with(r#"[{"part":1,"rest":[[1,2]],"offset":[[0,0]]}]"#).is_ok());
     }
 
     #[test]

@@ -1040,9 +1040,9 @@ fn a_pin_placed_in_a_pose_on_a_part_that_follows_moves_nothing() {
         .expect("pinned");
         let pin = doc.project().handles.len() - 1;
         assert_eq!(bound_to(&doc, pin), [leg], "{method:?}");
-        let carried = (doc.project().parts.as_ref()).map(|p| p.carried.clone());
+        let carried = &doc.project().carried;
         assert!(
-            carried.is_some_and(|c| c.len() == 1 && c[0].part == leg),
+            carried.len() == 1 && carried[0].part == Some(leg),
             "{method:?}: the leg carries its followed shape"
         );
         // Nothing moved, on the leg or elsewhere.
@@ -1093,10 +1093,7 @@ fn a_pin_placed_in_a_pose_on_a_part_that_follows_moves_nothing() {
         doc.check_reopens().expect("reopens dragged");
         // Removed, the leg follows again and carries nothing.
         doc.apply(Edit::Remove(pin)).expect("removed");
-        assert!(
-            (doc.project().parts.as_ref()).is_some_and(|p| p.carried.is_empty()),
-            "{method:?}"
-        );
+        assert!(doc.project().carried.is_empty(), "{method:?}");
         let set = doc.parts().expect("parts").rig().set();
         assert_eq!(set.followed[leg], Some(body));
         doc.check_reopens().expect("reopens following");
@@ -1564,4 +1561,186 @@ fn new_weights_draw_the_handles_depths_by_the_new_cells_as_a_reopen_does() {
         "drawn as a reopen draws it"
     );
     doc.check_reopens().expect("reopens alike");
+}
+
+/// The built-in picture at 3,000 vertices under `method`, its sample rig's point
+/// handles dragged 40–150 px (the bar at rest).
+fn built_in_posed(method: Method) -> Document {
+    let image = render::decode_image(pipeline::DEFAULT_IMAGE, &render::ImageLimits::default())
+        .expect("the built-in picture");
+    let mut project = Project::from_json(pipeline::DEFAULT_RIG).expect("its rig");
+    project.density = Some(3_000);
+    project.method = method;
+    let moves = [
+        [40.0, -20.0],
+        [0.0; 2],
+        [-20.0, -60.0],
+        [-20.0, 40.0],
+        [60.0, 30.0],
+        [-90.0, -150.0],
+    ];
+    for (h, t) in project.handles.iter_mut().zip(moves) {
+        if let HandleSpec::Point { translate, .. } = h {
+            *translate = t;
+        }
+    }
+    Document::new(image, None, project).expect("opens")
+}
+
+#[test]
+fn under_arap_and_mls_a_handle_removed_in_a_pose_lets_go_near_it_and_nothing_away() {
+    for method in [Method::Arap, Method::Mls] {
+        let mut doc = built_in_posed(method);
+        let rest = doc.mesh().positions().to_vec();
+        let edge = doc.mesh().mean_edge_length();
+        let count = doc.project().handles.len();
+        let (mut relaxed, mut removals) = (0, 0);
+        for i in 0..count {
+            let snapshot = doc.snapshot();
+            let shown = doc.deformed().to_vec();
+            let removed = rest_segment(&doc.project().handles[i]);
+            let next = (doc.project().handles.iter().enumerate())
+                .filter(|&(j, _)| j != i)
+                .map(|(_, h)| geometry::segment_distance(removed, rest_segment(h)))
+                .fold(f64::INFINITY, f64::min);
+            doc.apply(Edit::Remove(i)).expect("removed");
+            removals += 1;
+            let after = doc.deformed().to_vec();
+            let (mut far, mut own) = (0.0f64, 0.0f64);
+            for ((a, b), p) in shown.iter().zip(&after).zip(&rest) {
+                let from = geometry::point_segment_distance(*p, removed[0], removed[1]);
+                if from >= 2.0 * next {
+                    far = far.max(a.distance(*b));
+                } else if from <= edge {
+                    own = own.max(a.distance(*b));
+                }
+            }
+            assert!(far < 1e-6, "{method:?}, handle {i}: {far} px away from it");
+            relaxed += usize::from(own > 1.0);
+            doc.check_reopens().expect("reopens as shown");
+            doc.undo_to(snapshot).expect("undone");
+            let back = doc.deformed().to_vec();
+            let off = (shown.iter().zip(&back))
+                .map(|(a, b)| a.distance(*b))
+                .fold(0.0f64, f64::max);
+            assert!(off < 1e-6, "{method:?}, handle {i}: undone, {off} px off");
+        }
+        // What a removed handle was moving lets go (the bar, at rest, held nothing).
+        assert!(
+            relaxed + 1 >= removals,
+            "{method:?}: {relaxed} of {removals}"
+        );
+        // Removed twice in a row: the shape carried is carried on.
+        let shown = doc.deformed().to_vec();
+        doc.apply(Edit::Remove(0)).expect("removed");
+        doc.apply(Edit::Remove(0)).expect("removed again");
+        assert!(doc.project().carried.len() == 1 && doc.project().carried[0].part.is_none());
+        doc.check_reopens().expect("reopens as shown");
+        // Another method, or the pose reset, drops the shape.
+        let mut other = doc.clone();
+        other.apply(Edit::Method(Method::C2)).expect("C²");
+        assert!(other.project().carried.is_empty());
+        doc.apply(Edit::ResetPose).expect("reset");
+        assert!(doc.project().carried.is_empty());
+        let rest_now = doc.mesh().positions().to_vec();
+        let off = (rest_now.iter().zip(doc.deformed()))
+            .map(|(a, b)| a.distance(*b))
+            .fold(0.0f64, f64::max);
+        assert!(off < 1e-6, "{method:?}: at rest after a reset ({off} px)");
+        assert!(shown.len() == rest_now.len());
+    }
+}
+
+#[test]
+fn under_mls_a_pin_placed_in_a_pose_moves_nothing() {
+    let mut doc = built_in_posed(Method::Mls);
+    // Three places on the picture shown, away from the handles.
+    let rest = doc.mesh().positions().to_vec();
+    let handles: Vec<[DVec2; 2]> = doc.project().handles.iter().map(rest_segment).collect();
+    let clear = |v: usize| {
+        (handles.iter()).all(|h| geometry::point_segment_distance(rest[v], h[0], h[1]) > 40.0)
+    };
+    let picks: Vec<usize> = (1..=3)
+        .filter_map(|k| (k * rest.len() / 4..rest.len()).find(|&v| clear(v)))
+        .collect();
+    assert_eq!(picks.len(), 3);
+    for (i, v) in picks.into_iter().enumerate() {
+        let before = doc.deformed().to_vec();
+        let at = before[v];
+        let (rest, _, _) = doc.unwarp(at).expect("on the picture");
+        let (rotate, scale) = doc.local_pose(rest, at);
+        doc.apply(Edit::Add(HandleSpec::Point {
+            rest: rest.to_array(),
+            translate: (at - rest).to_array(),
+            rotate,
+            scale,
+            depth: 0,
+        }))
+        .expect("insert");
+        let jump = (before.iter().zip(doc.deformed()))
+            .map(|(a, b)| a.distance(*b))
+            .fold(0.0, f64::max);
+        assert!(jump < 1e-6, "insertion {i}: the picture moved by {jump} px");
+        doc.check_reopens().expect("reopens as shown");
+    }
+    // Beside another handle, the picture is meshed anew around the pair: it shows
+    // what the old mesh showed there.
+    let HandleSpec::Point {
+        rest, translate, ..
+    } = doc.project().handles[0]
+    else {
+        unreachable!("the sample rig's first handle is a point");
+    };
+    let at = DVec2::from(rest) + DVec2::from(translate) + DVec2::new(1.0, 0.0);
+    let (rest_at, rotate, scale) = doc.unwarp(at).expect("on the picture");
+    let vertices = doc.mesh().len();
+    let before = doc.deformed().to_vec();
+    let old_rest = doc.mesh().clone();
+    doc.apply(Edit::Add(HandleSpec::Point {
+        rest: rest_at.to_array(),
+        translate: (at - rest_at).to_array(),
+        rotate,
+        scale,
+        depth: 0,
+    }))
+    .expect("beside another");
+    assert!(doc.mesh().len() > vertices, "meshed anew around the pair");
+    let shown_before = pipeline::carried::resample(&old_rest, &before, doc.mesh().positions());
+    let jump = (shown_before.iter().zip(doc.deformed()))
+        .map(|(a, b)| a.distance(*b))
+        .fold(0.0, f64::max);
+    assert!(
+        jump < 1e-6,
+        "beside another: the picture moved by {jump} px"
+    );
+    doc.check_reopens().expect("reopens as shown");
+    // The new pin moves what is around it.
+    let last = doc.project().handles.len() - 1;
+    let HandleSpec::Point {
+        rest,
+        translate,
+        rotate,
+        scale,
+        depth,
+    } = doc.project().handles[last]
+    else {
+        unreachable!("a point");
+    };
+    let before = doc.deformed().to_vec();
+    doc.apply(Edit::Pose(
+        last,
+        HandleSpec::Point {
+            rest,
+            translate: [translate[0] + 10.0, translate[1]],
+            rotate,
+            scale,
+            depth,
+        },
+    ))
+    .expect("dragged");
+    let moved = (before.iter().zip(doc.deformed()))
+        .map(|(a, b)| a.distance(*b))
+        .fold(0.0, f64::max);
+    assert!(moved > 5.0, "{moved}");
+    doc.check_reopens().expect("reopens dragged");
 }
