@@ -999,7 +999,7 @@ fn walk(seed: u64, actions: usize) {
     );
     println!(
         "  with two keys or more: {keyed} actions (at most {most_keys} keys); with pose \
-         markers: {marked}; pins placed in a pose under ARAP or C², none moving the picture: {held}; handles removed in a pose under C², checked: \
+         markers: {marked}; pins placed in a pose, none moving the picture: {held}; handles removed in a pose, checked: \
          {removed_checked}; with cuts: {with_cuts}; with parts: {with_parts}"
     );
     slowest.sort_by(|a, b| b.0.total_cmp(&a.0));
