@@ -17,6 +17,7 @@ use anyhow::{Context, Result, bail};
 use glam::DVec2;
 use image::RgbaImage;
 use pipeline::cage::CageCoordinates;
+use pipeline::carried::Keep;
 use pipeline::{ArapRig, Controls, Deformer, Follow, Method, PartsDeformer};
 use project::{
     CageSpec, HandleSpec, LbcSettings, MetricChoice, Middle, Placement, Project, RigidityStroke,
@@ -707,11 +708,13 @@ impl Document {
                 project.remove_handle(index);
                 self.drop_shapes_of_unbound(&mut project)?;
                 if posed {
-                    // Under ARAP and MLS, what it moved relaxes and the picture away
-                    // from it stays where it was.
+                    // What it moved relaxes and the picture away from it stays where
+                    // it was: under ARAP and MLS on one picture, and on each part it
+                    // bound under every method.
                     let others: Vec<_> = project.handles.iter().map(rest_segment).collect();
                     let away = pipeline::carried::away_from(rest_segment(&removed), &others);
                     self.carry_shape(&mut project, &away)?;
+                    self.keep_parts(&mut project, index, &removed)?;
                 }
                 if !overlaid && posed && partition_left {
                     // In a posed state a handle of the partition leaves its nodes
@@ -942,16 +945,65 @@ impl Document {
         };
         project.holds.extend(holds);
         // A part it binds that followed another until now keeps the shape following
-        // gave it; the parts set up for it are posed from when the edit is made.
-        self.primed = match (self.parts(), self.layers.as_deref()) {
-            (Some(parts), Some(layers)) => parts.carry(layers, project, index, None)?,
-            _ => None,
+        // gave it, and under MLS every part it binds keeps the shape it has; the parts
+        // set up for it are posed from when the edit is made.
+        if let (Some(parts), Some(layers)) = (self.parts(), self.layers.as_deref()) {
+            let all = |_: DVec2| 1.0;
+            let rig = parts.rig();
+            let targets: Vec<(usize, &Keep)> = (pipeline::parts::bindings(layers, project)?
+                .iter()
+                .enumerate())
+            .filter(|(k, bound)| {
+                bound.contains(&index)
+                    && (rig.followed().get(*k).is_some_and(Option::is_some)
+                        || (project.method == Method::Mls && rig.bound(*k).is_some()))
+            })
+            .map(|(k, _)| (k, &all as &Keep))
+            .collect();
+            self.primed = parts
+                .keep(layers, project, &targets, None)?
+                .map(|parts| Box::new(parts) as Box<dyn Deformer>);
         }
-        .map(|parts| Box::new(parts) as Box<dyn Deformer>);
         if posed && project.method == Method::Mls {
             // MLS cannot hold the picture where it is (a new handle is a new term in
             // every point's fit): the picture carries what it would lose.
             self.carry_shape(project, &|_| 1.0)?;
+        }
+        Ok(())
+    }
+
+    /// Drawn as parts in a posed state, with handle `index` (`removed`) just taken out
+    /// of `project`: each part it bound that other handles still bind keeps the shape
+    /// it has away from it (beyond twice its distance to the nearest handle binding
+    /// the part), and lets go near it; the shapes are written to `project`'s
+    /// `carried`, the parts set up for it kept to be taken when the edit is made.
+    fn keep_parts(
+        &mut self,
+        project: &mut Project,
+        index: usize,
+        removed: &HandleSpec,
+    ) -> Result<()> {
+        let (Some(parts), Some(layers)) = (self.parts(), self.layers.as_deref()) else {
+            return Ok(());
+        };
+        let after = pipeline::parts::bindings(layers, project)?;
+        let aways: Vec<(usize, Box<Keep>)> = (parts.rig().bindings().iter())
+            .enumerate()
+            .filter(|(k, bound)| {
+                bound.contains(&index) && after.get(*k).is_some_and(|b| !b.is_empty())
+            })
+            .map(|(k, _)| {
+                let others: Vec<_> = (after[k].iter())
+                    .map(|&h| rest_segment(&project.handles[h]))
+                    .collect();
+                let away = pipeline::carried::away_from(rest_segment(removed), &others);
+                (k, Box::new(away) as Box<Keep>)
+            })
+            .collect();
+        let targets: Vec<(usize, &Keep)> =
+            aways.iter().map(|(k, away)| (*k, away.as_ref())).collect();
+        if let Some(kept) = parts.keep(layers, project, &targets, None)? {
+            self.primed = Some(Box::new(kept));
         }
         Ok(())
     }
@@ -962,7 +1014,7 @@ impl Document {
     /// `carried`. Where the edit meshes the picture anew (handles crowding together),
     /// the new mesh is shown where the old one showed the picture; otherwise the
     /// method that followed the edit is kept, to be taken when the edit is made.
-    fn carry_shape(&mut self, project: &mut Project, keep: &dyn Fn(DVec2) -> f64) -> Result<()> {
+    fn carry_shape(&mut self, project: &mut Project, keep: &Keep) -> Result<()> {
         if self.parts().is_some()
             || !project.method.sets_up_on_the_mesh()
             || project.method != self.project.method

@@ -103,6 +103,10 @@ impl Carried {
     }
 }
 
+/// How much of what is shown an edit keeps at each rest point (1: all of it, 0:
+/// none, letting the method's new answer show).
+pub type Keep = dyn Fn(DVec2) -> f64;
+
 /// `x` to 10⁻⁷ (what a rig file keeps of an offset, in pixels: the same in memory as
 /// written and read back).
 fn tenth_micro(x: f64) -> f64 {
@@ -425,7 +429,7 @@ pub fn keep(
     method: &dyn Deformer,
     before: &[DVec2],
     old: Option<&Arc<CarriedShape>>,
-    keep: &dyn Fn(DVec2) -> f64,
+    keep: &Keep,
 ) -> Result<Option<Arc<CarriedShape>>> {
     let (rest, triangles) = (method.rest(), method.triangles());
     let placed = method.deformed();
@@ -439,17 +443,32 @@ pub fn keep(
     if let Some(old) = old {
         Carried::on(old, rest)?.apply(rest, triangles, &mut let_go);
     }
-    let shown: Vec<DVec2> = (rest.iter().zip(before.iter().zip(&let_go)))
+    Ok(between(None, rest, triangles, &placed, &let_go, before, keep).map(Arc::new))
+}
+
+/// The shape (of `part`, `None`: the picture) of a mesh at rest at `rest` (in
+/// `triangles`) whose method puts its vertices at `placed`, that shows each vertex
+/// at `before` where `keep` (at its rest point) is 1 and at `let_go` where it is 0,
+/// blending in between; `None` where that is `placed` itself (nothing to carry).
+pub(crate) fn between(
+    part: Option<usize>,
+    rest: &[DVec2],
+    triangles: &[[u32; 3]],
+    placed: &[DVec2],
+    let_go: &[DVec2],
+    before: &[DVec2],
+    keep: &Keep,
+) -> Option<CarriedShape> {
+    let shown: Vec<DVec2> = (rest.iter().zip(before.iter().zip(let_go)))
         .map(|(&p, (&kept, &gone))| {
             let s = keep(p).clamp(0.0, 1.0);
             gone + (kept - gone) * s
         })
         .collect();
-    let record = Carried::record(None, rest, triangles, &placed, &shown);
-    if (record.offset.iter()).all(|d| DVec2::from(*d).length() < 1e-9) {
-        return Ok(None);
-    }
-    Ok(Some(Arc::new(record)))
+    let record = Carried::record(part, rest, triangles, placed, &shown);
+    (record.offset.iter())
+        .any(|d| DVec2::from(*d).length() >= 1e-9)
+        .then_some(record)
 }
 
 /// How much of the picture a handle removed in a posed state leaves where it was, at
@@ -458,7 +477,7 @@ pub fn keep(
 /// that what the removed handle was moving relaxes to what the others give, and the
 /// picture away from it stays. `removed` and `others` are the handles' rest
 /// geometries (a point, or a bar's two ends).
-pub fn away_from(removed: [DVec2; 2], others: &[[DVec2; 2]]) -> impl Fn(DVec2) -> f64 {
+pub fn away_from(removed: [DVec2; 2], others: &[[DVec2; 2]]) -> impl Fn(DVec2) -> f64 + use<> {
     let near = (others.iter())
         .map(|&o| geometry::segment_distance(removed, o))
         .fold(f64::INFINITY, f64::min);

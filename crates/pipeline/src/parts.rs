@@ -288,6 +288,10 @@ impl Bound {
     }
 }
 
+/// What [`PartRig::keep`] gives: each target's new shape (`None`: none) and the parts
+/// set up with them.
+pub type Kept = (Vec<(usize, Option<Arc<CarriedShape>>)>, PartRig);
+
 /// Where a follower's vertex lies on the mesh of the part it follows.
 #[derive(Clone, Copy)]
 enum Tie {
@@ -552,71 +556,76 @@ impl PartRig {
         Ok(holds)
     }
 
-    /// What handle `index` of `project` (just placed, in the pose shown, on `artwork`
-    /// these parts were set up on, with what it holds already in `project`) makes the
-    /// parts carry: each part it binds that followed another until now keeps the shape
-    /// following gave it ([`crate::carried`]), so that it does not jump to what its own
-    /// method gives it. Returns the shapes (none when the pin binds no follower) and
-    /// the parts set up for `project` with them, to be posed from.
+    /// The shapes an edit in a posed state makes the parts carry, so that what
+    /// `keep` says stays where it is shown: `edited` is the rig file after the edit
+    /// (on `artwork` these parts were set up on, with what its handles hold already),
+    /// and for each part of `targets` (a layer's index), `keep` gives at each of its
+    /// rest points (canvas pixels) how much of what is shown now stays (1: all, 0:
+    /// what its method gives after the edit, with the shape it carried until now) —
+    /// a part that followed another keeps the shape following gave it when a pin
+    /// first binds it (all of it), a part a removed handle bound lets go near it. A
+    /// target that no handle binds after the edit follows (or stays) and carries
+    /// nothing. Returns each target's new shape (`None`: none) and the parts set up for
+    /// `edited` with them; `None` where `edited` is not posed.
     ///
     /// # Errors
     /// As [`PartRig::update`].
-    pub fn carry(
+    pub fn keep(
         &self,
         artwork: &layers::Artwork,
-        project: &Project,
-        index: usize,
+        edited: &Project,
+        targets: &[(usize, &crate::carried::Keep)],
         density: Option<usize>,
-    ) -> Result<Option<(Vec<Arc<CarriedShape>>, Self)>> {
-        let followers: Vec<usize> = (bindings(artwork, project)?.iter().enumerate())
-            .filter(|(k, bound)| {
-                bound.contains(&index)
-                    && matches!(
-                        self.parts.get(*k),
-                        Some(Part::Follows {
-                            leader: Some(_),
-                            ..
-                        })
-                    )
-            })
-            .map(|(k, _)| k)
-            .collect();
-        if followers.is_empty() || !project.is_posed() {
+    ) -> Result<Option<Kept>> {
+        if targets.is_empty() || !edited.is_posed() {
             return Ok(None);
         }
-        let mut rig = self.update(artwork, project, density, &())?;
+        let mut rig = self.update(artwork, edited, density, &())?;
         let mut shapes = Vec::new();
-        for k in followers {
-            let (Part::Follows { mesh, .. }, Part::Bound(bound)) = (&self.parts[k], &rig.parts[k])
-            else {
+        for &(k, keep) in targets {
+            let Some(Part::Bound(bound)) = rig.parts.get(k) else {
                 continue;
             };
-            // Where following showed each vertex of the part's new mesh.
-            let followed =
-                Domain::new(mesh.rest.clone(), mesh.triangles.clone(), Metric::Euclidean)
+            // What is shown now of the part, and where that shows the new mesh's
+            // vertices (at rest, the same mesh but for handles that crowd together).
+            let (rest, triangles, shown) = match self.parts.get(k) {
+                Some(Part::Follows {
+                    mesh,
+                    leader: Some(_),
+                    ..
+                }) => (
+                    mesh.rest.clone(),
+                    mesh.triangles.clone(),
+                    mesh.deformed.clone(),
+                ),
+                Some(Part::Bound(old)) => (
+                    old.rest(),
+                    old.warper.deformer.triangles().to_vec(),
+                    old.deformed(),
+                ),
+                _ => continue,
+            };
+            let new_rest = bound.rest();
+            let before = if rest == new_rest {
+                shown
+            } else {
+                let old = Domain::new(rest, triangles, Metric::Euclidean)
                     .map_err(|e| anyhow::anyhow!("part {k}: {e}"))?;
-            let rest = bound.rest();
-            let shown: Vec<DVec2> = (rest.iter())
-                .map(|&p| match followed.locate(p) {
-                    Some((t, b)) => {
-                        let [i, j, l] = followed.triangles()[t].map(|v| v as usize);
-                        mesh.deformed[i] * b[0] + mesh.deformed[j] * b[1] + mesh.deformed[l] * b[2]
-                    }
-                    None => followed
-                        .nearest_vertex(p)
-                        .map_or(p, |v| p + mesh.deformed[v as usize] - mesh.rest[v as usize]),
-                })
-                .collect();
-            let triangles = bound.warper.deformer.triangles();
-            let record = Carried::record(Some(k), &rest, triangles, &bound.placed(), &shown);
-            if (record.offset.iter()).all(|d| DVec2::from(*d).length() < 1e-9) {
-                // Following left it where its method puts it (at rest): nothing to carry.
-                continue;
-            }
-            let record = Arc::new(record);
-            let carrying = Arc::clone(bound).carrying(Some(&record))?;
-            rig.parts[k] = Part::Bound(carrying);
-            shapes.push(record);
+                crate::carried::resample(&old, &shown, &new_rest)
+            };
+            let new_triangles = bound.warper.deformer.triangles();
+            let record = crate::carried::between(
+                Some(k),
+                &new_rest,
+                new_triangles,
+                &bound.placed(),
+                &bound.deformed(),
+                &before,
+                keep,
+            )
+            .map(Arc::new);
+            rig.parts[k] = Part::Bound(Arc::clone(bound).carrying(record.as_ref())?);
+            shapes.push((k, record));
         }
         rig.move_followers();
         Ok(Some((shapes, rig)))
@@ -1153,26 +1162,26 @@ impl PartsDeformer {
         Ok(())
     }
 
-    /// [`PartRig::carry`] for these parts: the shapes that handle `index` of
-    /// `project` (just placed in the pose shown, with what it holds) makes the parts
-    /// it binds carry are added to `project`'s parts, and the parts set up for it
-    /// returned; `None` (`project` untouched) where it binds no part that follows
-    /// another.
+    /// [`PartRig::keep`] for these parts: the shapes are written to `project`'s
+    /// `carried` (a target left without one loses its own), and the parts set up for
+    /// it returned; `None` (`project` untouched) where nothing is kept.
     ///
     /// # Errors
     /// As [`PartsDeformer::update`].
-    pub fn carry(
+    pub fn keep(
         &self,
         artwork: &layers::Artwork,
         project: &mut Project,
-        index: usize,
+        targets: &[(usize, &crate::carried::Keep)],
         density: Option<usize>,
     ) -> Result<Option<Self>> {
-        let Some((shapes, rig)) = self.rig.carry(artwork, project, index, density)? else {
+        let Some((shapes, rig)) = self.rig.keep(artwork, project, targets, density)? else {
             return Ok(None);
         };
-        (project.carried).retain(|c| shapes.iter().all(|s| s.part != c.part));
-        project.carried.extend(shapes);
+        for (k, shape) in shapes {
+            (project.carried).retain(|c| c.part != Some(k));
+            project.carried.extend(shape);
+        }
         project.carried.sort_by_key(|c| c.part);
         Self::with_rig(artwork, project, |_| Ok(rig), &()).map(Some)
     }

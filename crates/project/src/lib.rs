@@ -679,10 +679,12 @@ pub struct PartsSpec {
 /// their Delaunay triangles, and one off them its nearest listed vertex's. Offsets are
 /// kept to 10⁻⁷ px.
 ///
-/// Drawn as parts, a part that followed another keeps the shape following gave it
-/// when a pin first binds it in a pose. On one picture, under ARAP and MLS, a handle
-/// removed in a pose leaves the picture away from it where it was, and under MLS a
-/// handle placed in a pose moves nothing.
+/// On one picture, under ARAP and MLS, a handle removed in a pose leaves the picture
+/// away from it where it was, and under MLS a handle placed in a pose moves nothing.
+/// Drawn as parts (under every method), a part that followed another keeps the shape
+/// following gave it when a pin first binds it in a pose, a part a removed pin bound
+/// stays where it was away from it, and under MLS a part a new pin binds moves
+/// nothing.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CarriedShape {
