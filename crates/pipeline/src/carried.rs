@@ -165,27 +165,38 @@ pub(crate) fn local_frames(
     moved: &[DVec2],
     triangles: &[[u32; 3]],
 ) -> Vec<[f64; 2]> {
+    use rayon::prelude::*;
+    // Each triangle's closest similarity, weighted by its rest area (in parallel: the
+    // Jacobians are the work), then summed into its corners.
+    let weighted: Vec<[f64; 3]> = triangles
+        .par_iter()
+        .with_min_len(4096)
+        .map(|t| {
+            let [i, j, k] = t.map(|v| v as usize);
+            let (e1, e2) = (rest[j] - rest[i], rest[k] - rest[i]);
+            let det = e1.perp_dot(e2);
+            if det.abs() < 1e-12 {
+                return [0.0; 3];
+            }
+            let (f1, f2) = (moved[j] - moved[i], moved[k] - moved[i]);
+            // J = [f1 f2] [e1 e2]⁻¹; its closest similarity's a = (J₀₀ + J₁₁) / 2 and
+            // b = (J₁₀ - J₀₁) / 2.
+            let inv = [[e2.y / det, -e2.x / det], [-e1.y / det, e1.x / det]];
+            let j00 = f1.x * inv[0][0] + f2.x * inv[1][0];
+            let j01 = f1.x * inv[0][1] + f2.x * inv[1][1];
+            let j10 = f1.y * inv[0][0] + f2.y * inv[1][0];
+            let j11 = f1.y * inv[0][1] + f2.y * inv[1][1];
+            let area = det.abs();
+            [area * (j00 + j11) / 2.0, area * (j10 - j01) / 2.0, area]
+        })
+        .collect();
     let mut sums = vec![[0.0f64; 3]; rest.len()];
-    for t in triangles {
-        let [i, j, k] = t.map(|v| v as usize);
-        let (e1, e2) = (rest[j] - rest[i], rest[k] - rest[i]);
-        let det = e1.perp_dot(e2);
-        if det.abs() < 1e-12 {
-            continue;
-        }
-        let (f1, f2) = (moved[j] - moved[i], moved[k] - moved[i]);
-        // J = [f1 f2] [e1 e2]⁻¹; its closest similarity's a = (J₀₀ + J₁₁) / 2 and
-        // b = (J₁₀ - J₀₁) / 2.
-        let inv = [[e2.y / det, -e2.x / det], [-e1.y / det, e1.x / det]];
-        let j00 = f1.x * inv[0][0] + f2.x * inv[1][0];
-        let j01 = f1.x * inv[0][1] + f2.x * inv[1][1];
-        let j10 = f1.y * inv[0][0] + f2.y * inv[1][0];
-        let j11 = f1.y * inv[0][1] + f2.y * inv[1][1];
-        let area = det.abs();
-        for v in [i, j, k] {
-            sums[v][0] += area * (j00 + j11) / 2.0;
-            sums[v][1] += area * (j10 - j01) / 2.0;
-            sums[v][2] += area;
+    for (t, w) in triangles.iter().zip(&weighted) {
+        for v in *t {
+            let sum = &mut sums[v as usize];
+            sum[0] += w[0];
+            sum[1] += w[1];
+            sum[2] += w[2];
         }
     }
     sums.iter()

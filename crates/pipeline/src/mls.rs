@@ -111,6 +111,10 @@ impl MlsRig {
                 .iter()
                 .map(rest_control)
                 .eq(handles.iter().map(rest_control));
+        if same_rest && self.handles == handles && self.positions.len() == self.rest.len() {
+            // The same pose, posed already: the positions stand.
+            return Ok(());
+        }
         if !same_rest {
             let clock = Instant::now();
             self.table = Arc::new(precompute(&self.rest, handles, &options)?);
