@@ -195,13 +195,13 @@ pub struct Document {
 /// The picture's mesh, and C²'s weights of it where they are used.
 #[derive(Clone)]
 enum Base {
-    /// The C² rig, which holds the mesh: under C², and under a cage (the handles stay,
-    /// for going back to them).
+    /// The C² rig, which holds the mesh: under C².
     Rig(Box<Rig>),
-    /// The mesh alone, under a method that sets up on it (ARAP, MLS) and weighs
-    /// nothing of C²'s; `virtuals` keeps the C² rig's virtual handles (the rig file's
-    /// `virtual_*` fields alone), carried through the edits as a save carries them, so
-    /// that going back to C² builds the rig a reopen would build.
+    /// The mesh alone, under every other method (ARAP and MLS set up on it; under a
+    /// cage the handles stay on it, for going back to them), which weighs nothing of
+    /// C²'s; `virtuals` keeps the C² rig's virtual handles (the rig file's `virtual_*`
+    /// fields alone), carried through the edits as a save carries them, so that going
+    /// back to C² builds the rig a reopen would build.
     Mesh {
         mesh: Box<Domain>,
         virtuals: Box<Project>,
@@ -209,9 +209,9 @@ enum Base {
 }
 
 impl Base {
-    /// `project`'s on `image`: its rig, or under ARAP and MLS its mesh alone.
+    /// `project`'s on `image`: its rig under C², else its mesh alone.
     fn of(image: &RgbaImage, project: &Project) -> Result<Self> {
-        if project.method.sets_up_on_the_mesh() {
+        if !project.method.uses_virtual_handles() {
             let mesh = pipeline::mesh_picture_for(image, project)?;
             weights_core::check_handles_on(&mesh, &pipeline::handles(project))?;
             Ok(Base::Mesh {
@@ -1247,13 +1247,13 @@ impl Document {
             virtual_copy: std::mem::take(&mut project.virtual_copy),
             ..Project::default()
         };
-        if project.method.sets_up_on_the_mesh() {
+        if !project.method.uses_virtual_handles() {
             return self.restore_bare(project, saved_virtuals, exact);
         }
         if let Base::Mesh { mesh, .. } = &self.base {
-            // Back to C² (or to a cage) from a method that keeps the mesh alone: the
-            // rig built on it from the handles and virtual handles kept, as a reopen
-            // of the rig file saved now would build it; then on as from C².
+            // Back to C² from a method that keeps the mesh alone: the rig built on it
+            // from the handles and virtual handles kept, as a reopen of the rig file
+            // saved now would build it; then on as from C².
             let mut with = self.snapshot();
             with.method = Method::C2;
             let mesh = pipeline::with_metric(Domain::clone(mesh), &with)?;
@@ -1382,12 +1382,12 @@ impl Document {
         }
     }
 
-    /// [`Document::restore_with`] under a method that sets up on the mesh alone (ARAP,
-    /// MLS): the mesh anew where the density, the crowding of handles or the cuts ask
-    /// for another (the rule [`pipeline::prepare`] meshes by), the handles checked as
-    /// C²'s rig checks them, the virtual handles kept for going back to C² carried as
-    /// a rig would carry them; a method new to the mesh is set up before anything
-    /// changes.
+    /// [`Document::restore_with`] under a method that keeps the mesh alone (ARAP and
+    /// MLS, which set up on it; a cage, which leaves the handles on it): the mesh anew
+    /// where the density, the crowding of handles or the cuts ask for another (the
+    /// rule [`pipeline::prepare`] meshes by), the handles checked as C²'s rig checks
+    /// them, the virtual handles kept for going back to C² carried as a rig would carry
+    /// them; a handle method new to the mesh is set up before anything changes.
     fn restore_bare(
         &mut self,
         project: Project,
@@ -1430,12 +1430,15 @@ impl Document {
         let mesh = new_mesh.as_ref().unwrap_or(self.mesh());
         weights_core::check_handles_on(mesh, &pipeline::handles(&project))?;
         let parts = self.layers.is_some() && project.parts.is_some();
-        let fresh = if !parts && (new_mesh.is_some() || self.method.is_none()) {
+        let handles = project.method.controls() == Controls::Handles;
+        let fresh = if handles && !parts && (new_mesh.is_some() || self.method.is_none()) {
             pipeline::on_mesh(&project, mesh, Some(&self.image))?
         } else {
             None
         };
-        let method_changed = project.method != self.project.method;
+        // Another method, or another rest cage, draws another mesh.
+        let method_changed = project.method != self.project.method
+            || CageKey::of(&project) != CageKey::of(&self.project);
         match (new_mesh, &mut self.base) {
             (Some(mesh), _) => {
                 let virtuals = virtuals.unwrap_or_else(|| virtuals_of(&self.snapshot()));

@@ -278,3 +278,69 @@ impl Sequence {
             .collect()
     }
 }
+
+/// A mesh that nothing moves: what a method shows while it has nothing to warp by (a
+/// cage chosen and not solved yet), the picture at rest.
+#[derive(Clone)]
+pub struct Still {
+    method: Method,
+    rest: Vec<DVec2>,
+    triangles: Vec<[u32; 3]>,
+}
+
+impl Still {
+    /// `mesh` (its rest positions and triangles) at rest, standing for `method`.
+    pub fn new(method: Method, rest: Vec<DVec2>, triangles: Vec<[u32; 3]>) -> Self {
+        Self {
+            method,
+            rest,
+            triangles,
+        }
+    }
+}
+
+impl Deformer for Still {
+    fn method(&self) -> Method {
+        self.method
+    }
+
+    fn rest(&self) -> &[DVec2] {
+        &self.rest
+    }
+
+    fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+
+    fn follow(&mut self, project: &Project) -> Result<Follow> {
+        Ok(if project.method == self.method {
+            Follow::Followed
+        } else {
+            Follow::NeedsSetup
+        })
+    }
+
+    fn deformed(&self) -> Vec<DVec2> {
+        self.rest.clone()
+    }
+
+    fn output(&self) -> Output<'_> {
+        Output::Positions(&self.rest)
+    }
+
+    fn weights(&self, _listing: WeightsListing) -> Result<serde_json::Value> {
+        anyhow::bail!("{} has nothing set up to weigh by yet", self.method.label())
+    }
+
+    fn bench(&mut self, _project: &Project, _poses: usize) -> Result<serde_json::Value> {
+        anyhow::bail!("{} has nothing set up to time yet", self.method.label())
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+
+    fn clone_box(&self) -> Box<dyn Deformer> {
+        Box::new(self.clone())
+    }
+}

@@ -28,7 +28,7 @@ pub use layers::{Artwork, Layer, write_ora};
 pub use mesh::Mesh;
 pub use method::{
     Backdrop, Controls, Deformer, Follow, Listener, Method, Output, SkinTable, Skinning,
-    SolveProgress, Source, WeightsListing, on_mesh, setup,
+    SolveProgress, Source, Still, WeightsListing, on_mesh, setup,
 };
 pub use order::draw_order;
 pub use parts::{

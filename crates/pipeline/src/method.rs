@@ -32,7 +32,7 @@ use crate::cage::CageDeformer;
 use crate::carried::Carrying;
 pub use crate::deformer::{
     Backdrop, Deformer, Follow, Listener, Output, SkinTable, Skinning, SolveProgress, Source,
-    WeightsListing,
+    Still, WeightsListing,
 };
 use crate::mls::MlsRig;
 pub use project::{Controls, Method};

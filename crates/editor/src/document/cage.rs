@@ -100,7 +100,14 @@ impl Document {
     /// (kept while the solution stays the same; none until the cage is solved).
     pub(super) fn sync_cage(&mut self) -> Result<()> {
         let Some(solution) = self.cage_solution().cloned() else {
-            self.method = None;
+            // Not solved yet: the picture at rest.
+            let mesh = self.mesh();
+            let still = pipeline::Still::new(
+                self.project.method,
+                mesh.positions().to_vec(),
+                mesh.triangles().to_vec(),
+            );
+            self.method = Some((self.mesh_version, Box::new(still)));
             return Ok(());
         };
         if let Some(layers) = self.layers.clone().filter(|_| self.project.parts.is_some()) {

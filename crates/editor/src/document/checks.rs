@@ -25,7 +25,7 @@ impl Document {
         if !self.project.virtual_handles.is_empty() {
             bail!("virtual handles belong to the rig while editing, not to the rig file");
         }
-        if self.project.method.sets_up_on_the_mesh() == self.rig().is_some() {
+        if self.project.method.uses_virtual_handles() != self.rig().is_some() {
             bail!(
                 "{} with{} a C² rig",
                 self.project.method.label(),
@@ -140,11 +140,13 @@ impl Document {
                 }
             }
             Controls::Cage => {
-                let solved = self.cage_solution();
-                if self
-                    .cage_deformer()
-                    .is_none_or(|cage| solved.is_none_or(|s| !Arc::ptr_eq(cage.solution(), s)))
-                {
+                // The solved cage's deformer, or the picture at rest until it is solved.
+                let in_step = match (self.cage_deformer(), self.cage_solution()) {
+                    (Some(cage), Some(solved)) => Arc::ptr_eq(cage.solution(), solved),
+                    (None, None) => deformer.as_any().is::<pipeline::Still>(),
+                    _ => false,
+                };
+                if !in_step {
                     bail!("the cage deformer is not the rig file's solved cage");
                 }
             }

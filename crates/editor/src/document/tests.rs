@@ -1602,6 +1602,47 @@ fn arap_and_mls_keep_the_mesh_alone_and_c2_comes_back_as_it_was_or_as_a_reopen_b
 }
 
 #[test]
+fn under_a_cage_the_document_keeps_the_mesh_alone_and_c2_comes_back_as_a_reopen_builds_it() {
+    let mut doc = Document::built_in().expect("the built-in picture");
+    doc.apply(Edit::Add(point(300.0, 300.0))).expect("inserted");
+    let mesh = doc.mesh().positions().to_vec();
+    let before = doc.rig().expect("a C² rig").clone();
+    // A cage drawn around the picture: LBC is chosen, and no C² rig is kept for it.
+    let (w, h) = doc.image.dimensions();
+    let (w, h) = (f64::from(w), f64::from(h));
+    doc.apply(Edit::Cage {
+        rest: vec![
+            [2.0, 2.0],
+            [w - 2.0, 2.0],
+            [w - 2.0, h - 2.0],
+            [2.0, h - 2.0],
+        ],
+        vertices: 500,
+    })
+    .expect("a cage");
+    assert_eq!(doc.method(), Method::Lbc);
+    assert!(doc.rig().is_none(), "no C² rig under a cage");
+    assert_eq!(doc.mesh().positions(), mesh.as_slice());
+    // Not solved yet: the picture at rest.
+    let off = (doc.mesh().positions().to_vec().iter().zip(doc.deformed()))
+        .map(|(a, b)| a.distance(*b))
+        .fold(0.0f64, f64::max);
+    assert!(off == 0.0, "unsolved, the picture at rest ({off} px)");
+    doc.sanity_check().expect("sane unsolved");
+    doc.solve_cage(&mut |_| true).expect("solved");
+    doc.apply(Edit::Method(Method::Lbc))
+        .expect("the solve taken");
+    assert!(doc.cage_deformer().is_some());
+    doc.sanity_check().expect("sane solved");
+    // Back to the handles: the very rig it left.
+    doc.apply(Edit::Method(Method::C2)).expect("back");
+    let rig = doc.rig().expect("a C² rig again");
+    assert_eq!(rig.virtual_vertices(), before.virtual_vertices());
+    rig.same_weights_as(&before).expect("the same weights");
+    doc.sanity_check().expect("sane");
+}
+
+#[test]
 fn new_weights_draw_the_handles_depths_by_the_new_cells_as_a_reopen_does() {
     let mut doc = Document::built_in().expect("the built-in picture");
     // A handle in front: the triangles of its C² cell are drawn after the others.
