@@ -945,8 +945,10 @@ impl Document {
         };
         project.holds.extend(holds);
         // A part it binds that followed another until now keeps the shape following
-        // gave it, and under MLS every part it binds keeps the shape it has; the parts
-        // set up for it are posed from when the edit is made.
+        // gave it; under MLS, which cannot hold a part, and under C², whose overlaid
+        // handle holds it to within its fit, every part it binds keeps the shape it has
+        // (ARAP's holds keep it already). The parts set up for it are posed from when
+        // the edit is made.
         if let (Some(parts), Some(layers)) = (self.parts(), self.layers.as_deref()) {
             let all = |_: DVec2| 1.0;
             let rig = parts.rig();
@@ -956,7 +958,7 @@ impl Document {
             .filter(|(k, bound)| {
                 bound.contains(&index)
                     && (rig.followed().get(*k).is_some_and(Option::is_some)
-                        || (project.method == Method::Mls && rig.bound(*k).is_some()))
+                        || (project.method != Method::Arap && rig.bound(*k).is_some()))
             })
             .map(|(k, _)| (k, &all as &Keep))
             .collect();

@@ -845,18 +845,18 @@ fn walk(seed: u64, actions: usize) {
                 let now = doc.project().handles.clone();
                 let placed = now.len() == handles.len() + 1 && now[..handles.len()] == handles[..];
                 // On one picture a new pin holds it where it was under every handle
-                // method (MLS by a shape carried). Drawn as parts, under ARAP and MLS,
-                // it holds each part it binds, and a part that only followed another
-                // until then carries the shape following gave it — unless its parts
-                // were meshed anew (C² meshes a pin's point in).
+                // method (MLS by a shape carried). Drawn as parts it holds each part
+                // it binds (ARAP by its holds, C² and MLS by shapes carried), and a
+                // part that only followed another until then carries the shape
+                // following gave it — unless its parts were meshed anew (C² meshes a
+                // pin's point in).
                 let holding = match doc.parts() {
                     None => true,
                     Some(now) => {
                         use pipeline::Deformer as _;
-                        matches!(doc.method(), project::Method::Arap | project::Method::Mls)
-                            && parts
-                                .as_ref()
-                                .is_some_and(|rest| now.rest() == rest.as_slice())
+                        parts
+                            .as_ref()
+                            .is_some_and(|rest| now.rest() == rest.as_slice())
                     }
                 };
                 if pinned && placed && doc.mesh_version() == mesh && holding {

@@ -946,10 +946,10 @@ fn pins_placed_in_a_pose_on_parts(method: Method) -> Vec<f64> {
 
 #[test]
 fn a_pin_placed_in_a_pose_on_parts_leaves_the_other_parts_where_they_were() {
-    // Under C² its own parts move as the flat picture's do (the lizard's target: at
-    // most 5 px).
+    // Under C² its own parts keep the shape they have (the overlaid handle alone moved
+    // them up to 2.2 px on the raised arm).
     let own = pins_placed_in_a_pose_on_parts(Method::C2);
-    assert!(own.iter().all(|&d| d <= 5.0), "{own:?}");
+    assert!(own.iter().all(|&d| d <= 1e-5), "{own:?}");
 }
 
 #[test]
