@@ -1755,6 +1755,32 @@ fn under_arap_and_mls_a_handle_removed_in_a_pose_lets_go_near_it_and_nothing_awa
 }
 
 #[test]
+fn a_carried_shape_follows_the_picture_onto_a_new_density_and_reopens_alike() {
+    let mut doc = built_in_posed(Method::Arap);
+    doc.apply(Edit::Remove(0)).expect("removed");
+    assert_eq!(doc.project().carried.len(), 1, "a shape carried");
+    let (rest, shown) = (doc.mesh().clone(), doc.deformed().to_vec());
+    // Another density: another mesh, the shape interpolated onto it.
+    let mut settings = doc.settings();
+    settings.density = 5_000;
+    doc.apply(Edit::Settings(settings)).expect("a new density");
+    assert_ne!(doc.mesh().len(), rest.len());
+    assert_eq!(doc.project().carried.len(), 1, "the shape kept");
+    doc.check_reopens().expect("reopens alike");
+    doc.sanity_check().expect("sane");
+    // Where the old mesh showed the picture, the new one shows it too, but for the
+    // interpolation of the solve and the shape between the old vertices.
+    let before = pipeline::carried::resample(&rest, &shown, doc.mesh().positions());
+    let moved: Vec<f64> = (before.iter().zip(doc.deformed()))
+        .map(|(a, b)| a.distance(*b))
+        .collect();
+    let mut sorted = moved.clone();
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted[sorted.len() / 2];
+    assert!(median < 0.5, "median {median} px");
+}
+
+#[test]
 fn under_mls_a_pin_placed_in_a_pose_moves_nothing() {
     let mut doc = built_in_posed(Method::Mls);
     // Three places on the picture shown, away from the handles.
