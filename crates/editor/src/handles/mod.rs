@@ -171,7 +171,16 @@ impl HandleTool {
             && let Some(doc) = host.document()
         {
             let ms = doc.last_update_ms;
-            host.info(&format!("removed a handle; weights updated in {ms:.1} ms"));
+            // In a pose, what it moved lets go and the picture away from it keeps its
+            // shape (carried where the method alone would move it).
+            let kept = if doc.project().is_posed() && !doc.project().carried.is_empty() {
+                "; what it moved let go, the rest kept its shape"
+            } else {
+                ""
+            };
+            host.info(&format!(
+                "removed a handle{kept}; weights updated in {ms:.1} ms"
+            ));
         }
     }
 
