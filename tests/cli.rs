@@ -1718,3 +1718,63 @@ fn a_project_of_several_pictures_with_parts_renders_them_in_its_order() {
     ]);
     assert!(line.contains("one of the inputs"), "{line}");
 }
+
+#[test]
+fn a_carried_shape_is_drawn_by_deform_under_arap_and_mls_and_ignored_under_c2() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+    fs::copy(
+        root.join("assets/lizard.png"),
+        dir.path().join("lizard.png"),
+    )
+    .expect("copy");
+    // A shape of one offset everywhere (three listed vertices around the picture,
+    // which no mesh of it matches: interpolated), on a rig at rest.
+    let rig = |method: &str, carried: bool| {
+        let shape = r#","carried":[{"rest":[[-1e4,-1e4],[1e4,-1e4],[0,1e4]],
+            "offset":[[1.5,-0.5],[1.5,-0.5],[1.5,-0.5]]}]"#;
+        format!(
+            r#"{{"version":1,"image":"lizard.png","method":"{method}","density":2000,
+            "handles":[{{"type":"point","rest":[300,300]}},{{"type":"point","rest":[450,240]}}]{}}}"#,
+            if carried { shape } else { "" }
+        )
+    };
+    let deformed = |method: &str, carried: bool| -> Vec<[f64; 2]> {
+        let path = dir.path().join(format!("{method}-{carried}.json"));
+        fs::write(&path, rig(method, carried)).expect("write the rig");
+        let obj = dir.path().join(format!("{method}-{carried}.obj"));
+        ok(&[
+            OsStr::new("deform"),
+            OsStr::new("--rig"),
+            path.as_os_str(),
+            OsStr::new("-o"),
+            obj.as_os_str(),
+        ]);
+        (fs::read_to_string(&obj).expect("the OBJ").lines())
+            .filter_map(|l| l.strip_prefix("v "))
+            .map(|l| {
+                let mut n = l
+                    .split_whitespace()
+                    .map(|w| w.parse::<f64>().expect("a number"));
+                [n.next().expect("x"), n.next().expect("y")]
+            })
+            .collect()
+    };
+    for method in ["arap", "mls"] {
+        let (plain, carried) = (deformed(method, false), deformed(method, true));
+        assert_eq!(plain.len(), carried.len());
+        // At rest the local frames are the identity: every vertex moved by the offset.
+        for (p, q) in plain.iter().zip(&carried) {
+            let d = [q[0] - p[0], q[1] - p[1]];
+            assert!(
+                (d[0] - 1.5).abs() < 1e-6 && (d[1] + 0.5).abs() < 1e-6,
+                "{method}: {p:?} went to {q:?}"
+            );
+        }
+    }
+    assert_eq!(
+        deformed("c2", true),
+        deformed("c2", false),
+        "C² draws no shape"
+    );
+}
