@@ -407,6 +407,7 @@ impl Monkey {
             }
             97 => self.perform(),
             98 => self.pin_in_pose(),
+            99 if self.rng.chance(0.5) => self.remove_in_pose(),
             _ => {
                 let size = *self.rng.pick(&[
                     Vec2::new(1200.0, 800.0),
@@ -431,10 +432,26 @@ impl Monkey {
         self.frames(1);
     }
 
-    /// A pin clicked onto the picture under ARAP or the C² weights, in whatever pose
-    /// it is in (the walk checks that it moves nothing): one of them chosen if a
-    /// handle method is in use, the Puppet tool, a click on a vertex of the picture
-    /// where it is shown.
+    /// A handle removed in a posed state, as the Delete key removes the one selected
+    /// (the walk checks that the picture away from it does not move).
+    fn remove_in_pose(&mut self) -> String {
+        let app = self.h.state();
+        let Some(count) = (app.document())
+            .filter(|d| !app.is_busy() && d.project().is_posed())
+            .map(|d| d.project().handles.len())
+            .filter(|&n| n > 0)
+        else {
+            return "remove in a pose (not now)".to_owned();
+        };
+        let i = self.rng.below(count);
+        let done = self.h.state_mut().edit(Edit::Remove(i));
+        self.frames(2);
+        format!("remove handle {i} in a pose (applied={done})")
+    }
+
+    /// A pin clicked onto the picture under a handle method, in whatever pose it is in
+    /// (the walk checks that it moves nothing): the Puppet tool, a click on a vertex of
+    /// the picture where it is shown.
     fn pin_in_pose(&mut self) -> String {
         let app = self.h.state();
         let usable = !app.is_busy()
@@ -443,19 +460,6 @@ impl Monkey {
                 .is_some_and(|d| d.method().controls() == project::Controls::Handles);
         if !usable {
             return "pin in a pose (not now)".to_owned();
-        }
-        let holding = app
-            .document()
-            .is_some_and(|d| matches!(d.method(), project::Method::Arap | project::Method::C2));
-        if !holding {
-            let method = *self.rng.pick(&[project::Method::Arap, project::Method::C2]);
-            if let Some(node) = self.h.query_all_by_label(method.label()).next() {
-                node.click();
-            }
-            // A large picture sets ARAP up on the worker.
-            self.frames(1);
-            self.wait_for_job();
-            return format!("{} chosen", method.label());
         }
         if self.h.state().tool != editor::Tool::Puppet {
             // (A tool changes nothing on the picture: on to the click.)

@@ -92,9 +92,21 @@ impl Document {
     /// through the rest triangle that contains it. `None` off the mesh.
     pub fn forward(&mut self, p: DVec2) -> Option<DVec2> {
         self.deformed();
+        // Drawn as parts, the parts' joined mesh (the topmost triangle first), whose
+        // vertices the positions are; else the picture's mesh.
+        let on_top: Option<Vec<[u32; 3]>> = self.parts().map(|_| {
+            let mut order = self.draw_order();
+            order.reverse();
+            order
+        });
         let deformed = self.deformed.as_ref().map(|(_, d)| d.as_slice())?;
-        let domain = self.mesh();
-        let ([a, b, c], [u, v, w]) = super::locate(domain.positions(), domain.triangles(), p)?;
+        let ([a, b, c], [u, v, w]) = match (self.parts(), &on_top) {
+            (Some(parts), Some(order)) => super::locate(pipeline::Deformer::rest(parts), order, p)?,
+            _ => {
+                let domain = self.mesh();
+                super::locate(domain.positions(), domain.triangles(), p)?
+            }
+        };
         let at = |v: u32| deformed.get(v as usize).copied();
         Some(at(a)? * u + at(b)? * v + at(c)? * w)
     }

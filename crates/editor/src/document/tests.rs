@@ -1163,6 +1163,51 @@ fn a_pin_removed_in_a_pose_on_parts_leaves_its_parts_where_they_were_away_from_i
 }
 
 #[test]
+fn drawn_as_parts_a_pin_placed_while_keys_exist_takes_each_key_where_it_shows_the_picture() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut doc = puppet(dir.path());
+    doc.apply(Edit::Parts(Some(project::PartsSpec::default())))
+        .expect("parts");
+    // The sample's pose keyed at 0 and 1 s.
+    for time in [0.0, 1.0] {
+        let keyed = doc.keyed_at(time);
+        doc.apply(Edit::Animation(Some(Box::new(keyed))))
+            .expect("a key");
+    }
+    // A pin on the body where it is shown: each key (the pose shown) gives it the
+    // place it was clicked at (the parts' mesh, not the picture's own, says where).
+    let at = DVec2::new(300.0, 420.0);
+    let (rest, angle, scale) = doc.unwarp(at).expect("on the picture");
+    let before = shown_by_part(&doc);
+    doc.apply(Edit::Add(HandleSpec::Point {
+        rest: rest.to_array(),
+        translate: (at - rest).to_array(),
+        rotate: angle,
+        scale,
+        depth: 0,
+    }))
+    .expect("pinned");
+    let pin = doc.project().handles.len() - 1;
+    for key in doc.keys() {
+        let project::HandlePose::Point { translate, .. } = key.pose.handles[pin] else {
+            panic!("a point's pose");
+        };
+        let placed = rest + DVec2::from(translate);
+        assert!(
+            placed.distance(at) < 1e-6,
+            "key at {}: {placed} for {at}",
+            key.time
+        );
+    }
+    let after = shown_by_part(&doc);
+    let moved = (after.iter())
+        .filter_map(|(k, p)| before.get(k).map(|q| p.distance(*q)))
+        .fold(0.0f64, f64::max);
+    assert!(moved < 1e-5, "the picture moved {moved} px");
+    doc.check_reopens().expect("reopens as shown");
+}
+
+#[test]
 fn a_pin_placed_beside_another_on_parts_refines_that_part_as_a_reopen_does() {
     let dir = tempfile::tempdir().expect("temp dir");
     let mut doc = puppet(dir.path());
