@@ -1503,9 +1503,10 @@ impl Document {
             order
         });
         let deformed = self.deformed.as_ref().map(|(_, d)| d.as_slice())?;
+        // Else the mesh the method moves (the picture's, or a cage's inside).
         let (rest, triangles) = match (self.parts(), &on_top) {
             (Some(parts), Some(order)) => (parts.rest(), order.as_slice()),
-            _ => (self.mesh().positions(), self.mesh().triangles()),
+            _ => (self.deformer().rest(), self.deformer().triangles()),
         };
         let ([a, b, c], [u, v, w]) = locate(deformed, triangles, p)?;
         let [pa, pb, pc] = [a, b, c].map(|v| deformed[v as usize]);

@@ -89,11 +89,12 @@ impl Document {
     }
 
     /// Where the current pose takes the picture's point `p` (image pixels at rest):
-    /// through the rest triangle that contains it. `None` off the mesh.
+    /// through the rest triangle of the mesh shown that contains it. `None` off the
+    /// mesh.
     pub fn forward(&mut self, p: DVec2) -> Option<DVec2> {
         self.deformed();
         // Drawn as parts, the parts' joined mesh (the topmost triangle first), whose
-        // vertices the positions are; else the picture's mesh.
+        // vertices the positions are; else the mesh the method moves.
         let on_top: Option<Vec<[u32; 3]>> = self.parts().map(|_| {
             let mut order = self.draw_order();
             order.reverse();
@@ -103,8 +104,8 @@ impl Document {
         let ([a, b, c], [u, v, w]) = match (self.parts(), &on_top) {
             (Some(parts), Some(order)) => super::locate(pipeline::Deformer::rest(parts), order, p)?,
             _ => {
-                let domain = self.mesh();
-                super::locate(domain.positions(), domain.triangles(), p)?
+                let deformer = self.deformer();
+                super::locate(deformer.rest(), deformer.triangles(), p)?
             }
         };
         let at = |v: u32| deformed.get(v as usize).copied();

@@ -1679,6 +1679,20 @@ fn under_a_cage_the_document_keeps_the_mesh_alone_and_c2_comes_back_as_a_reopen_
         .expect("the solve taken");
     assert!(doc.cage_deformer().is_some());
     doc.sanity_check().expect("sane solved");
+    // Posed, the picture's points are found on the cage's own mesh, which the cage
+    // moves (not on the handles' mesh, whose vertices the positions are not).
+    let mut pose = doc.cage_rest();
+    pose[2] += DVec2::new(40.0, 25.0);
+    doc.apply(Edit::CagePose(pose.iter().map(|p| p.to_array()).collect()))
+        .expect("posed");
+    let at = DVec2::new(w * 0.6, h * 0.6);
+    let (rest, _, _) = doc.unwarp(at).expect("on the picture");
+    let back = doc.forward(rest).expect("on the picture");
+    assert!(
+        back.distance(at) < 1e-6,
+        "{at} unwarped to {rest}, forward {back}"
+    );
+    assert!(rest.distance(at) > 1.0, "the cage moved the picture there");
     // Back to the handles: the very rig it left.
     doc.apply(Edit::Method(Method::C2)).expect("back");
     let rig = doc.rig().expect("a C² rig again");
