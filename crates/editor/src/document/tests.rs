@@ -1537,28 +1537,11 @@ fn pins_added_one_by_one_weigh_as_a_build_with_euclidean_distances_and_a_fixed_b
 /// bar removed. Returns the largest move of the picture twice the bar's distance to the
 /// next handle away and farther, and of its own points (within an edge of it).
 fn bar_removed_among_dragged_handles() -> (f64, f64) {
-    let image = render::decode_image(pipeline::DEFAULT_IMAGE, &render::ImageLimits::default())
-        .expect("the built-in picture");
-    let mut project = Project::from_json(pipeline::DEFAULT_RIG).expect("its rig");
-    project.density = Some(3_000);
-    let moves = [
-        [40.0, -20.0],
-        [0.0; 2],
-        [-20.0, -60.0],
-        [-20.0, 40.0],
-        [60.0, 30.0],
-        [-90.0, -150.0],
-    ];
-    for (h, t) in project.handles.iter_mut().zip(moves) {
-        if let HandleSpec::Point { translate, .. } = h {
-            *translate = t;
-        }
-    }
-    let bar = match project.handles[1] {
+    let mut doc = built_in_posed(Method::C2);
+    let bar = match doc.project().handles[1] {
         HandleSpec::Bar { rest, .. } => rest.map(DVec2::from),
         _ => panic!("the sample rig's second handle is its bar"),
     };
-    let mut doc = Document::new(image, None, project).expect("opens");
     let shown = doc.deformed().to_vec();
     let rest = doc.mesh().positions().to_vec();
     let edge = doc.mesh().mean_edge_length();
