@@ -244,6 +244,13 @@ struct Change {
     remesh: bool,
 }
 
+/// `rest`, found by following the pose back from `at`; `at` itself where the two are
+/// within rounding (the picture is not posed there), so a handle added to a picture at
+/// rest is exactly at rest.
+pub(crate) fn unmoved(rest: DVec2, at: DVec2) -> DVec2 {
+    if rest.distance(at) < 1e-9 { at } else { rest }
+}
+
 /// A handle's rest geometry as a segment (a point's: of no length).
 fn rest_segment(handle: &HandleSpec) -> [DVec2; 2] {
     match *handle {
@@ -1489,6 +1496,22 @@ impl Document {
         (self.deformed.as_ref())
             .filter(|(v, _)| *v == version)
             .map(|(_, d)| d.as_slice())
+    }
+
+    /// The point handle a click at `at` (image pixels, current pose) places: at rest
+    /// where the picture shown there lies, with the rotation and scale the pose has
+    /// around it ([`Document::local_pose`]). `None` off the picture.
+    pub fn point_at(&mut self, at: DVec2) -> Option<HandleSpec> {
+        let (rest, _, _) = self.unwarp(at)?;
+        let rest = unmoved(rest, at);
+        let (rotate, scale) = self.local_pose(rest, at);
+        Some(HandleSpec::Point {
+            rest: rest.to_array(),
+            translate: (at - rest).to_array(),
+            rotate,
+            scale,
+            depth: 0,
+        })
     }
 
     /// The rest position under `p` in the current pose, and the local similarity the

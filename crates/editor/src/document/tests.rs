@@ -175,15 +175,7 @@ fn under_arap_a_pin_placed_in_a_bent_pose_holds_the_picture_where_it_is() {
     {
         let before = doc.deformed().to_vec();
         let at = DVec2::new(x, y);
-        let (rest, _, _) = doc.unwarp(at).expect("on the picture");
-        let (rotate, scale) = doc.local_pose(rest, at);
-        let new = HandleSpec::Point {
-            rest: rest.to_array(),
-            translate: (at - rest).to_array(),
-            rotate,
-            scale,
-            depth: 0,
-        };
+        let new = doc.point_at(at).expect("on the picture");
         doc.apply(Edit::Add(new)).expect("insert");
         let jump = before
             .iter()
@@ -608,16 +600,8 @@ fn under_c2_a_pin_placed_in_a_posed_state_is_overlaid_and_moves_no_key() {
         let before = doc.deformed().to_vec();
         let keys_before = pictures(&mut doc);
         let at = DVec2::new(x, y);
-        let (rest, _, _) = doc.unwarp(at).expect("on the picture");
-        let (rotate, scale) = doc.local_pose(rest, at);
-        doc.apply(Edit::Add(HandleSpec::Point {
-            rest: rest.to_array(),
-            translate: (at - rest).to_array(),
-            rotate,
-            scale,
-            depth: 0,
-        }))
-        .expect("insert");
+        let pin = doc.point_at(at).expect("on the picture");
+        doc.apply(Edit::Add(pin)).expect("insert");
         assert_eq!(doc.project().overlaid.len(), i + 1, "laid over the weights");
         let largest = |a: &[DVec2], b: &[DVec2]| {
             a.iter()
@@ -887,16 +871,9 @@ fn pins_placed_in_a_pose_on_parts(method: Method) -> Vec<f64> {
         DVec2::new(170.0, 326.0),
         DVec2::new(362.0, 345.0),
     ] {
-        let (rest, angle, scale) = doc
-            .unwarp(at)
+        let handle = doc
+            .point_at(at)
             .unwrap_or_else(|| panic!("{at} is on the picture"));
-        let handle = HandleSpec::Point {
-            rest: rest.to_array(),
-            translate: (at - rest).to_array(),
-            rotate: angle,
-            scale,
-            depth: 0,
-        };
         let snapshot = doc.snapshot();
         doc.apply(Edit::Add(handle)).expect("added");
         // The parts the pin binds, and those that follow them, are set up again; the
@@ -1032,15 +1009,18 @@ fn a_pin_placed_in_a_pose_on_a_part_that_follows_moves_nothing() {
             .expect("the leg's vertices");
         let at = moved[v];
         assert!(at.distance(rest[v]) > 20.0, "the knee followed the hips");
-        let (rest, angle, scale) = doc.unwarp(at).expect("on the leg");
-        doc.apply(Edit::Add(HandleSpec::Point {
-            rest: rest.to_array(),
-            translate: (at - rest).to_array(),
+        let placed = doc.point_at(at).expect("on the leg");
+        let HandleSpec::Point {
+            rest,
             rotate: angle,
             scale,
-            depth: 0,
-        }))
-        .expect("pinned");
+            ..
+        } = placed
+        else {
+            unreachable!("a point");
+        };
+        let rest = DVec2::from(rest);
+        doc.apply(Edit::Add(placed)).expect("pinned");
         let pin = doc.project().handles.len() - 1;
         assert_eq!(bound_to(&doc, pin), [leg], "{method:?}");
         let carried = &doc.project().carried;
@@ -1177,16 +1157,13 @@ fn drawn_as_parts_a_pin_placed_while_keys_exist_takes_each_key_where_it_shows_th
     // A pin on the body where it is shown: each key (the pose shown) gives it the
     // place it was clicked at (the parts' mesh, not the picture's own, says where).
     let at = DVec2::new(300.0, 420.0);
-    let (rest, angle, scale) = doc.unwarp(at).expect("on the picture");
+    let placed = doc.point_at(at).expect("on the picture");
+    let HandleSpec::Point { rest, .. } = placed else {
+        unreachable!("a point");
+    };
+    let rest = DVec2::from(rest);
     let before = shown_by_part(&doc);
-    doc.apply(Edit::Add(HandleSpec::Point {
-        rest: rest.to_array(),
-        translate: (at - rest).to_array(),
-        rotate: angle,
-        scale,
-        depth: 0,
-    }))
-    .expect("pinned");
+    doc.apply(Edit::Add(placed)).expect("pinned");
     let pin = doc.project().handles.len() - 1;
     for key in doc.keys() {
         let project::HandlePose::Point { translate, .. } = key.pose.handles[pin] else {
@@ -1838,16 +1815,8 @@ fn under_mls_a_pin_placed_in_a_pose_moves_nothing() {
     for (i, v) in picks.into_iter().enumerate() {
         let before = doc.deformed().to_vec();
         let at = before[v];
-        let (rest, _, _) = doc.unwarp(at).expect("on the picture");
-        let (rotate, scale) = doc.local_pose(rest, at);
-        doc.apply(Edit::Add(HandleSpec::Point {
-            rest: rest.to_array(),
-            translate: (at - rest).to_array(),
-            rotate,
-            scale,
-            depth: 0,
-        }))
-        .expect("insert");
+        let pin = doc.point_at(at).expect("on the picture");
+        doc.apply(Edit::Add(pin)).expect("insert");
         let jump = (before.iter().zip(doc.deformed()))
             .map(|(a, b)| a.distance(*b))
             .fold(0.0, f64::max);
@@ -1863,18 +1832,11 @@ fn under_mls_a_pin_placed_in_a_pose_moves_nothing() {
         unreachable!("the sample rig's first handle is a point");
     };
     let at = DVec2::from(rest) + DVec2::from(translate) + DVec2::new(1.0, 0.0);
-    let (rest_at, rotate, scale) = doc.unwarp(at).expect("on the picture");
+    let beside = doc.point_at(at).expect("on the picture");
     let vertices = doc.mesh().len();
     let before = doc.deformed().to_vec();
     let old_rest = doc.mesh().clone();
-    doc.apply(Edit::Add(HandleSpec::Point {
-        rest: rest_at.to_array(),
-        translate: (at - rest_at).to_array(),
-        rotate,
-        scale,
-        depth: 0,
-    }))
-    .expect("beside another");
+    doc.apply(Edit::Add(beside)).expect("beside another");
     assert!(doc.mesh().len() > vertices, "meshed anew around the pair");
     let shown_before = pipeline::carried::resample(&old_rest, &before, doc.mesh().positions());
     let jump = (shown_before.iter().zip(doc.deformed()))

@@ -17,7 +17,7 @@ use egui::{Painter, Pos2, Response, Ui};
 use glam::DVec2;
 use project::HandleSpec;
 
-use crate::document::{Document, Edit, posed};
+use crate::document::{Document, Edit, posed, unmoved};
 use crate::tool::{CanvasTool, Host, Tool};
 
 /// A drag of a handle in progress.
@@ -328,13 +328,6 @@ impl CanvasTool for HandleTool {
     }
 }
 
-/// `rest`, found by following the pose back from `at`; `at` itself where the two are
-/// within rounding (the picture is not posed there), so a handle added to a picture at
-/// rest is exactly at rest.
-fn unmoved(rest: DVec2, at: DVec2) -> DVec2 {
-    if rest.distance(at) < 1e-9 { at } else { rest }
-}
-
 /// Sets each point handle's rotation to the one that best turns the directions to its
 /// neighbours (all other handles, nearer ones weighing more) from rest to now: the
 /// pseudo-edge heuristic of bounded biharmonic weights.
@@ -380,20 +373,11 @@ pub(crate) fn auto_rotate(handles: &mut [HandleSpec]) {
 /// the picture shown there lies, with the rotation and scale the pose has around it
 /// ([`Document::local_pose`]). `None` (and a message) off the picture.
 fn point_under(host: &mut dyn Host, at: DVec2) -> Option<HandleSpec> {
-    let doc = host.document_mut()?;
-    let Some((rest, _, _)) = doc.unwarp(at) else {
+    let point = host.document_mut()?.point_at(at);
+    if point.is_none() {
         host.error(&anyhow::anyhow!("click on the picture to add a handle"));
-        return None;
-    };
-    let rest = unmoved(rest, at);
-    let (rotate, scale) = doc.local_pose(rest, at);
-    Some(HandleSpec::Point {
-        rest: rest.to_array(),
-        translate: (at - rest).to_array(),
-        rotate,
-        scale,
-        depth: 0,
-    })
+    }
+    point
 }
 
 #[cfg(test)]
