@@ -28,6 +28,7 @@ mod animation;
 mod cage;
 mod checks;
 mod depth;
+mod rigging;
 mod shown;
 #[cfg(test)]
 mod tests;
@@ -315,8 +316,10 @@ impl Document {
         project.density = Some(project.density.unwrap_or(pipeline::DEFAULT_DENSITY));
         // Drawn as parts under handles, the parts are set up beside the picture's own
         // mesh and rig, on the other core.
-        let parts_layers = (layers.as_deref())
-            .filter(|_| project.parts.is_some() && project.method.controls() == Controls::Handles);
+        let parts_layers = (layers.as_deref()).filter(|_| {
+            project.parts.is_some()
+                && rigging::rigging(project.method.controls()).parts_set_up_on_opening()
+        });
         let (base, parts) = rayon::join(
             || Base::of(&image, &project),
             || parts_layers.map(|layers| PartsDeformer::new(layers, &project, None, &())),
@@ -372,9 +375,13 @@ impl Document {
 
     /// [`Document::sync_method`]'s first half: the deformer alone.
     fn sync_deformer(&mut self) -> Result<()> {
-        if self.project.method.controls() == Controls::Cage {
-            return self.sync_cage();
-        }
+        let rigging = self.rigging();
+        rigging.sync(self)
+    }
+
+    /// [`Document::sync_deformer`] under handles: the method set up on the picture's
+    /// mesh or on the parts (C²: the rig itself, no deformer).
+    fn sync_handles(&mut self) -> Result<()> {
         // Set up already where working out an edit did (a shape carried).
         if let Some(mut primed) = self.primed.take()
             && primed.method() == self.project.method
@@ -767,15 +774,10 @@ impl Document {
                 }
             }
             Edit::Settings(settings) => settings.write_to(&mut project),
-            Edit::Method(method)
-                if method.controls() == Controls::Cage && project.cage.is_none() =>
-            {
-                bail!(
-                    "{} warps by a cage: draw one first with the cage tool (K)",
-                    method.name().to_uppercase()
-                )
-            }
             Edit::Method(method) => {
+                if let Some(why) = rigging::rigging(method.controls()).refusal(method, &project) {
+                    bail!(why);
+                }
                 if method != project.method {
                     // The picture's shape is carried on its method's warp.
                     project.carried.retain(|c| c.part.is_some());
@@ -1439,8 +1441,10 @@ impl Document {
         let mesh = new_mesh.as_ref().unwrap_or(self.mesh());
         weights_core::check_handles_on(mesh, &pipeline::handles(&project))?;
         let parts = self.layers.is_some() && project.parts.is_some();
-        let handles = project.method.controls() == Controls::Handles;
-        let fresh = if handles && !parts && (new_mesh.is_some() || self.method.is_none()) {
+        let fresh = if project.method.sets_up_on_the_mesh()
+            && !parts
+            && (new_mesh.is_some() || self.method.is_none())
+        {
             pipeline::on_mesh(&project, mesh, Some(&self.image))?
         } else {
             None

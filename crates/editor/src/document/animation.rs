@@ -3,7 +3,7 @@
 
 use anyhow::Result;
 use glam::DVec2;
-use project::{Animation, Controls, HandlePose, HandleSpec, Key, Pose};
+use project::{Animation, HandlePose, HandleSpec, Key, Pose};
 
 use super::Document;
 
@@ -131,23 +131,12 @@ impl Document {
             .map(|k| k.pose.clone())
             .chain(animation.spatial_keys.iter().map(|k| k.pose.clone()))
             .collect();
-        if self.project.method.controls() == Controls::Cage {
-            return Ok(vec![HandlePose::rest(handle); poses.len()]);
-        }
-        let current = self.project.clone();
-        let fitted = poses
-            .iter()
-            .map(|pose| {
-                self.show_pose(pose)?;
-                Ok(self.fit(handle))
-            })
-            .collect::<Result<Vec<_>>>();
-        self.restore(current)?;
-        fitted
+        let rigging = self.rigging();
+        rigging.fit_into(self, handle, &poses)
     }
 
     /// `handle`'s pose that fits the current pose (see [`Document::fit_into_keys`]).
-    fn fit(&mut self, handle: &HandleSpec) -> HandlePose {
+    pub(super) fn fit(&mut self, handle: &HandleSpec) -> HandlePose {
         match *handle {
             HandleSpec::Point { rest, .. } => {
                 let rest = DVec2::from(rest);
@@ -185,15 +174,10 @@ impl Document {
         let current = self.project.clone();
         let shown = self.show_pose(pose).map(|_| {
             let deformer = self.deformer();
-            let cage = deformer.method().controls() == Controls::Cage;
             PosedMesh {
                 rest: deformer.rest().to_vec(),
                 deformed: deformer.deformed(),
-                triangles: if cage {
-                    deformer.triangles().to_vec()
-                } else {
-                    self.draw_order()
-                },
+                triangles: self.rigging().drawn_triangles(self),
             }
         });
         self.restore(current)?;

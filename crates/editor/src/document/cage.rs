@@ -284,8 +284,9 @@ impl Document {
     /// the current one's rows are coordinates, and the pose deforms its mesh to finite
     /// points.
     pub(super) fn cage_sanity_check(&self) -> Result<()> {
-        if self.project.method.controls() == Controls::Cage && self.project.cage.is_none() {
-            bail!("{} without a cage", self.project.method.label());
+        let method = self.project.method;
+        if let Some(why) = self.rigging().refusal(method, &self.project) {
+            bail!("{} chosen though {why}", method.label());
         }
         if self.solutions.len() > SOLUTIONS_KEPT {
             bail!("{} solved cages kept", self.solutions.len());

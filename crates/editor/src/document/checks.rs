@@ -4,7 +4,7 @@
 use std::sync::Arc;
 
 use anyhow::{Context, Result, bail};
-use pipeline::{Controls, Deformer, Follow};
+use pipeline::{Deformer, Follow};
 use project::Project;
 
 use super::Document;
@@ -81,14 +81,7 @@ impl Document {
     fn method_sanity_check(&self) -> Result<()> {
         let method = self.project.method;
         let Some((mesh, deformer)) = &self.method else {
-            // The rig is the deformer (C²), or the cage is not solved yet.
-            let ok = match method.controls() {
-                Controls::Handles => self
-                    .rig()
-                    .is_some_and(|rig| Deformer::method(rig) == method),
-                Controls::Cage => self.cage_solution().is_none(),
-            };
-            if !ok {
+            if !self.rigging().may_have_no_state(self) {
                 bail!("method {} has no deformer", method.name());
             }
             return Ok(());
@@ -100,57 +93,7 @@ impl Document {
                 deformer.method().name()
             );
         }
-        match method.controls() {
-            Controls::Handles if self.project.parts.is_some() => {
-                let parts = self.parts().context("drawn as parts without the parts")?;
-                if *mesh != self.mesh_version || self.layers.is_none() {
-                    bail!("the parts were set up for another picture");
-                }
-                if parts.rest().len() != parts.composer().uv().len() {
-                    bail!("the parts' mesh and texture disagree");
-                }
-                let layers = self.layers.as_deref().context("parts without layers")?;
-                if parts.rig().bindings() != pipeline::parts::bindings(layers, &self.project)? {
-                    bail!("the parts are bound otherwise than the rig file binds them");
-                }
-                // Each overlap's order is kept at a triangle's rest centroid on the
-                // part it names (looked up by the bits of its coordinates, -0 as 0).
-                let key =
-                    |part: Option<usize>, at: [f64; 2]| (part, at.map(|c| (c + 0.0).to_bits()));
-                let places: Vec<_> = (self.project.overlaps.iter())
-                    .flat_map(|o| [o.front, o.back])
-                    .collect();
-                let mut missing: std::collections::HashSet<_> =
-                    places.iter().map(|p| key(p.part, p.at)).collect();
-                let (rest, triangles) = (parts.rest(), parts.triangles());
-                for (t, &k) in triangles.iter().zip(parts.part_of()) {
-                    if missing.is_empty() {
-                        break;
-                    }
-                    let centroid = t.iter().map(|&v| rest[v as usize]).sum::<glam::DVec2>() / 3.0;
-                    missing.remove(&key(Some(k as usize), centroid.to_array()));
-                }
-                if let Some(place) = places.iter().find(|p| missing.contains(&key(p.part, p.at))) {
-                    bail!("an overlap's order is kept at {place:?}, on no triangle of that part");
-                }
-            }
-            Controls::Handles => {
-                if *mesh != self.mesh_version || deformer.rest() != self.mesh().positions() {
-                    bail!("the {} deformer was set up on another mesh", method.name());
-                }
-            }
-            Controls::Cage => {
-                // The solved cage's deformer, or the picture at rest until it is solved.
-                let in_step = match (self.cage_deformer(), self.cage_solution()) {
-                    (Some(cage), Some(solved)) => Arc::ptr_eq(cage.solution(), solved),
-                    (None, None) => deformer.as_any().is::<pipeline::Still>(),
-                    _ => false,
-                };
-                if !in_step {
-                    bail!("the cage deformer is not the rig file's solved cage");
-                }
-            }
-        }
+        self.rigging().check(self, *mesh, deformer.as_ref())?;
         let deformed = deformer.deformed();
         if let Some(v) = deformed.iter().position(|p| !p.is_finite()) {
             bail!("{} sends sample {v} to a non-finite point", method.label());
@@ -161,6 +104,56 @@ impl Document {
                 "the {} deformer is out of step with the rig file",
                 method.label()
             );
+        }
+        Ok(())
+    }
+
+    /// The parts' part of [`Document::method_sanity_check`]: set up for this picture,
+    /// bound as the rig file binds them, and every overlap's order kept on a triangle.
+    pub(super) fn parts_sanity_check(&self, mesh: u64) -> Result<()> {
+        let parts = self.parts().context("drawn as parts without the parts")?;
+        if mesh != self.mesh_version || self.layers.is_none() {
+            bail!("the parts were set up for another picture");
+        }
+        if parts.rest().len() != parts.composer().uv().len() {
+            bail!("the parts' mesh and texture disagree");
+        }
+        let layers = self.layers.as_deref().context("parts without layers")?;
+        if parts.rig().bindings() != pipeline::parts::bindings(layers, &self.project)? {
+            bail!("the parts are bound otherwise than the rig file binds them");
+        }
+        // Each overlap's order is kept at a triangle's rest centroid on the
+        // part it names (looked up by the bits of its coordinates, -0 as 0).
+        let key = |part: Option<usize>, at: [f64; 2]| (part, at.map(|c| (c + 0.0).to_bits()));
+        let places: Vec<_> = (self.project.overlaps.iter())
+            .flat_map(|o| [o.front, o.back])
+            .collect();
+        let mut missing: std::collections::HashSet<_> =
+            places.iter().map(|p| key(p.part, p.at)).collect();
+        let (rest, triangles) = (parts.rest(), parts.triangles());
+        for (t, &k) in triangles.iter().zip(parts.part_of()) {
+            if missing.is_empty() {
+                break;
+            }
+            let centroid = t.iter().map(|&v| rest[v as usize]).sum::<glam::DVec2>() / 3.0;
+            missing.remove(&key(Some(k as usize), centroid.to_array()));
+        }
+        if let Some(place) = places.iter().find(|p| missing.contains(&key(p.part, p.at))) {
+            bail!("an overlap's order is kept at {place:?}, on no triangle of that part");
+        }
+        Ok(())
+    }
+
+    /// The cage's part of [`Document::method_sanity_check`]: `deformer` is the solved
+    /// cage's, or the picture at rest until it is solved.
+    pub(super) fn cage_deformer_check(&self, deformer: &dyn Deformer) -> Result<()> {
+        let in_step = match (self.cage_deformer(), self.cage_solution()) {
+            (Some(cage), Some(solved)) => Arc::ptr_eq(cage.solution(), solved),
+            (None, None) => deformer.as_any().is::<pipeline::Still>(),
+            _ => false,
+        };
+        if !in_step {
+            bail!("the cage deformer is not the rig file's solved cage");
         }
         Ok(())
     }

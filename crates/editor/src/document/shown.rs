@@ -31,14 +31,7 @@ impl Document {
     /// cage being drawn). Parts are drawn under handles, and under a cage that moves
     /// them; a cage drawn over a handle method shows the picture at rest.
     pub fn shown(&self, in_hand: Controls, warping: bool) -> Shown<'_> {
-        match (in_hand, self.parts()) {
-            (Controls::Handles, Some(parts)) => Shown::Parts(parts),
-            (Controls::Cage, Some(parts)) if self.controls() == Controls::Cage => {
-                Shown::Parts(parts)
-            }
-            (Controls::Handles, None) => Shown::Picture(self.deformer()),
-            (Controls::Cage, _) => Shown::Cage(self.cage_deformer().filter(|_| warping)),
-        }
+        super::rigging::rigging(in_hand).shown(self, warping)
     }
 }
 
