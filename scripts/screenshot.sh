@@ -47,7 +47,7 @@ if [ "$mode" = cage ]; then
   # (Enter) and a wait for the solve.
   xdotool key k
   sleep 1
-  xdotool mousemove 67 397 click 1
+  xdotool mousemove 67 341 click 1
   sleep 1
   xdotool key h
   sleep 0.5
@@ -55,8 +55,8 @@ if [ "$mode" = cage ]; then
   # The solve takes a few seconds in a release build.
   sleep "${SOLVE_SECONDS:-12}"
   # The cage's vertex by the tail's end, then the one by the front leg.
-  drag 933 567 975 480
-  drag 739 261 800 192
+  drag 926 565 968 478
+  drag 735 263 796 194
   xdotool mousemove 1100 760
   sleep 1.5
   import -window root "$out"

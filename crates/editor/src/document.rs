@@ -805,6 +805,9 @@ impl Document {
             Edit::Cuts(cuts) => project.cuts = cuts,
             Edit::Cage { rest, vertices } => {
                 if project.lbc.and_then(|l| l.density).is_none() {
+                    // The first cage's count; a cage of very many vertices gets fewer
+                    // inside, so that the default is never refused as too much work.
+                    let vertices = vertices.min(pipeline::cage::default_cage_vertices(rest.len()));
                     project.lbc = Some(LbcSettings {
                         density: Some(vertices),
                         ..project.lbc.unwrap_or_default()

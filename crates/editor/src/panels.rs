@@ -123,8 +123,10 @@ impl eframe::App for EditorApp {
             if ctx.input_mut(|i| i.consume_key(Modifiers::NONE, Key::Escape)) {
                 self.cancel_job();
             }
-            // Keep the elapsed time and the spinner moving.
-            ctx.request_repaint_after(std::time::Duration::from_millis(100));
+            // Keep the elapsed time and the spinner moving, four times a second: more
+            // often, drawing the window (in software, on a machine without a GPU) took
+            // the cores a solve on the worker needs.
+            ctx.request_repaint_after(std::time::Duration::from_millis(250));
         } else if self.pending.is_none() && self.file_dialog.is_none() {
             // A question or a dialog takes the keys: nothing acts on the document
             // behind it.

@@ -25,17 +25,26 @@ use crate::deformer::{
 };
 
 /// Mesh vertices inside a cage when neither a `--density` nor the rig names a count:
-/// the solve's time grows quickly with it (a few seconds at this size).
-pub const DEFAULT_CAGE_VERTICES: usize = 2000;
+/// the picture's own default density ([`crate::DEFAULT_DENSITY`]), so that a picture
+/// warped by a cage is as fine as one warped by handles (the solve takes 1.5–2.5 s at
+/// this size on a 2-core machine; see docs/performance.md).
+pub const DEFAULT_CAGE_VERTICES: usize = crate::DEFAULT_DENSITY;
 
 /// How many mesh vertices the inside of `project`'s cage is triangulated to: `density`
 /// (a command line's `--density`) if given, else the rig's `lbc.density`, else its
-/// `density`, else [`DEFAULT_CAGE_VERTICES`].
+/// `density`, else [`default_cage_vertices`] for its cage.
 pub fn cage_vertices(project: &Project, density: Option<usize>) -> usize {
     density
         .or(project.lbc.and_then(|l| l.density))
         .or(project.density)
-        .unwrap_or(DEFAULT_CAGE_VERTICES)
+        .unwrap_or_else(|| default_cage_vertices(project.cage.as_ref().map_or(0, |c| c.rest.len())))
+}
+
+/// Mesh vertices inside a cage of `corners` vertices when nothing names a count:
+/// [`DEFAULT_CAGE_VERTICES`], or fewer where a cage has so many vertices that the solve
+/// would pass [`MAX_CAGE_WORK`] (a default is never refused).
+pub fn default_cage_vertices(corners: usize) -> usize {
+    DEFAULT_CAGE_VERTICES.min(MAX_CAGE_WORK / corners.max(1))
 }
 
 /// The most work a solve may take: mesh vertices inside the cage times cage vertices.
@@ -756,6 +765,28 @@ mod tests {
     #[test]
     fn cage_density_follows_the_command_line_then_lbc_then_the_rig() {
         let mut project = Project::default();
+        assert_eq!(cage_vertices(&project, None), DEFAULT_CAGE_VERTICES);
+        // By default, as fine as the picture's own mesh…
+        assert_eq!(DEFAULT_CAGE_VERTICES, crate::DEFAULT_DENSITY);
+        // …unless the cage has so many vertices that the solve would be refused.
+        let ring = |n: usize| {
+            (0..n)
+                .map(|i| {
+                    let a = i as f64 / n as f64 * std::f64::consts::TAU;
+                    [100.0 * a.cos(), 100.0 * a.sin()]
+                })
+                .collect()
+        };
+        project.cage = Some(project::CageSpec {
+            rest: ring(1000),
+            pose: None,
+        });
+        assert_eq!(cage_vertices(&project, None), 3000);
+        assert!(check_work(cage_vertices(&project, None), 1000).is_ok());
+        project.cage = Some(project::CageSpec {
+            rest: ring(26),
+            pose: None,
+        });
         assert_eq!(cage_vertices(&project, None), DEFAULT_CAGE_VERTICES);
         project.density = Some(5000);
         assert_eq!(cage_vertices(&project, None), 5000);

@@ -188,13 +188,14 @@ impl CageTool {
         let mut density = self.density_draft.unwrap_or(current_density);
         let r = ui
             .add(
-                egui::Slider::new(&mut density, 100..=20_000)
+                egui::Slider::new(&mut density, 100..=100_000)
                     .logarithmic(true)
                     .text("Vertices inside"),
             )
             .on_hover_text(
                 "The mesh inside the cage the coordinates are solved on: more is smoother \
-                 and slower",
+                 and slower (20,000, the picture's own density, by default: a second or \
+                 two to solve)",
             );
         if r.drag_stopped() || (r.changed() && !r.dragged()) {
             settings.density = Some(density);

@@ -29,7 +29,7 @@ impl EditorApp {
             }
             if let Some((what, seconds)) = self.busy_with() {
                 ui.separator();
-                ui.spinner();
+                turning_arc(ui, seconds);
                 ui.label(format!("{what}… {seconds:.1} s"));
                 if let Some((first, last)) = self.solve_progress() {
                     ui.add(
@@ -257,4 +257,26 @@ fn solve_text(p: &lbc::Progress) -> String {
         p.dual_threshold,
         p.penalty
     )
+}
+
+/// A spinner that turns with `seconds`: the frame loop's repaints while a job runs
+/// (ten a second) move it. (egui's own spinner asks for a repaint every frame, which
+/// on a machine drawing in software took the cores a solve on the worker needs: a
+/// cage took three times as long in the editor as on the command line.)
+fn turning_arc(ui: &mut egui::Ui, seconds: f64) {
+    let size = ui.spacing().interact_size.y;
+    let (rect, _) = ui.allocate_exact_size(egui::vec2(size, size), egui::Sense::hover());
+    if !ui.is_rect_visible(rect) {
+        return;
+    }
+    let radius = rect.height() / 2.0 - 2.0;
+    let start = (seconds * std::f64::consts::TAU) as f32;
+    let points: Vec<egui::Pos2> = (0..=20)
+        .map(|i| {
+            let angle = start + i as f32 / 20.0 * std::f32::consts::PI * 1.5;
+            rect.center() + radius * egui::vec2(angle.cos(), angle.sin())
+        })
+        .collect();
+    let stroke = ui.visuals().widgets.noninteractive.fg_stroke;
+    ui.painter().add(egui::Shape::line(points, stroke));
 }
