@@ -120,6 +120,43 @@ fn keys_set_by_posing_at_a_time_play_back_and_undo() {
 }
 
 #[test]
+fn a_key_set_between_frames_keeps_the_pose_shown() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    three_keys(&mut h);
+    step(&mut h, -18);
+    // Playback paused leaves the time between two frames.
+    h.key_press(Key::Space);
+    h.step();
+    std::thread::sleep(std::time::Duration::from_millis(130));
+    h.step();
+    h.key_press(Key::Space);
+    h.run();
+    let fps = 24.0;
+    let off_frame = |t: f64| (t * fps - (t * fps).round()).abs();
+    let between = h.state().timeline.time;
+    assert!(
+        off_frame(between) > 1e-6,
+        "paused between frames ({between} s)"
+    );
+    let shown = pose(&h);
+
+    // I: a key at the frame, holding the pose shown, which stays shown (it showed
+    // the new key blended with the next one, the pose at the time it was).
+    h.key_press(Key::I);
+    h.run();
+    let time = h.state().timeline.time;
+    assert!(off_frame(time) < 1e-9, "the key's frame ({time} s)");
+    let key = keys(&h)
+        .into_iter()
+        .find(|k| (k.time - time).abs() < 1e-9)
+        .expect("a key at the frame");
+    assert_eq!(key.pose, shown, "the key holds the pose shown");
+    assert_eq!(pose(&h), shown, "and the pose shown stays");
+    h.state().sanity_check().expect("the editor's invariants");
+}
+
+#[test]
 fn handles_added_or_removed_keep_every_key() {
     let dir = tempfile::tempdir().expect("temp dir");
     let mut h = editor(dir.path());

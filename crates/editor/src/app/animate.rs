@@ -175,10 +175,16 @@ impl EditorApp {
         let time = snap(self.timeline.time, self.fps());
         let animation = doc.keyed_at(time);
         let count = animation.keys.len();
+        // The timeline moves to the key's frame before the edit, which shows the keys'
+        // pose at the timeline's time: at the time it was (between frames, after
+        // playback or a scrub) that is the new key blended with the next one, not the
+        // pose just keyed.
+        let was = std::mem::replace(&mut self.timeline.time, time);
         if self.edit(Edit::Animation(Some(Box::new(animation)))) {
-            self.timeline.time = time;
             let keys = if count == 1 { "key" } else { "keys" };
             self.info(format!("key set at {time:.2} s ({count} {keys})"));
+        } else {
+            self.timeline.time = was;
         }
     }
 
