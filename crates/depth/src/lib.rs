@@ -408,11 +408,6 @@ fn decide(
     }
     was.sort_unstable();
     let mut vote = vec![0.0f64; grown.count];
-    // For each region and remembered region: triangles of A seen in its front and
-    // back, of B in its front and back.
-    let mut seen: Vec<Vec<(usize, [u64; 4])>> = vec![Vec::new(); grown.count];
-    // The region (plus one) in which each triangle was last counted, per sheet.
-    let mut counted = vec![[0usize; 2]; involved.triangles.len()];
     for (p, &(region, s_in_a)) in pairs.iter().zip(&grown.sides) {
         let (a, b) = if s_in_a { (p.s, p.t) } else { (p.t, p.s) };
         vote[region] += if rank[a as usize] > rank[b as usize] {
@@ -420,9 +415,37 @@ fn decide(
         } else {
             -p.area
         };
-        if was.is_empty() {
-            continue;
+    }
+    // For each region and remembered region: triangles of A seen in its front and
+    // back, of B in its front and back, each triangle once.
+    let mut seen: Vec<Vec<(usize, [u64; 4])>> = vec![Vec::new(); grown.count];
+    // The region (plus one) in which each triangle was last counted, per sheet: the
+    // pairs are visited region by region (a counting sort by region), so that a
+    // triangle in many pairs of a region is counted once there however the pairs
+    // were found (counted again each time another region's pair came between, it
+    // weighed each remembered triangle by its number of pairs, which a rig file's
+    // saved orders, one pair of triangles each, do not know).
+    let mut counted = vec![[0usize; 2]; involved.triangles.len()];
+    let by_region = if was.is_empty() {
+        Vec::new()
+    } else {
+        let mut start = vec![0usize; grown.count + 1];
+        for &(region, _) in &grown.sides {
+            start[region + 1] += 1;
         }
+        for r in 0..grown.count {
+            start[r + 1] += start[r];
+        }
+        let mut by_region = vec![0usize; grown.sides.len()];
+        for (k, &(region, _)) in grown.sides.iter().enumerate() {
+            by_region[start[region]] = k;
+            start[region] += 1;
+        }
+        by_region
+    };
+    for &k in &by_region {
+        let (p, (region, s_in_a)) = (&pairs[k], grown.sides[k]);
+        let (a, b) = if s_in_a { (p.s, p.t) } else { (p.t, p.s) };
         for (t, on_a) in [(a, true), (b, false)] {
             let i = involved.index(t);
             let mark = &mut counted[i][usize::from(!on_a)];
