@@ -386,7 +386,8 @@ fn grow_regions(involved: &Involved, pairs: &[overlap::Pair]) -> Grown {
 
 /// For each region, whether its sheet A is in front: as the remembered region it
 /// continues has it (the one sharing triangles with both its sheets; with several, the
-/// most shared), else as the predefined order has most of its area.
+/// most shared, and the majority of those that share as much), else as the predefined
+/// order has most of its area.
 fn decide(
     involved: &Involved,
     grown: &Grown,
@@ -469,15 +470,32 @@ fn decide(
     }
     (0..grown.count)
         .map(|region| {
-            let (mut same, mut swapped) = (0u64, 0u64);
-            for &(_, [a_front, a_back, b_front, b_back]) in &seen[region] {
-                if a_front > 0 && b_back > 0 {
-                    same += a_front + b_back;
-                }
-                if a_back > 0 && b_front > 0 {
-                    swapped += a_back + b_front;
-                }
-            }
+            // What each remembered region says: its triangles found in this one's
+            // sheets the same way round, and turned over.
+            let says = seen[region]
+                .iter()
+                .map(|&(_, [a_front, a_back, b_front, b_back])| {
+                    let same = if a_front > 0 && b_back > 0 {
+                        a_front + b_back
+                    } else {
+                        0
+                    };
+                    let swapped = if a_back > 0 && b_front > 0 {
+                        a_back + b_front
+                    } else {
+                        0
+                    };
+                    (same, swapped)
+                });
+            // The region continues the remembered one it shares most with; where
+            // several share as much (a file's saved orders: one pair of triangles
+            // each), they decide by majority. (Summed over every remembered region,
+            // the regions that share only some of its triangles — a sheet that is also
+            // the middle of a stack of three — could outvote the one it continues.)
+            let most = says.clone().map(|(a, b)| a.max(b)).max().unwrap_or(0);
+            let (same, swapped) = says
+                .filter(|&(a, b)| most > 0 && a.max(b) == most)
+                .fold((0, 0), |(s, w), (a, b)| (s + a, w + b));
             match same.cmp(&swapped) {
                 std::cmp::Ordering::Greater => true,
                 std::cmp::Ordering::Less => false,
