@@ -157,6 +157,28 @@ fn a_key_set_between_frames_keeps_the_pose_shown() {
 }
 
 #[test]
+fn reset_pose_with_record_armed_is_keyed_as_any_pose() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = editor(dir.path());
+    three_keys(&mut h);
+    // At the last key, with *Record* armed but no take under way (no drag).
+    click_label(&mut h, "⏺ Record");
+    assert!(h.state().timeline.is_recording() && !h.state().timeline.is_taking());
+    let before = pose(&h);
+    click_label(&mut h, "Reset pose");
+    let shown = pose(&h);
+    assert_ne!(shown, before, "the pose went back to rest");
+    let time = h.state().timeline.time;
+    let project = h.state().document().expect("doc").project().clone();
+    assert_eq!(
+        animation::pose_at(&project, time).expect("a pose").handles,
+        shown.handles,
+        "the keys show the pose shown at {time} s"
+    );
+    h.state().sanity_check().expect("the editor's invariants");
+}
+
+#[test]
 fn handles_added_or_removed_keep_every_key() {
     let dir = tempfile::tempdir().expect("temp dir");
     let mut h = editor(dir.path());

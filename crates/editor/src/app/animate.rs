@@ -305,9 +305,12 @@ impl EditorApp {
     }
 
     /// After a pose change at the timeline's time (an edit, or a drag's end, from
-    /// `before`): with keys, the pose is keyed there, in the same undo step.
+    /// `before`): with keys, the pose is keyed there, in the same undo step. A take
+    /// under way keys its own frames; with *Record* merely armed, a pose changed
+    /// otherwise than by a take's drag (*Reset pose*, a pasted pose) is keyed as
+    /// always, or the keys would show another pose at that time.
     pub(crate) fn autokey(&mut self, before: &project::Project) {
-        if self.timeline.is_recording() || self.tool == Tool::Perform {
+        if self.timeline.is_taking() || self.tool == Tool::Perform {
             return;
         }
         let time = snap(self.timeline.time, self.fps());
