@@ -848,18 +848,7 @@ fn pins_placed_in_a_pose_on_parts(method: Method) -> Vec<f64> {
     // (A method chosen for parts sets every part up by it: it reopens the same.)
     doc.check_reopens().expect("reopens before");
     // Each vertex where it is shown, by its part and where it lies at rest.
-    type Shown = std::collections::HashMap<(u32, [u64; 2]), DVec2>;
-    let shown = |doc: &Document| -> Shown {
-        let parts = doc.parts().expect("parts");
-        let (rest, moved) = (parts.rest(), parts.deformed());
-        (0..rest.len() as u32)
-            .filter_map(|v| {
-                let part = parts.part_of_vertex(v)?;
-                let at = rest[v as usize];
-                Some(((part, [at.x.to_bits(), at.y.to_bits()]), moved[v as usize]))
-            })
-            .collect()
-    };
+    let shown = shown_by_part;
     let before = shown(&doc);
     let mut own_moves = Vec::new();
     // On the body, the head, the raised arm and the back arm's shoulder (a joint of
