@@ -68,7 +68,7 @@ fn main() {
         deform.sort_by(f64::total_cmp);
         println!(
             "{:12} {:2} cage vertices, {:6} mesh vertices: {:6.3} s (geodesics {:.3} s, \
-             factorisation {:.3} s, ADMM {:.3} s = {} iterations × {:.2} ms, projection {:.3} s), \
+             factorisation {:.3} s, ADMM {:.3} s = {} iterations × {:.2} ms on {} threads, projection {:.3} s), \
              converged {}, objective {:.6e}, {:.2} weights per vertex, deformation {:.2} ms",
             case.name,
             case.cage.len(),
@@ -79,6 +79,7 @@ fn main() {
             r.admm.as_secs_f64(),
             r.iterations,
             r.admm.as_secs_f64() * 1e3 / r.iterations.max(1) as f64,
+            r.threads,
             r.projection.as_secs_f64(),
             r.converged,
             r.objective,

@@ -41,4 +41,7 @@ pub struct Report {
     pub admm: Duration,
     /// Time for the final projection.
     pub projection: Duration,
+    /// Threads the iterations ran on, after the first few timed them on all of
+    /// rayon's threads and on one (see the crate docs).
+    pub threads: usize,
 }

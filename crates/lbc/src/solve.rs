@@ -135,6 +135,7 @@ pub fn solve_with_distances(
         factorisation: Duration::ZERO,
         admm: Duration::ZERO,
         projection: Duration::ZERO,
+        threads: 1,
     };
     let mut clamped = None;
     if !problem.interior.is_empty() && n > 3 {
@@ -163,7 +164,7 @@ struct Problem {
     /// `√A_s·∇λ_k`: `G` of the paper with the gradient integrated over `√A_s`.
     g: Vec<[DVec2; 3]>,
     /// `φ_i^s·√A_s`, triangle-major.
-    coef: Vec<f64>,
+    coef: Vec<Stored>,
     /// `φ_i^s·A_s` and the plain gradients, for the objective.
     elements: Elements,
     phi: Vec<f64>,
@@ -220,7 +221,7 @@ impl Problem {
         let coef = phi
             .iter()
             .enumerate()
-            .map(|(si, &p)| p * elements.area[si / n].sqrt())
+            .map(|(si, &p)| (p * elements.area[si / n].sqrt()) as Stored)
             .collect();
         let mut interior = Vec::new();
         let mut row_of = vec![None; q.len()];
@@ -377,21 +378,29 @@ impl Problem {
         2 * self.triangles.len() * self.n
     }
 
-    /// `Gᵀ t₁` for the triangle part `t1` of a state vector, per unknown row (the
-    /// iterations get it from [`Problem::iterate`]'s pass over the triangles
-    /// instead; this is for the start and after a change of the penalty).
-    fn gather(&self, t1: &[f64], gt: &mut [f64]) {
+    /// `Gᵀ t₁` for the triangle part `t1` of a state vector, per unknown row: a
+    /// gather over each row's incident triangles (which sit near each other, the
+    /// triangles being numbered by their first vertex along a Z-order curve). Adding
+    /// each triangle's terms into per-thread copies of all rows instead cost 10%
+    /// more an iteration at 20k vertices, in filling and summing the copies.
+    fn gather(&self, t1: &[Stored], gt: &mut [f64]) {
+        gt.par_chunks_mut(self.n)
+            .enumerate()
+            .for_each(|(j, acc)| self.gather_row(t1, j, acc));
+    }
+
+    /// Unknown row `j` of [`Problem::gather`].
+    #[inline(always)]
+    fn gather_row(&self, t1: &[Stored], j: usize, acc: &mut [f64]) {
         let n = self.n;
-        gt.par_chunks_mut(n).enumerate().for_each(|(j, acc)| {
-            acc.fill(0.0);
-            for &(s, c) in self.incidences(j) {
-                let g = self.g[s as usize][c as usize];
-                let (tx, ty) = t1[2 * s as usize * n..(2 * s as usize + 2) * n].split_at(n);
-                for ((a, x), y) in acc.iter_mut().zip(tx).zip(ty) {
-                    *a += g.x * x + g.y * y;
-                }
+        acc.fill(0.0);
+        for &(s, c) in self.incidences(j) {
+            let g = self.g[s as usize][c as usize];
+            let (tx, ty) = t1[2 * s as usize * n..(2 * s as usize + 2) * n].split_at(n);
+            for ((a, &x), &y) in acc.iter_mut().zip(tx).zip(ty) {
+                *a += g.x * f64::from(x) + g.y * f64::from(y);
             }
-        });
+        }
     }
 
     /// The Y-update towards the targets in the state vector `t`: the unknown rows
@@ -408,19 +417,19 @@ impl Problem {
     /// last call, the dual residual's square over `μ²`: with `L = GᵀG + βM` and
     /// `L Y = R`, it is `ΔY · ΔR`, a sum over the unknown rows rather than a pass over
     /// every triangle.
-    fn y_update(&self, factor: &RowFactor, t: &[f64], b: &mut YBuffers, z: &mut [f64]) -> f64 {
+    fn y_update(&self, factor: &RowFactor, t: &[Stored], b: &mut YBuffers, z: &mut [f64]) -> f64 {
         let n = self.n;
         let t2 = &t[self.triangle_part()..];
         let gt = &b.gt;
         b.rhs.par_chunks_mut(n).enumerate().for_each(|(j, acc)| {
             let root = self.root[j];
             let row = j * n..(j + 1) * n;
-            for ((a, t), (e, g)) in acc
+            for ((a, &t), (e, g)) in acc
                 .iter_mut()
                 .zip(&t2[row.clone()])
                 .zip(self.gte[row.clone()].iter().zip(&gt[row]))
             {
-                *a = root * t - e + g;
+                *a = root * f64::from(t) - e + g;
             }
             let kt: DVec3 = acc.iter().zip(&self.k).map(|(a, k)| *a * *k).sum();
             let coef = self.ktk_inv * kt;
@@ -463,19 +472,18 @@ impl Problem {
         dual
     }
 
-    /// One ADMM iteration as a map of its state: the Y-update from `t` (into `z`),
-    /// then the multipliers `u = t − (Gz, z)`, the X-update by group soft-thresholding
-    /// (eq. 30) and the W-update by clamping (eq. 31), both over-relaxed, and the next
-    /// state `x̃ + u` into `next`; the clamped `W` goes into `clamped`. The residuals
-    /// are summed only when `measure` (they cost about a third of the pass over the
-    /// triangles).
+    /// One ADMM iteration as a map of its state, in place: the Y-update from `t`
+    /// (into `z`), then the multipliers `u = t − (Gz, z)`, the X-update by group
+    /// soft-thresholding (eq. 30) and the W-update by clamping (eq. 31), both
+    /// over-relaxed, and the next state `x̃ + u` into `t`; the clamped `W` goes into
+    /// `clamped`. The residuals are summed only when `measure` (they cost about a
+    /// third of the pass over the triangles).
     #[allow(clippy::too_many_arguments)]
     fn iterate(
         &self,
         factor: &RowFactor,
-        t: &[f64],
+        t: &mut [Stored],
         z: &mut [f64],
-        next: &mut [f64],
         clamped: &mut [f64],
         penalty: f64,
         alpha: f64,
@@ -485,88 +493,39 @@ impl Problem {
         let n = self.n;
         let dual = self.y_update(factor, t, b, z);
         let z = &*z;
-        let (t1, t2) = t.split_at(self.triangle_part());
-        let (next1, next2) = next.split_at_mut(self.triangle_part());
+        let (t1, t2) = t.split_at_mut(self.triangle_part());
         let inverse_penalty = 1.0 / penalty;
-        // The triangles in one contiguous range per part; each part also adds its
-        // triangles' `Gᵀ x̃` terms into its own buffer (the next Y-update's `Gᵀt₁`),
-        // so that no pass gathers them from every triangle again.
-        let per_part = self.triangles.len().div_ceil(b.parts.len()).max(1);
-        let parts = self.triangles.len().div_ceil(per_part).max(1);
-        let gradients = next1
-            .par_chunks_mut(2 * n * per_part)
-            .zip(t1.par_chunks(2 * n * per_part))
-            .zip(b.parts.par_iter_mut())
+        let gradients = t1
+            .par_chunks_mut(2 * n)
             .enumerate()
-            .map(|(part, ((next1, t1), gt))| {
-                gt.fill(0.0);
-                let mut r = Residuals::default();
-                for (k, (out, ts)) in next1
-                    .chunks_exact_mut(2 * n)
-                    .zip(t1.chunks_exact(2 * n))
-                    .enumerate()
-                {
-                    let s = part * per_part + k;
-                    if measure {
-                        self.shrink_triangle::<true>(s, z, ts, out, inverse_penalty, alpha, &mut r);
-                    } else {
-                        self.shrink_triangle::<false>(
-                            s,
-                            z,
-                            ts,
-                            out,
-                            inverse_penalty,
-                            alpha,
-                            &mut r,
-                        );
-                    }
-                    let (ox, oy) = out.split_at(n);
-                    for (corner, &v) in self.triangles[s].iter().enumerate() {
-                        let Some(j) = self.row_of[v as usize] else {
-                            continue;
-                        };
-                        let g = self.g[s][corner];
-                        let row = &mut gt[j as usize * n..(j as usize + 1) * n];
-                        for ((a, x), y) in row.iter_mut().zip(ox).zip(oy) {
-                            *a += g.x * x + g.y * y;
-                        }
-                    }
+            .fold(Residuals::default, |mut r, (s, ts)| {
+                if measure {
+                    self.shrink_triangle::<true>(s, z, ts, inverse_penalty, alpha, &mut r);
+                } else {
+                    self.shrink_triangle::<false>(s, z, ts, inverse_penalty, alpha, &mut r);
                 }
                 r
             })
             .reduce(Residuals::default, Residuals::add);
-        {
-            let (first, rest) = b.parts[..parts]
-                .split_first_mut()
-                .expect("one part at least");
-            let rest = &*rest;
-            b.gt.par_chunks_mut(CHUNK)
-                .zip(first.par_chunks(CHUNK))
-                .enumerate()
-                .for_each(|(c, (gt, first))| {
-                    gt.copy_from_slice(first);
-                    for other in rest {
-                        for (a, o) in gt.iter_mut().zip(&other[c * CHUNK..]) {
-                            *a += o;
-                        }
-                    }
-                });
-        }
-        let values = next2
+        // The W-update row by row, with the next Y-update's `Gᵀt₁` gathered on the
+        // way.
+        let t1 = &*t1;
+        let values = t2
             .par_chunks_mut(n)
-            .zip(t2.par_chunks(n))
             .zip(clamped.par_chunks_mut(n))
+            .zip(b.gt.par_chunks_mut(n))
             .enumerate()
-            .map(|(j, ((out, tj), wj))| {
+            .map(|(j, ((tj, wj), gt))| {
+                self.gather_row(t1, j, gt);
                 let v = self.interior[j] as usize;
                 let zj = &z[v * n..(v + 1) * n];
                 let (root, m) = (self.root[j], self.split[j]);
                 let mut r = Residuals::default();
                 for i in 0..n {
-                    let u = tj[i] / root - zj[i];
+                    let u = f64::from(tj[i]) / root - zj[i];
                     let w = (zj[i] - u).max(0.0);
                     wj[i] = w;
-                    out[i] = root * (alpha * w + (1.0 - alpha) * zj[i] + u);
+                    tj[i] = (root * (alpha * w + (1.0 - alpha) * zj[i] + u)) as Stored;
                     r.add_terms([(w - zj[i]).powi(2), w * w, zj[i] * zj[i], u * u]);
                 }
                 r.scaled(m)
@@ -580,15 +539,13 @@ impl Problem {
     /// The X-update of [`Problem::iterate`] on triangle `s`: the gradients `p = Gz`
     /// from its corners' rows, `u = t − p` from its part `ts` of the state, group
     /// soft-thresholding of `p − u` by `φ√A/μ`, over-relaxation, and its part of the
-    /// next state `x̃ + u` into `out`; the residual terms go into `r`.
-    #[allow(clippy::too_many_arguments)]
+    /// next state `x̃ + u` into `ts`; the residual terms go into `r`.
     #[inline(always)]
     fn shrink_triangle<const MEASURE: bool>(
         &self,
         s: usize,
         z: &[f64],
-        ts: &[f64],
-        out: &mut [f64],
+        ts: &mut [Stored],
         inverse_penalty: f64,
         alpha: f64,
         r: &mut Residuals,
@@ -598,24 +555,18 @@ impl Problem {
         let (za, zb, zc) = (&z[a..a + n], &z[b..b + n], &z[c..c + n]);
         let [ga, gb, gc] = self.g[s];
         let coef = &self.coef[s * n..(s + 1) * n];
-        let (tx, ty) = ts[..2 * n].split_at(n);
-        let (ox, oy) = out[..2 * n].split_at_mut(n);
-        let step = |i: usize| {
+        let (tx, ty) = ts[..2 * n].split_at_mut(n);
+        let step = |i: usize, t: DVec2| {
             let p = DVec2::new(
                 ga.x * za[i] + gb.x * zb[i] + gc.x * zc[i],
                 ga.y * za[i] + gb.y * zb[i] + gc.y * zc[i],
             );
-            shrink(
-                p,
-                DVec2::new(tx[i], ty[i]),
-                coef[i] * inverse_penalty,
-                alpha,
-            )
+            shrink(p, t, f64::from(coef[i]) * inverse_penalty, alpha)
         };
         if MEASURE {
             for i in 0..n {
-                let (next, x, p, u) = step(i);
-                (ox[i], oy[i]) = (next.x, next.y);
+                let (next, x, p, u) = step(i, DVec2::new(tx[i].into(), ty[i].into()));
+                (tx[i], ty[i]) = (next.x as Stored, next.y as Stored);
                 r.add_terms([
                     (x - p).length_squared(),
                     x.length_squared(),
@@ -624,18 +575,23 @@ impl Problem {
                 ]);
             }
         } else {
-            for i in 0..n {
-                let (next, ..) = step(i);
-                (ox[i], oy[i]) = (next.x, next.y);
-            }
+            shrink_rows(
+                [ga, gb, gc],
+                [za, zb, zc],
+                tx,
+                ty,
+                coef,
+                inverse_penalty,
+                alpha,
+            );
         }
     }
 
-    /// The state `t` = `x̃ + u` of [`Problem::iterate`]'s `next` when the penalty is
-    /// multiplied by `factor` (the scaled multipliers `u = λ/μ` divide by it):
-    /// `next − u (1 − 1/factor)`, with `u = t − (Gz, z)` recomputed from the
+    /// The state `next` = `x̃ + u` that [`Problem::iterate`] made from `t` when the
+    /// penalty is multiplied by `factor` (the scaled multipliers `u = λ/μ` divide by
+    /// it): `next − u (1 − 1/factor)`, with `u = t − (Gz, z)` recomputed from the
     /// iteration's input `t` and its `z`.
-    fn rescale(&self, t: &[f64], z: &[f64], next: &mut [f64], factor: f64) {
+    fn rescale(&self, t: &[Stored], z: &[f64], next: &mut [Stored], factor: f64) {
         let n = self.n;
         let keep = 1.0 - 1.0 / factor;
         let (t1, t2) = t.split_at(self.triangle_part());
@@ -649,8 +605,11 @@ impl Problem {
                 let g = &self.g[s];
                 for i in 0..n {
                     let p = g[0] * z[t[0] + i] + g[1] * z[t[1] + i] + g[2] * z[t[2] + i];
-                    out[i] -= keep * (ts[i] - p.x);
-                    out[n + i] -= keep * (ts[n + i] - p.y);
+                    let shift = |o: Stored, t: Stored, p: f64| {
+                        (f64::from(o) - keep * (f64::from(t) - p)) as Stored
+                    };
+                    out[i] = shift(out[i], ts[i], p.x);
+                    out[n + i] = shift(out[n + i], ts[n + i], p.y);
                 }
             });
         next2
@@ -661,7 +620,8 @@ impl Problem {
                 let v = self.interior[j] as usize;
                 let root = self.root[j];
                 for i in 0..n {
-                    out[i] -= keep * (tj[i] - root * z[v * n + i]);
+                    let u = f64::from(tj[i]) - root * z[v * n + i];
+                    out[i] = (f64::from(out[i]) - keep * u) as Stored;
                 }
             });
     }
@@ -688,7 +648,6 @@ impl Problem {
         let len = self.triangle_part() + mi * n;
         let mut buffers = YBuffers {
             gt: vec![0.0; mi * n],
-            parts: vec![vec![0.0; mi * n]; rayon::current_num_threads().max(1)],
             rhs: vec![0.0; mi * n],
             r: vec![0.0; mi * n],
             r_previous: vec![0.0; mi * n],
@@ -700,7 +659,7 @@ impl Problem {
         // variable and multiplier zero (a regularised harmonic solve), and the state
         // whose multipliers are zero, `t = (Gz, √(βM) z)`, which the Y-update maps to
         // that same `z`.
-        let mut t = vec![0.0; len];
+        let mut t: Vec<Stored> = vec![0.0; len];
         self.y_update(factor, &t, &mut buffers, z);
         let mut p = vec![DVec2::ZERO; self.triangles.len() * n];
         self.apply_g(z, &mut p);
@@ -708,14 +667,14 @@ impl Problem {
             let (t1, t2) = t.split_at_mut(self.triangle_part());
             for (ts, ps) in t1.chunks_exact_mut(2 * n).zip(p.chunks_exact(n)) {
                 for (i, p) in ps.iter().enumerate() {
-                    ts[i] = p.x;
-                    ts[n + i] = p.y;
+                    ts[i] = p.x as Stored;
+                    ts[n + i] = p.y as Stored;
                 }
             }
             for (j, &v) in self.interior.iter().enumerate() {
                 let v = v as usize;
                 for i in 0..n {
-                    t2[j * n + i] = self.root[j] * z[v * n + i];
+                    t2[j * n + i] = (self.root[j] * z[v * n + i]) as Stored;
                 }
             }
             self.gather(t1, &mut buffers.gt);
@@ -726,7 +685,7 @@ impl Problem {
         // first estimate.
         let mut mu = settings.initial_penalty.unwrap_or_else(|| {
             let gradients: f64 = p.iter().map(|p| p.length_squared()).sum();
-            let weights: f64 = self.coef.iter().map(|c| c * c).sum();
+            let weights: f64 = self.coef.iter().map(|&c| f64::from(c).powi(2)).sum();
             if gradients > 0.0 {
                 (weights / gradients).sqrt()
             } else {
@@ -734,29 +693,45 @@ impl Problem {
             }
         });
         drop(p);
-        let mut next = vec![0.0; len];
+        // The state an iteration started from, kept where the penalty may change
+        // after it (see `rescale`).
+        let mut previous: Vec<Stored> = Vec::new();
         let mut clamped = vec![0.0; mi * n];
         let alpha = settings.relaxation;
         report.converged = false;
         let tiny = 1e-14 * (len as f64).sqrt();
         let (mut last_change, mut interval) = (0, PENALTY_INTERVAL);
         let mut state = None;
+        let mut threads = ThreadChoice::new();
         for it in 1..=settings.max_iterations {
             let measure = it % MEASURE_EVERY == 0 || it == settings.max_iterations;
-            let r = self.iterate(
-                factor,
-                &t,
-                z,
-                &mut next,
-                &mut clamped,
-                mu,
-                alpha,
-                &mut buffers,
-                measure,
-            );
+            let may_rebalance =
+                measure && settings.adaptive_penalty && it - last_change >= interval;
+            if may_rebalance {
+                previous.clear();
+                previous.extend_from_slice(&t);
+            }
+            let clock = Instant::now();
+            let mut iterate = || {
+                self.iterate(
+                    factor,
+                    &mut t,
+                    z,
+                    &mut clamped,
+                    mu,
+                    alpha,
+                    &mut buffers,
+                    measure,
+                )
+            };
+            let r = match threads.single_for(it) {
+                Some(pool) => pool.install(iterate),
+                None => iterate(),
+            };
+            threads.took(it, clock.elapsed());
             report.iterations = it;
+            report.threads = threads.count();
             if !measure {
-                std::mem::swap(&mut t, &mut next);
                 let mut shown = state.unwrap_or(Progress {
                     iteration: it,
                     primal_residual: f64::INFINITY,
@@ -796,20 +771,16 @@ impl Problem {
             }
             let ratio = (state.primal_residual / state.primal_threshold)
                 / (state.dual_residual / state.dual_threshold);
-            if settings.adaptive_penalty
-                && it - last_change >= interval
-                && !(1.0 / PENALTY_BAND..=PENALTY_BAND).contains(&ratio)
-            {
+            if may_rebalance && !(1.0 / PENALTY_BAND..=PENALTY_BAND).contains(&ratio) {
                 // Residual balancing: the penalty moves towards equal relative
                 // residuals, by at most a factor of ten, and less and less often.
                 let factor = ratio.sqrt().clamp(0.1, 10.0);
                 mu *= factor;
-                self.rescale(&t, z, &mut next, factor);
-                self.gather(&next[..self.triangle_part()], &mut buffers.gt);
+                self.rescale(&previous, z, &mut t, factor);
+                self.gather(&t[..self.triangle_part()], &mut buffers.gt);
                 last_change = it;
                 interval *= 2;
             }
-            std::mem::swap(&mut t, &mut next);
         }
         Ok(clamped)
     }
@@ -870,8 +841,6 @@ impl Problem {
 struct YBuffers {
     /// `Gᵀt₁` of the state the next Y-update starts from.
     gt: Vec<f64>,
-    /// One `Gᵀt₁` buffer per part of the triangles (see [`Problem::iterate`]).
-    parts: Vec<Vec<f64>>,
     /// `R`, solved in place into `Y`.
     rhs: Vec<f64>,
     /// A copy of `R`.
@@ -882,6 +851,78 @@ struct YBuffers {
     /// The factor's working rows.
     scratch: Vec<Vec<f64>>,
 }
+
+/// Whether the iterations run on all of rayon's threads or on one, whichever a few
+/// timed iterations each way find faster (see the crate docs for why one can win).
+/// The iterates are the same either way; only the order of the residuals' sums may
+/// differ.
+struct ThreadChoice {
+    /// A pool of one thread, when rayon has more.
+    single: Option<rayon::ThreadPool>,
+    /// Time of the trial iterations on all threads and on one.
+    all: Duration,
+    one: Duration,
+    /// The choice, once the trials are done.
+    chosen_single: Option<bool>,
+}
+
+/// Iterations timed on all threads, then on one (each five long, with one that
+/// measures the residuals, so that both do the same work).
+const TRIAL_ALL: std::ops::RangeInclusive<usize> = 6..=10;
+const TRIAL_ONE: std::ops::RangeInclusive<usize> = 11..=15;
+
+impl ThreadChoice {
+    fn new() -> Self {
+        let single = (rayon::current_num_threads() > 1)
+            .then(|| rayon::ThreadPoolBuilder::new().num_threads(1).build().ok())
+            .flatten();
+        Self {
+            single,
+            all: Duration::ZERO,
+            one: Duration::ZERO,
+            chosen_single: None,
+        }
+    }
+
+    /// The one-thread pool if iteration `it` runs on it.
+    fn single_for(&self, it: usize) -> Option<&rayon::ThreadPool> {
+        let on_one = self
+            .chosen_single
+            .unwrap_or_else(|| TRIAL_ONE.contains(&it));
+        self.single.as_ref().filter(|_| on_one)
+    }
+
+    /// Iteration `it` took `time`.
+    fn took(&mut self, it: usize, time: Duration) {
+        if self.single.is_none() || self.chosen_single.is_some() {
+            return;
+        }
+        if TRIAL_ALL.contains(&it) {
+            self.all += time;
+        } else if TRIAL_ONE.contains(&it) {
+            self.one += time;
+            if it == *TRIAL_ONE.end() {
+                self.chosen_single = Some(self.one < self.all);
+            }
+        }
+    }
+
+    /// Threads the iterations run on now.
+    fn count(&self) -> usize {
+        match self.chosen_single {
+            Some(true) => 1,
+            _ if self.single.is_none() => 1,
+            _ => rayon::current_num_threads(),
+        }
+    }
+}
+
+/// How the iterations keep their state and the weights `φ√A`, which they stream
+/// through once an iteration: single precision halves that traffic, the largest part
+/// of an iteration on a large mesh, and every sum and update is done in double
+/// precision. (Rounding the state to 6·10⁻⁸ relative is far below the relative stop
+/// at 10⁻³; the coordinates themselves are solved in double precision.)
+type Stored = f32;
 
 /// Chunk length of the parallel sums over the unknown rows.
 const CHUNK: usize = 1 << 14;
@@ -941,6 +982,35 @@ fn shrink(p: DVec2, t: DVec2, threshold: f64, alpha: f64) -> (DVec2, DVec2, DVec
     let keep = (1.0 - threshold / a.length().max(f64::MIN_POSITIVE)).max(0.0);
     let x = keep * a;
     (alpha * x + (1.0 - alpha) * p + u, x, p, u)
+}
+
+/// The non-measuring X-update of one triangle (see [`Problem::shrink_triangle`]),
+/// written on plain numbers over whole rows so that the compiler works on several
+/// cage vertices at once.
+#[inline(never)]
+fn shrink_rows(
+    [ga, gb, gc]: [DVec2; 3],
+    [za, zb, zc]: [&[f64]; 3],
+    tx: &mut [Stored],
+    ty: &mut [Stored],
+    coef: &[Stored],
+    inverse_penalty: f64,
+    alpha: f64,
+) {
+    let n = tx.len();
+    let (ty, coef) = (&mut ty[..n], &coef[..n]);
+    let (za, zb, zc) = (&za[..n], &zb[..n], &zc[..n]);
+    for i in 0..n {
+        let px = ga.x * za[i] + gb.x * zb[i] + gc.x * zc[i];
+        let py = ga.y * za[i] + gb.y * zb[i] + gc.y * zc[i];
+        let ux = f64::from(tx[i]) - px;
+        let uy = f64::from(ty[i]) - py;
+        let (ax, ay) = (px - ux, py - uy);
+        let length = (ax * ax + ay * ay).sqrt().max(f64::MIN_POSITIVE);
+        let keep = (1.0 - f64::from(coef[i]) * inverse_penalty / length).max(0.0);
+        tx[i] = (alpha * keep * ax + (1.0 - alpha) * px + ux) as Stored;
+        ty[i] = (alpha * keep * ay + (1.0 - alpha) * py + uy) as Stored;
+    }
 }
 
 /// `β`: the `W = W̃` split enters the augmented Lagrangian as `β‖W − W̃‖²_M`, the

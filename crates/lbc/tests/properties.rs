@@ -210,6 +210,35 @@ fn converged_objective_is_stable() {
     );
 }
 
+/// The iterations run on all of rayon's threads or on one, whichever the first few
+/// find faster: either way the iterates are the same, so a solve on one thread and
+/// one on two give the same coordinates (the residuals' sums may be added in another
+/// order, which can only move the last bits of the stopping test).
+#[test]
+fn one_thread_or_two_solve_alike() {
+    let domain = Domain::triangulate(&star(10, false), 1500).expect("triangulates");
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a pool");
+        pool.install(|| solve(&domain, &Settings::default(), &mut |_| true).expect("solves"))
+    };
+    let (one, two) = (run(1), run(2));
+    assert_eq!(one.report.threads, 1);
+    assert!(
+        one.report.iterations > 15,
+        "the solve outlasts the trials ({} iterations)",
+        one.report.iterations
+    );
+    assert_eq!(one.report.iterations, two.report.iterations);
+    for v in 0..one.vertices() {
+        for (a, b) in one.row(v).iter().zip(two.row(v)) {
+            assert!((a - b).abs() < 1e-12, "vertex {v}: {a} vs {b}");
+        }
+    }
+}
+
 #[test]
 fn progress_can_cancel() {
     let domain = Domain::triangulate(&star(8, false), 200).expect("triangulates");

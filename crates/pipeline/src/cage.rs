@@ -431,6 +431,7 @@ impl Deformer for CageDeformer {
             factorisation_ms: ms(report.factorisation),
             admm_iterations: report.iterations,
             admm_ms: ms(report.admm),
+            admm_threads: report.threads,
             projection_ms: ms(report.projection),
             converged: report.converged,
             nonzeros_per_vertex: solved.weights.len() as f64
@@ -488,6 +489,8 @@ struct LbcBench {
     factorisation_ms: f64,
     admm_iterations: usize,
     admm_ms: f64,
+    /// Threads the iterations ran on (the faster of all and one, after a trial).
+    admm_threads: usize,
     projection_ms: f64,
     converged: bool,
     nonzeros_per_vertex: f64,
