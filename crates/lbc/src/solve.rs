@@ -61,7 +61,7 @@ pub struct Settings {
     /// weights to the gradients of the starting coordinates.
     pub initial_penalty: Option<f64>,
     /// Residual balancing (Boyd et al. 2011, §3.4.1): when the relative primal and
-    /// dual residuals differ by more than a factor of 2, multiply `μ` by the square
+    /// dual residuals differ by more than a factor of 1.5, multiply `μ` by the square
     /// root of their ratio (at most 10×), first after 10 iterations, then waiting
     /// twice as long after each change. The Y-update matrix does not depend on `μ`,
     /// so this costs no refactorisation.
@@ -1027,4 +1027,8 @@ const MEASURE_EVERY: usize = 5;
 /// ADMM from converging)…
 const PENALTY_INTERVAL: usize = 10;
 /// …and moves the penalty when their relative sizes differ by more than this factor.
-const PENALTY_BAND: f64 = 2.0;
+/// The stop waits for the larger of the two, so the nearer they are kept, the sooner
+/// both fall below it: 1.5 instead of 2 took 10–28% fewer iterations on the benchmark
+/// cages, the lizard's and the authors' (a few unchanged), with the objective within
+/// 0.06% of a run 100× tighter on all of them (0.11% with 2).
+const PENALTY_BAND: f64 = 1.5;

@@ -434,6 +434,7 @@ impl Deformer for CageDeformer {
             admm_threads: report.threads,
             projection_ms: ms(report.projection),
             converged: report.converged,
+            objective: report.objective,
             nonzeros_per_vertex: solved.weights.len() as f64
                 / solved.domain.positions().len().max(1) as f64,
             deform_ms_median: median(deform),
@@ -493,6 +494,8 @@ struct LbcBench {
     admm_threads: usize,
     projection_ms: f64,
     converged: bool,
+    /// Eq. (14) of the coordinates, in the rig's units.
+    objective: f64,
     nonzeros_per_vertex: f64,
     deform_ms_median: f64,
     /// The paper's P(t) as `[t, P(t)]` pairs (eq. 20).
