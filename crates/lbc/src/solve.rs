@@ -987,7 +987,6 @@ fn shrink(p: DVec2, t: DVec2, threshold: f64, alpha: f64) -> (DVec2, DVec2, DVec
 /// The non-measuring X-update of one triangle (see [`Problem::shrink_triangle`]),
 /// written on plain numbers over whole rows so that the compiler works on several
 /// cage vertices at once.
-#[inline(never)]
 fn shrink_rows(
     [ga, gb, gc]: [DVec2; 3],
     [za, zb, zc]: [&[f64]; 3],

@@ -702,6 +702,14 @@ fn puppet(dir: &Path) -> Document {
     Document::open_project(&path).expect("opens")
 }
 
+/// [`puppet`] drawn as parts.
+fn puppet_parts(dir: &Path) -> Document {
+    let mut doc = puppet(dir);
+    doc.apply(Edit::Parts(Some(project::PartsSpec::default())))
+        .expect("parts");
+    doc
+}
+
 /// The parts (layer indices) handle `h` of `doc` binds, drawn as parts.
 fn bound_to(doc: &Document, h: usize) -> Vec<usize> {
     let bindings = doc.parts().expect("parts").rig().bindings();
@@ -839,9 +847,7 @@ fn a_layered_picture_drawn_as_parts_shows_what_render_draws_of_it() {
 /// move of a vertex of the parts it does bind (matched by part and rest position).
 fn pins_placed_in_a_pose_on_parts(method: Method) -> Vec<f64> {
     let dir = tempfile::tempdir().expect("temp dir");
-    let mut doc = puppet(dir.path());
-    doc.apply(Edit::Parts(Some(project::PartsSpec::default())))
-        .expect("parts");
+    let mut doc = puppet_parts(dir.path());
     if method != doc.project().method {
         doc.apply(Edit::Method(method)).expect("method");
     }
@@ -933,9 +939,7 @@ fn under_arap_a_pin_placed_in_a_pose_on_parts_holds_its_own_parts_too() {
 /// (so the leg follows the body) and the body's hip bar turned by 0.5 rad: the
 /// document, the leg's and the body's layer indices.
 fn puppet_with_a_follower(dir: &Path, method: Method) -> (Document, usize, usize) {
-    let mut doc = puppet(dir);
-    doc.apply(Edit::Parts(Some(project::PartsSpec::default())))
-        .expect("parts");
+    let mut doc = puppet_parts(dir);
     if method != doc.project().method {
         doc.apply(Edit::Method(method)).expect("method");
     }
@@ -1079,9 +1083,7 @@ fn a_pin_placed_in_a_pose_on_a_part_that_follows_moves_nothing() {
 fn a_pin_removed_in_a_pose_on_parts_leaves_its_parts_where_they_were_away_from_it() {
     for method in [Method::C2, Method::Arap, Method::Mls] {
         let dir = tempfile::tempdir().expect("temp dir");
-        let mut doc = puppet(dir.path());
-        doc.apply(Edit::Parts(Some(project::PartsSpec::default())))
-            .expect("parts");
+        let mut doc = puppet_parts(dir.path());
         if method != doc.project().method {
             doc.apply(Edit::Method(method)).expect("method");
         }
@@ -1130,9 +1132,7 @@ fn a_pin_removed_in_a_pose_on_parts_leaves_its_parts_where_they_were_away_from_i
 #[test]
 fn drawn_as_parts_a_pin_placed_while_keys_exist_takes_each_key_where_it_shows_the_picture() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let mut doc = puppet(dir.path());
-    doc.apply(Edit::Parts(Some(project::PartsSpec::default())))
-        .expect("parts");
+    let mut doc = puppet_parts(dir.path());
     // The sample's pose keyed at 0 and 1 s.
     for time in [0.0, 1.0] {
         let keyed = doc.keyed_at(time);
@@ -1172,9 +1172,7 @@ fn drawn_as_parts_a_pin_placed_while_keys_exist_takes_each_key_where_it_shows_th
 #[test]
 fn a_pin_placed_beside_another_on_parts_refines_that_part_as_a_reopen_does() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let mut doc = puppet(dir.path());
-    doc.apply(Edit::Parts(Some(project::PartsSpec::default())))
-        .expect("parts");
+    let mut doc = puppet_parts(dir.path());
     // 1 px, then 0.5 px beside the body's pin at (320, 300): the part is meshed
     // again around the pair (the C² paper's up-sampling), as a fresh setup meshes it.
     for dx in [1.0, 0.5, 6.0] {
@@ -1202,9 +1200,7 @@ fn a_pin_placed_beside_another_on_parts_refines_that_part_as_a_reopen_does() {
 #[test]
 fn drawn_as_parts_the_heat_map_and_cells_are_each_parts_own() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let mut doc = puppet(dir.path());
-    doc.apply(Edit::Parts(Some(project::PartsSpec::default())))
-        .expect("parts");
+    let doc = puppet_parts(dir.path());
     let parts = doc.parts().expect("parts");
     let n = parts.rest().len();
     let set = parts.rig().set();
@@ -1236,9 +1232,7 @@ fn drawn_as_parts_the_heat_map_and_cells_are_each_parts_own() {
 #[test]
 fn under_arap_a_drag_on_parts_is_live_and_its_end_is_what_a_file_renders() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let mut doc = puppet(dir.path());
-    doc.apply(Edit::Parts(Some(project::PartsSpec::default())))
-        .expect("parts");
+    let mut doc = puppet_parts(dir.path());
     doc.apply(Edit::Method(Method::Arap)).expect("ARAP");
     // The raised arm's hand dragged on over five frames.
     let mut project = doc.project().clone();
@@ -1263,9 +1257,7 @@ fn under_arap_a_drag_on_parts_is_live_and_its_end_is_what_a_file_renders() {
 #[test]
 fn a_locked_part_takes_no_new_pin_or_paint_and_moves_as_before() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let mut doc = puppet(dir.path());
-    doc.apply(Edit::Parts(Some(project::PartsSpec::default())))
-        .expect("drawn as parts");
+    let mut doc = puppet_parts(dir.path());
     let (count, joint) = shoulder_joint(&mut doc);
     // (Layer 3, beneath the arm.)
     let body = *joint.iter().min().expect("the body");
