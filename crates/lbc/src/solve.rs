@@ -575,15 +575,10 @@ impl Problem {
                 ]);
             }
         } else {
-            shrink_rows(
-                [ga, gb, gc],
-                [za, zb, zc],
-                tx,
-                ty,
-                coef,
-                inverse_penalty,
-                alpha,
-            );
+            for i in 0..n {
+                let (next, ..) = step(i, DVec2::new(tx[i].into(), ty[i].into()));
+                (tx[i], ty[i]) = (next.x as Stored, next.y as Stored);
+            }
         }
     }
 
@@ -982,34 +977,6 @@ fn shrink(p: DVec2, t: DVec2, threshold: f64, alpha: f64) -> (DVec2, DVec2, DVec
     let keep = (1.0 - threshold / a.length().max(f64::MIN_POSITIVE)).max(0.0);
     let x = keep * a;
     (alpha * x + (1.0 - alpha) * p + u, x, p, u)
-}
-
-/// The non-measuring X-update of one triangle (see [`Problem::shrink_triangle`]),
-/// written on plain numbers over whole rows so that the compiler works on several
-/// cage vertices at once.
-fn shrink_rows(
-    [ga, gb, gc]: [DVec2; 3],
-    [za, zb, zc]: [&[f64]; 3],
-    tx: &mut [Stored],
-    ty: &mut [Stored],
-    coef: &[Stored],
-    inverse_penalty: f64,
-    alpha: f64,
-) {
-    let n = tx.len();
-    let (ty, coef) = (&mut ty[..n], &coef[..n]);
-    let (za, zb, zc) = (&za[..n], &zb[..n], &zc[..n]);
-    for i in 0..n {
-        let px = ga.x * za[i] + gb.x * zb[i] + gc.x * zc[i];
-        let py = ga.y * za[i] + gb.y * zb[i] + gc.y * zc[i];
-        let ux = f64::from(tx[i]) - px;
-        let uy = f64::from(ty[i]) - py;
-        let (ax, ay) = (px - ux, py - uy);
-        let length = (ax * ax + ay * ay).sqrt().max(f64::MIN_POSITIVE);
-        let keep = (1.0 - f64::from(coef[i]) * inverse_penalty / length).max(0.0);
-        tx[i] = (alpha * keep * ax + (1.0 - alpha) * px + ux) as Stored;
-        ty[i] = (alpha * keep * ay + (1.0 - alpha) * py + uy) as Stored;
-    }
 }
 
 /// `β`: the `W = W̃` split enters the augmented Lagrangian as `β‖W − W̃‖²_M`, the
