@@ -413,11 +413,20 @@ impl Problem {
     /// `R` (3 dot products) costs far less than multiplying by `Mᵀ` and then by `M`
     /// (n − 3 each), for three more right-hand side columns in the solve.
     ///
-    /// Returns `‖G ΔZ‖² + β‖ΔZ‖²_M` for the change `ΔZ` of the unknown rows since the
-    /// last call, the dual residual's square over `μ²`: with `L = GᵀG + βM` and
-    /// `L Y = R`, it is `ΔY · ΔR`, a sum over the unknown rows rather than a pass over
-    /// every triangle.
-    fn y_update(&self, factor: &RowFactor, t: &[Stored], b: &mut YBuffers, z: &mut [f64]) -> f64 {
+    /// With `measure`, returns `‖G ΔZ‖² + β‖ΔZ‖²_M` for the change `ΔZ` of the unknown
+    /// rows since the last call, the dual residual's square over `μ²`: with
+    /// `L = GᵀG + βM` and `L Y = R`, it is `ΔY · ΔR`, a sum over the unknown rows
+    /// rather than a pass over every triangle (zero when the last call did not
+    /// `keep` its `R` and `Y`; `keep` them where the next call measures).
+    fn y_update(
+        &self,
+        factor: &RowFactor,
+        t: &[Stored],
+        b: &mut YBuffers,
+        z: &mut [f64],
+        measure: bool,
+        keep: bool,
+    ) -> f64 {
         let n = self.n;
         let t2 = &t[self.triangle_part()..];
         let gt = &b.gt;
@@ -437,7 +446,9 @@ impl Problem {
                 *a -= k.dot(coef);
             }
         });
-        b.r.copy_from_slice(&b.rhs);
+        if keep || measure {
+            b.r.copy_from_slice(&b.rhs);
+        }
         factor.solve_rows(&mut b.rhs, n, &mut b.scratch);
         for ((y, &v), h) in b
             .rhs
@@ -450,7 +461,7 @@ impl Problem {
                 *w = h + y;
             }
         }
-        let dual = if b.has_previous {
+        let dual = if measure && b.has_previous {
             b.rhs
                 .par_chunks(CHUNK)
                 .zip(b.y_previous.par_chunks(CHUNK))
@@ -466,9 +477,11 @@ impl Problem {
         } else {
             0.0
         };
-        std::mem::swap(&mut b.r, &mut b.r_previous);
-        std::mem::swap(&mut b.rhs, &mut b.y_previous);
-        b.has_previous = true;
+        if keep {
+            std::mem::swap(&mut b.r, &mut b.r_previous);
+            std::mem::swap(&mut b.rhs, &mut b.y_previous);
+        }
+        b.has_previous = keep;
         dual
     }
 
@@ -477,7 +490,8 @@ impl Problem {
     /// soft-thresholding (eq. 30) and the W-update by clamping (eq. 31), both
     /// over-relaxed, and the next state `x̃ + u` into `t`; the clamped `W` goes into
     /// `clamped`. The residuals are summed only when `measure` (they cost about a
-    /// third of the pass over the triangles).
+    /// third of the pass over the triangles), and the Y-update keeps what the dual
+    /// residual needs only when `keep` (the next iteration measures).
     #[allow(clippy::too_many_arguments)]
     fn iterate(
         &self,
@@ -489,9 +503,10 @@ impl Problem {
         alpha: f64,
         b: &mut YBuffers,
         measure: bool,
+        keep: bool,
     ) -> Residuals {
         let n = self.n;
-        let dual = self.y_update(factor, t, b, z);
+        let dual = self.y_update(factor, t, b, z, measure, keep);
         let z = &*z;
         let (t1, t2) = t.split_at_mut(self.triangle_part());
         let inverse_penalty = 1.0 / penalty;
@@ -654,8 +669,10 @@ impl Problem {
         // variable and multiplier zero (a regularised harmonic solve), and the state
         // whose multipliers are zero, `t = (Gz, √(βM) z)`, which the Y-update maps to
         // that same `z`.
+        let measures =
+            |it: usize| it.is_multiple_of(MEASURE_EVERY) || it == settings.max_iterations;
         let mut t: Vec<Stored> = vec![0.0; len];
-        self.y_update(factor, &t, &mut buffers, z);
+        self.y_update(factor, &t, &mut buffers, z, false, measures(1));
         let mut p = vec![DVec2::ZERO; self.triangles.len() * n];
         self.apply_g(z, &mut p);
         {
@@ -699,7 +716,7 @@ impl Problem {
         let mut state = None;
         let mut threads = ThreadChoice::new();
         for it in 1..=settings.max_iterations {
-            let measure = it % MEASURE_EVERY == 0 || it == settings.max_iterations;
+            let (measure, keep) = (measures(it), measures(it + 1));
             let may_rebalance =
                 measure && settings.adaptive_penalty && it - last_change >= interval;
             if may_rebalance {
@@ -717,6 +734,7 @@ impl Problem {
                     alpha,
                     &mut buffers,
                     measure,
+                    keep,
                 )
             };
             let r = match threads.single_for(it) {
