@@ -113,8 +113,10 @@ impl Factor {
 /// sides are rows of `n` weights per mesh vertex. Each step of the substitution is
 /// then a short contiguous `axpy` on a row, and the permutation a copy of whole rows.
 pub(crate) struct RowFactor {
-    /// Row `i` of the factor is unknown `perm[i]`.
+    /// Row `i` of the factor is unknown `perm[i]`…
     perm: Vec<u32>,
+    /// …and unknown `p` is row `position[p]`.
+    position: Vec<u32>,
     /// `L` by columns, the diagonal first in each.
     col_ptr: Vec<usize>,
     row_idx: Vec<u32>,
@@ -172,12 +174,17 @@ impl RowFactor {
                 "a column of the factor does not start at its diagonal".into(),
             ));
         }
-        let perm = match symbolic.perm() {
+        let perm: Vec<u32> = match symbolic.perm() {
             Some(p) => p.arrays().0.iter().map(|&i| i as u32).collect(),
             None => (0..n as u32).collect(),
         };
+        let mut position = vec![0; perm.len()];
+        for (i, &p) in perm.iter().enumerate() {
+            position[p as usize] = i as u32;
+        }
         Ok(Self {
             perm,
+            position,
             col_ptr,
             row_idx,
             values,
@@ -272,12 +279,13 @@ impl RowFactor {
                 }
             });
         }
-        for (i, &p) in self.perm.iter().enumerate() {
-            let row = &mut b[p as usize * width..(p as usize + 1) * width];
+        let scratch = &*scratch;
+        b.par_chunks_mut(width).enumerate().for_each(|(p, row)| {
+            let i = self.position[p] as usize;
             for (k, chunk) in row.chunks_mut(w).enumerate() {
                 chunk.copy_from_slice(&scratch[k][i * w..i * w + chunk.len()]);
             }
-        }
+        });
     }
 }
 

@@ -450,17 +450,15 @@ impl Problem {
             b.r.copy_from_slice(&b.rhs);
         }
         factor.solve_rows(&mut b.rhs, n, &mut b.scratch);
-        for ((y, &v), h) in b
-            .rhs
-            .chunks_exact(n)
-            .zip(&self.interior)
-            .zip(self.h.chunks_exact(n))
-        {
-            let v = v as usize;
-            for ((w, y), h) in z[v * n..(v + 1) * n].iter_mut().zip(y).zip(h) {
-                *w = h + y;
+        let y = &b.rhs;
+        z.par_chunks_mut(n).enumerate().for_each(|(v, w)| {
+            if let Some(j) = self.row_of[v] {
+                let row = j as usize * n..(j as usize + 1) * n;
+                for ((w, y), h) in w.iter_mut().zip(&y[row.clone()]).zip(&self.h[row]) {
+                    *w = h + y;
+                }
             }
-        }
+        });
         let dual = if measure && b.has_previous {
             b.rhs
                 .par_chunks(CHUNK)
