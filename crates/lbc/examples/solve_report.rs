@@ -3,11 +3,12 @@
 //!
 //! ```text
 //! cargo run --release -p lbc --example solve_report -- [--tolerance T] [--only NAME]
-//!     [--vertices N] [--penalty MU] [--relaxation ALPHA] [--trace]
+//!     [--vertices N] [--penalty MU] [--relaxation ALPHA] [--trace] [--narrow]
 //! ```
 //!
 //! `--penalty` fixes `μ` (no residual balancing); `--trace` prints the residuals as
-//! the solve goes.
+//! the solve goes; `--narrow` runs the passes as compiled for the baseline x86-64
+//! even where the CPU has AVX2.
 
 #[path = "../benches/cases/mod.rs"]
 mod cases;
@@ -31,6 +32,7 @@ fn main() {
         initial_penalty: penalty,
         adaptive_penalty: penalty.is_none(),
         relaxation: number("--relaxation").unwrap_or(Settings::default().relaxation),
+        wide_vectors: !args.iter().any(|a| a == "--narrow"),
         ..Settings::default()
     };
     let trace = args.iter().any(|a| a == "--trace");

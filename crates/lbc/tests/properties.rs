@@ -239,6 +239,28 @@ fn one_thread_or_two_solve_alike() {
     }
 }
 
+/// The iterations' passes compiled for AVX2 (where the CPU has it) and for the
+/// baseline give the same coordinates: no operation is fused or reordered.
+#[test]
+fn wide_vectors_or_not_solve_alike() {
+    let domain = Domain::triangulate(&star(10, false), 1500).expect("triangulates");
+    let run = |wide_vectors: bool| {
+        let settings = Settings {
+            wide_vectors,
+            ..Settings::default()
+        };
+        solve(&domain, &settings, &mut |_| true).expect("solves")
+    };
+    let (narrow, wide) = (run(false), run(true));
+    assert_eq!(narrow.report.iterations, wide.report.iterations);
+    assert!((narrow.report.objective - wide.report.objective).abs() < 1e-12);
+    for v in 0..narrow.vertices() {
+        for (a, b) in narrow.row(v).iter().zip(wide.row(v)) {
+            assert!((a - b).abs() < 1e-12, "vertex {v}: {a} vs {b}");
+        }
+    }
+}
+
 #[test]
 fn progress_can_cancel() {
     let domain = Domain::triangulate(&star(8, false), 200).expect("triangulates");
