@@ -81,8 +81,9 @@
 //! Iterations 6–10 run on all of rayon's threads and 11–15 on one; the faster way
 //! runs the rest ([`Report::threads`] says which). Where the mesh's working set
 //! outgrows the caches, one thread can beat two that share a core's caches: on a
-//! machine with two hardware threads, 76 ms an iteration on one against 104 ms on
-//! both at 92,000 vertices, while at 19,000 two take 6.1 ms and one 11 ms.
+//! machine with two hardware threads, the baseline passes took 76 ms an iteration on
+//! one against 104 ms on both at 92,000 vertices, while at 19,000 two took 6.1 ms and
+//! one 11 ms (with AVX2, two win at both sizes there).
 //!
 //! # Reading the paper
 //!
