@@ -2,9 +2,8 @@
 //! of the hat functions, the stiffness and lumped mass matrices, and sparse Cholesky
 //! factorisations with faer.
 
-use faer::linalg::solvers::SolveCore;
+use faer::Side;
 use faer::sparse::{SparseColMat, Triplet};
-use faer::{Conj, MatMut, Side};
 use geometry::orient;
 use glam::DVec2;
 
@@ -81,29 +80,6 @@ impl Elements {
             }
         }
         m
-    }
-}
-
-/// A sparse symmetric positive definite matrix, factorised once.
-pub(crate) struct Factor {
-    llt: faer::sparse::linalg::solvers::Llt<usize, f64>,
-}
-
-impl Factor {
-    /// Factorises the `n × n` matrix given by its lower triangle (duplicates summed),
-    /// with faer's fill-reducing ordering.
-    pub fn new(n: usize, lower: &[Triplet<usize, usize, f64>]) -> Result<Self, LbcError> {
-        let a = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, lower)
-            .map_err(|e| LbcError::Factorization(format!("{e:?}")))?;
-        let llt = a
-            .sp_cholesky(Side::Lower)
-            .map_err(|e| LbcError::Factorization(format!("{e:?}")))?;
-        Ok(Self { llt })
-    }
-
-    /// Solves for every column of `rhs` in place.
-    pub fn solve_in_place(&self, rhs: MatMut<'_, f64>) {
-        self.llt.solve_in_place_with_conj(Conj::No, rhs);
     }
 }
 

@@ -1,13 +1,12 @@
 //! Geodesic distance inside the cage by the heat method (Crane, Weischedel and
 //! Wardetzky 2013), as the paper computes it (its §5).
 
-use faer::Mat;
 use glam::DVec2;
 use rayon::prelude::*;
 
 use crate::domain::Domain;
 use crate::error::LbcError;
-use crate::fem::{Elements, Factor};
+use crate::fem::{Elements, RowFactor};
 
 /// For each cage vertex `i`, the geodesic distance inside the cage from it to every
 /// mesh vertex, divided by its own maximum (the paper's eq. 12): `D[i][v] ∈ [0, 1]`,
@@ -43,24 +42,29 @@ pub fn geodesic_distances(domain: &Domain) -> Result<Vec<Vec<f64>>, LbcError> {
     }
     let h = edge_sum / (3 * triangles.len()).max(1) as f64;
     let all = |v: u32| Some(v as usize);
-    let heat = Factor::new(
+    // The solves run on rows of `n` (a column per cage vertex), as the ADMM's do.
+    let wide = crate::wide::available();
+    let mut scratch = Vec::new();
+    let heat = RowFactor::new(
         nv,
         &elements.lower_triplets(triangles, &all, h * h, &mass, 1.0),
     )?;
-    let mut u = Mat::<f64>::zeros(nv, n);
+    let mut u = vec![0.0; nv * n];
     for (i, &v) in domain.cage_vertices().iter().enumerate() {
-        u[(v as usize, i)] = 1.0;
+        u[v as usize * n + i] = 1.0;
     }
-    heat.solve_in_place(u.as_mut());
+    heat.solve_rows(wide, &mut u, n, &mut scratch);
+    let u = columns_of(&u, n);
 
     // Divergence of the normalised field, per source (columns independent).
     let columns: Vec<Vec<f64>> = (0..n)
         .into_par_iter()
         .map(|i| {
+            let u = &u[i];
             let mut div = vec![0.0; nv];
             for (s, t) in triangles.iter().enumerate() {
                 let g = &elements.grad[s];
-                let grad_u: DVec2 = (0..3).map(|k| u[(t[k] as usize, i)] * g[k]).sum();
+                let grad_u: DVec2 = (0..3).map(|k| u[t[k] as usize] * g[k]).sum();
                 let x = -grad_u.normalize_or_zero();
                 for k in 0..3 {
                     div[t[k] as usize] += elements.area[s] * g[k].dot(x);
@@ -69,28 +73,31 @@ pub fn geodesic_distances(domain: &Domain) -> Result<Vec<Vec<f64>>, LbcError> {
             div
         })
         .collect();
-    let mut phi = Mat::<f64>::zeros(nv, n);
+    let mut phi = vec![0.0; nv * n];
     for (i, div) in columns.iter().enumerate() {
         for (v, &d) in div.iter().enumerate() {
-            phi[(v, i)] = d;
+            phi[v * n + i] = d;
         }
     }
+    drop(columns);
     // The mass term is relative to the domain's area, so that the frame does not matter.
     let total: f64 = mass.iter().sum();
-    let poisson = Factor::new(
+    let poisson = RowFactor::new(
         nv,
         &elements.lower_triplets(triangles, &all, 1.0, &mass, 1e-8 / total),
     )?;
-    poisson.solve_in_place(phi.as_mut());
+    poisson.solve_rows(wide, &mut phi, n, &mut scratch);
+    let phi = columns_of(&phi, n);
 
     let piece = pieces(nv, triangles);
     Ok((0..n)
         .into_par_iter()
         .map(|i| {
             let source = domain.cage_vertices()[i] as usize;
-            let at = phi[(source, i)];
+            let phi = &phi[i];
+            let at = phi[source];
             let reached = |v: usize| piece[v] == piece[source];
-            let mut d: Vec<f64> = (0..nv).map(|v| (phi[(v, i)] - at).max(0.0)).collect();
+            let mut d: Vec<f64> = phi.iter().map(|&p| (p - at).max(0.0)).collect();
             let max = (0..nv)
                 .filter(|&v| reached(v))
                 .map(|v| d[v])
@@ -105,6 +112,14 @@ pub fn geodesic_distances(domain: &Domain) -> Result<Vec<Vec<f64>>, LbcError> {
             d
         })
         .collect())
+}
+
+/// The columns of `rows` (row-major, `n` values a row), each as one vector.
+fn columns_of(rows: &[f64], n: usize) -> Vec<Vec<f64>> {
+    (0..n)
+        .into_par_iter()
+        .map(|i| rows.iter().skip(i).step_by(n).copied().collect())
+        .collect()
 }
 
 /// The connected piece of each of `nv` vertices (a representative vertex), joined
