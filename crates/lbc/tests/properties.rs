@@ -231,10 +231,16 @@ fn one_thread_or_two_solve_alike() {
         "the solve outlasts the trials ({} iterations)",
         one.report.iterations
     );
-    assert_eq!(one.report.iterations, two.report.iterations);
-    for v in 0..one.vertices() {
-        for (a, b) in one.row(v).iter().zip(two.row(v)) {
-            assert!((a - b).abs() < 1e-12, "vertex {v}: {a} vs {b}");
+    assert_solved_alike(&one, &two);
+}
+
+/// `a` and `b` took the same iterations to the same coordinates (to 10⁻¹²).
+fn assert_solved_alike(a: &Coordinates, b: &Coordinates) {
+    assert_eq!(a.report.iterations, b.report.iterations);
+    assert!((a.report.objective - b.report.objective).abs() < 1e-12);
+    for v in 0..a.vertices() {
+        for (x, y) in a.row(v).iter().zip(b.row(v)) {
+            assert!((x - y).abs() < 1e-12, "vertex {v}: {x} vs {y}");
         }
     }
 }
@@ -251,14 +257,7 @@ fn wide_vectors_or_not_solve_alike() {
         };
         solve(&domain, &settings, &mut |_| true).expect("solves")
     };
-    let (narrow, wide) = (run(false), run(true));
-    assert_eq!(narrow.report.iterations, wide.report.iterations);
-    assert!((narrow.report.objective - wide.report.objective).abs() < 1e-12);
-    for v in 0..narrow.vertices() {
-        for (a, b) in narrow.row(v).iter().zip(wide.row(v)) {
-            assert!((a - b).abs() < 1e-12, "vertex {v}: {a} vs {b}");
-        }
-    }
+    assert_solved_alike(&run(false), &run(true));
 }
 
 #[test]
