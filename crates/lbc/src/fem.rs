@@ -216,21 +216,18 @@ impl RowFactor {
 
     crate::wide::twice! {
     /// Solves `A X = B` in place for every column of `b` (row-major, `width` values
-    /// a row), in blocks of columns of an even width as near equal as can be, the
-    /// blocks on all threads: with several threads at least two blocks of at most 16
-    /// columns, with one thread blocks of at most 32 (fewer passes over the factor:
-    /// 10% off an iteration at 92,000 vertices, where the factor no longer fits the
-    /// caches). `scratch` holds their working rows; with `_wide`, compiled for AVX2.
+    /// a row), in blocks of columns of an even width as near equal as can be, at most
+    /// 32, as few as can be (each is a pass over the factor) but a multiple of the
+    /// threads (two at most), so that the threads share the blocks evenly: 26 columns
+    /// in two blocks of 14 on two threads and one of 26 on one; 34 in two of 18 (three
+    /// of 12 kept one thread waiting for the third: 7% off an iteration).
+    /// `scratch` holds their working rows; with `_wide`, compiled for AVX2.
     pub fn solve_rows / solve_rows_plain / solve_rows_avx2
         (&self, _wide: bool, b: &mut [f64], width: usize, scratch: &mut Vec<Vec<f64>>) {
         let n = self.perm.len();
-        let (widest, fewest) = if rayon::current_num_threads() > 1 {
-            (16, 2)
-        } else {
-            (32, 1)
-        };
-        let blocks = width.div_ceil(widest).max(fewest);
-        let w = (width.div_ceil(blocks).div_ceil(2) * 2).clamp(2, widest);
+        let threads = rayon::current_num_threads().clamp(1, 2);
+        let blocks = width.div_ceil(32).div_ceil(threads) * threads;
+        let w = (width.div_ceil(blocks).div_ceil(2) * 2).clamp(2, 32);
         let blocks = width.div_ceil(w);
         scratch.resize_with(blocks, Vec::new);
         {
@@ -313,8 +310,8 @@ mod tests {
         let (n, lower) = grid(23);
         let factor = RowFactor::new(n, &lower).expect("positive definite");
         let mut scratch = Vec::new();
-        // Blocks of up to 16 columns on several threads, of up to 32 on one; the
-        // plain and (where the CPU has it) the AVX2 copy, which give the same numbers.
+        // Blocks for two threads and for one; the plain and (where the CPU has it) the
+        // AVX2 copy, which give the same numbers.
         let one = rayon::ThreadPoolBuilder::new()
             .num_threads(1)
             .build()
