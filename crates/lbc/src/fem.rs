@@ -177,8 +177,14 @@ impl RowFactor {
         let (x, _) = x[..n * W].as_chunks_mut::<W>();
         for (row, &p) in x.iter_mut().zip(&self.perm) {
             let p = p as usize * width + first;
-            *row = [0.0; W];
-            row[..take].copy_from_slice(&b[p..p + take]);
+            if take == W {
+                // A copy of known length, inlined (a call to `memmove` per row
+                // otherwise).
+                *row = b[p..p + W].try_into().expect("W values");
+            } else {
+                *row = [0.0; W];
+                row[..take].copy_from_slice(&b[p..p + take]);
+            }
         }
         // L y = b.
         for j in 0..n {
@@ -263,7 +269,12 @@ impl RowFactor {
                 for (q, row) in rows.chunks_exact_mut(width).enumerate() {
                     let i = self.position[task * PER_TASK + q] as usize;
                     for (k, chunk) in row.chunks_mut(w).enumerate() {
-                        chunk.copy_from_slice(&scratch[k][i * w..i * w + chunk.len()]);
+                        let from = &scratch[k][i * w..i * w + chunk.len()];
+                        // Element by element: `copy_from_slice` calls `memmove`
+                        // for each of these short runs.
+                        for (c, f) in chunk.iter_mut().zip(from) {
+                            *c = *f;
+                        }
                     }
                 }
             });

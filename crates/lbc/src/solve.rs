@@ -563,15 +563,26 @@ impl Problem {
                     let v = self.interior[j] as usize;
                     let zj = &z[v * n..(v + 1) * n];
                     let (root, m) = (self.root[j], self.split[j]);
-                    let mut r = Residuals::default();
-                    for i in 0..n {
-                        let u = f64::from(tj[i]) / root - zj[i];
-                        let w = (zj[i] - u).max(0.0);
-                        wj[i] = w;
-                        tj[i] = (root * (alpha * w + (1.0 - alpha) * zj[i] + u)) as Stored;
-                        r.add_terms([(w - zj[i]).powi(2), w * w, zj[i] * zj[i], u * u]);
+                    let clamp = |t: Stored, z: f64| {
+                        let u = f64::from(t) / root - z;
+                        let w = (z - u).max(0.0);
+                        (w, (root * (alpha * w + (1.0 - alpha) * z + u)) as Stored, u)
+                    };
+                    if measure {
+                        let mut r = Residuals::default();
+                        for i in 0..n {
+                            let (w, next, u) = clamp(tj[i], zj[i]);
+                            (wj[i], tj[i]) = (w, next);
+                            r.add_terms([(w - zj[i]).powi(2), w * w, zj[i] * zj[i], u * u]);
+                        }
+                        sum = sum.add(r.scaled(m));
+                    } else {
+                        // Without the sums (in order, so not vectorised), a loop
+                        // the compiler vectorises.
+                        for i in 0..n {
+                            (wj[i], tj[i], _) = clamp(tj[i], zj[i]);
+                        }
                     }
-                    sum = sum.add(r.scaled(m));
                 }
                 sum
             })
