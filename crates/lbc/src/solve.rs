@@ -183,8 +183,10 @@ struct Problem {
     scale: f64,
     /// `Gᵀ E` per unknown row and cage vertex, with `E` of eq. (17) (`G` applied to
     /// the boundary values alone): the constant part of the Y-update's right-hand
-    /// side.
+    /// side. Only the rows next to the boundary have any: unknown row `j`'s are
+    /// `gte[gte_at[j] * n..]`, where `gte_at[j]` is not [`u32::MAX`].
     gte: Vec<f64>,
+    gte_at: Vec<u32>,
     /// Per unknown row, its `(triangle, corner)` incidences (CSR).
     adj_ptr: Vec<u32>,
     adj: Vec<(u32, u8)>,
@@ -192,8 +194,9 @@ struct Problem {
     /// Lagrangian (`m_v` the lumped mass), and its square root.
     split: Vec<f64>,
     root: Vec<f64>,
-    /// `H`: the least-norm rows of the unknown vertices, row-major.
-    h: Vec<f64>,
+    /// The columns of `K` (`x`, `y`, 1), for `H`'s rows (the least-norm solution of
+    /// `WK = B`), computed where they are used rather than streamed from memory.
+    k_columns: [Vec<f64>; 3],
 }
 
 impl Problem {
@@ -273,6 +276,7 @@ impl Problem {
             .map(|&v| SPLIT_WEIGHT * mass[v as usize])
             .collect();
         let root = split.iter().map(|m: &f64| m.sqrt()).collect();
+        let k_columns = [0, 1, 2].map(|c| k.iter().map(|k| k[c]).collect());
         let mut problem = Self {
             split,
             root,
@@ -289,7 +293,8 @@ impl Problem {
             q,
             scale,
             gte: Vec::new(),
-            h: Vec::new(),
+            gte_at: Vec::new(),
+            k_columns,
             adj_ptr,
             adj,
         };
@@ -310,12 +315,13 @@ impl Problem {
                 }
             }
         });
-        problem.gte = gte;
-        let mut h = vec![0.0; problem.interior.len() * n];
-        for (row, &v) in h.chunks_exact_mut(n).zip(&problem.interior) {
-            problem.least_norm(problem.q[v as usize], row);
+        problem.gte_at = vec![u32::MAX; problem.interior.len()];
+        for (j, row) in gte.chunks_exact(n).enumerate() {
+            if row.iter().any(|&x| x != 0.0) {
+                problem.gte_at[j] = (problem.gte.len() / n) as u32;
+                problem.gte.extend_from_slice(row);
+            }
         }
-        problem.h = h;
         problem
     }
 
@@ -445,12 +451,19 @@ impl Problem {
                     let j = task * PER_TASK + k;
                     let root = self.root[j];
                     let row = j * n..(j + 1) * n;
-                    for ((a, &t), (e, g)) in acc
-                        .iter_mut()
-                        .zip(&t2[row.clone()])
-                        .zip(self.gte[row.clone()].iter().zip(&gt[row]))
-                    {
-                        *a = root * f64::from(t) - e + g;
+                    let rows = acc.iter_mut().zip(&t2[row.clone()]).zip(&gt[row]);
+                    match self.gte_at[j] {
+                        u32::MAX => {
+                            for ((a, &t), g) in rows {
+                                *a = root * f64::from(t) + g;
+                            }
+                        }
+                        at => {
+                            let e = &self.gte[at as usize * n..(at as usize + 1) * n];
+                            for (((a, &t), g), e) in rows.zip(e) {
+                                *a = root * f64::from(t) - e + g;
+                            }
+                        }
                     }
                     let kt: DVec3 = acc.iter().zip(&self.k).map(|(a, k)| *a * *k).sum();
                     let coef = self.ktk_inv * kt;
@@ -467,11 +480,17 @@ impl Problem {
         z.par_chunks_mut(n * PER_TASK)
             .enumerate()
             .for_each(|(task, rows)| {
+                let [kx, ky, kz] = &self.k_columns;
                 for (k, w) in rows.chunks_exact_mut(n).enumerate() {
-                    if let Some(j) = self.row_of[task * PER_TASK + k] {
+                    let v = task * PER_TASK + k;
+                    if let Some(j) = self.row_of[v] {
                         let row = j as usize * n..(j as usize + 1) * n;
-                        for ((w, y), h) in w.iter_mut().zip(&y[row.clone()]).zip(&self.h[row]) {
-                            *w = h + y;
+                        // `H`'s row, as `least_norm` makes it.
+                        let a = self.ktk_inv * self.q[v].extend(1.0);
+                        for ((((w, y), kx), ky), kz) in
+                            w.iter_mut().zip(&y[row]).zip(kx).zip(ky).zip(kz)
+                        {
+                            *w = ((kx * a.x) + (ky * a.y) + (kz * a.z)) + y;
                         }
                     }
                 }
@@ -505,8 +524,8 @@ impl Problem {
     /// One ADMM iteration as a map of its state, in place: the Y-update from `t`
     /// (into `z`), then the multipliers `u = t − (Gz, z)`, the X-update by group
     /// soft-thresholding (eq. 30) and the W-update by clamping (eq. 31), both
-    /// over-relaxed, and the next state `x̃ + u` into `t`; the clamped `W` goes into
-    /// `clamped`. The residuals are summed only when `measure` (they cost about a
+    /// over-relaxed, and the next state `x̃ + u` into `t`; with `measure`, the clamped
+    /// `W` goes into `clamped`. The residuals are summed only when `measure` (they cost about a
     /// third of the pass over the triangles), and the Y-update keeps what the dual
     /// residual needs only when `keep` (the next iteration measures).
     fn iterate / iterate_plain / iterate_avx2 (
@@ -578,9 +597,10 @@ impl Problem {
                         sum = sum.add(r.scaled(m));
                     } else {
                         // Without the sums (in order, so not vectorised), a loop
-                        // the compiler vectorises.
-                        for i in 0..n {
-                            (wj[i], tj[i], _) = clamp(tj[i], zj[i]);
+                        // the compiler vectorises; nor the clamped `W`, which only
+                        // the last iteration's is used, and the last measures.
+                        for (t, &z) in tj.iter_mut().zip(zj) {
+                            (_, *t, _) = clamp(*t, z);
                         }
                     }
                 }
