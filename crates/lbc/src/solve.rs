@@ -551,12 +551,14 @@ impl Problem {
             .enumerate()
             .map(|(task, triangles)| {
                 let mut r = Residuals::default();
+                let mut terms = if measure { vec![0.0; 4 * n] } else { Vec::new() };
                 for (k, ts) in triangles.chunks_exact_mut(2 * n).enumerate() {
                     let s = task * PER_TASK + k;
                     if measure {
-                        self.shrink_triangle::<true>(s, z, ts, inverse_penalty, alpha, &mut r);
+                        self.shrink_triangle::<true>(s, z, ts, inverse_penalty, alpha, &mut terms);
+                        r = r.add(Residuals::of_terms(&terms, n));
                     } else {
-                        self.shrink_triangle::<false>(s, z, ts, inverse_penalty, alpha, &mut r);
+                        self.shrink_triangle::<false>(s, z, ts, inverse_penalty, alpha, &mut terms);
                     }
                 }
                 r
@@ -572,6 +574,7 @@ impl Problem {
             .enumerate()
             .map(|(task, ((t2, clamped), gt))| {
                 let mut sum = Residuals::default();
+                let mut terms = if measure { vec![0.0; 4 * n] } else { Vec::new() };
                 let rows = t2
                     .chunks_exact_mut(n)
                     .zip(clamped.chunks_exact_mut(n))
@@ -588,17 +591,19 @@ impl Problem {
                         (w, (root * (alpha * w + (1.0 - alpha) * z + u)) as Stored, u)
                     };
                     if measure {
-                        let mut r = Residuals::default();
+                        let (e0, e) = terms.split_at_mut(n);
+                        let (e1, e) = e.split_at_mut(n);
+                        let (e2, e3) = e.split_at_mut(n);
                         for i in 0..n {
                             let (w, next, u) = clamp(tj[i], zj[i]);
                             (wj[i], tj[i]) = (w, next);
-                            r.add_terms([(w - zj[i]).powi(2), w * w, zj[i] * zj[i], u * u]);
+                            (e0[i], e1[i], e2[i], e3[i]) =
+                                ((w - zj[i]).powi(2), w * w, zj[i] * zj[i], u * u);
                         }
-                        sum = sum.add(r.scaled(m));
+                        sum = sum.add(Residuals::of_terms(&terms, n).scaled(m));
                     } else {
-                        // Without the sums (in order, so not vectorised), a loop
-                        // the compiler vectorises; nor the clamped `W`, which only
-                        // the last iteration's is used, and the last measures.
+                        // Nor the clamped `W`, which only the last iteration's is
+                        // used, and the last measures.
                         for (t, &z) in tj.iter_mut().zip(zj) {
                             (_, *t, _) = clamp(*t, z);
                         }
@@ -625,7 +630,7 @@ impl Problem {
         ts: &mut [Stored],
         inverse_penalty: f64,
         alpha: f64,
-        r: &mut Residuals,
+        terms: &mut [f64],
     ) {
         let n = self.n;
         let [a, b, c] = self.triangles[s].map(|v| v as usize * n);
@@ -641,15 +646,18 @@ impl Problem {
             shrink(p, t, f64::from(coef[i]) * inverse_penalty, alpha)
         };
         if MEASURE {
+            let (e0, e) = terms[..4 * n].split_at_mut(n);
+            let (e1, e) = e.split_at_mut(n);
+            let (e2, e3) = e.split_at_mut(n);
             for i in 0..n {
                 let (next, x, p, u) = step(i, DVec2::new(tx[i].into(), ty[i].into()));
                 (tx[i], ty[i]) = (next.x as Stored, next.y as Stored);
-                r.add_terms([
+                (e0[i], e1[i], e2[i], e3[i]) = (
                     (x - p).length_squared(),
                     x.length_squared(),
                     p.length_squared(),
                     u.length_squared(),
-                ]);
+                );
             }
         } else {
             for i in 0..n {
@@ -1025,12 +1033,32 @@ struct Residuals {
 }
 
 impl Residuals {
-    /// Adds one entry's primal, split, unknown and multiplier terms.
-    fn add_terms(&mut self, [primal, split, unknown, multiplier]: [f64; 4]) {
-        self.primal += primal;
-        self.split += split;
-        self.unknown += unknown;
-        self.multiplier += multiplier;
+    /// The sums of `n` entries' primal, split, unknown and multiplier terms, given
+    /// as four runs of `n` in `terms`. Adding each entry's terms as a loop computes
+    /// them keeps that loop from being vectorised (floating-point sums are kept in
+    /// order); the terms are stored instead and summed here in four lanes.
+    #[inline(always)]
+    fn of_terms(terms: &[f64], n: usize) -> Self {
+        let sum = |run: &[f64]| {
+            let mut lanes = [0.0; 4];
+            let quads = run.chunks_exact(4);
+            let rest: f64 = quads.remainder().iter().sum();
+            for quad in quads {
+                for (lane, x) in lanes.iter_mut().zip(quad) {
+                    *lane += x;
+                }
+            }
+            (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + rest
+        };
+        let mut runs = terms[..4 * n].chunks_exact(n.max(1)).map(sum);
+        let mut next = || runs.next().unwrap_or(0.0);
+        Self {
+            primal: next(),
+            split: next(),
+            unknown: next(),
+            multiplier: next(),
+            dual: 0.0,
+        }
     }
 
     fn scaled(self, m: f64) -> Self {
