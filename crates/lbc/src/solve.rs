@@ -152,15 +152,23 @@ pub fn solve_with_distances(
         report.admm = t.elapsed();
     }
     let t = Instant::now();
+    let mut z = problem.unpadded(&z);
+    let clamped = clamped.map(|c| problem.unpadded(&c));
     problem.project(&mut z, clamped.as_deref());
     report.projection = t.elapsed();
     report.objective = problem.objective(&z);
-    Ok(Coordinates::new(n, z, report, problem.k, problem.q))
+    let mut k = problem.k;
+    k.truncate(n);
+    Ok(Coordinates::new(n, z, report, k, problem.q))
 }
 
 /// Everything fixed during the iterations, in the solver's frame.
 struct Problem {
+    /// Columns of the iterations' rows: the cage vertices, and zero columns up to
+    /// a multiple of four (see [`padded`]).
     n: usize,
+    /// Cage vertices.
+    cage_vertices: usize,
     triangles: Vec<[u32; 3]>,
     /// Mesh vertex of each unknown row.
     interior: Vec<u32>,
@@ -202,9 +210,10 @@ struct Problem {
 impl Problem {
     fn new(domain: &Domain, distances: &[Vec<f64>], tau: Tau) -> Self {
         let cage = domain.cage().vertices();
-        let n = cage.len();
+        let cage_vertices = cage.len();
+        let n = padded(cage_vertices);
         // The frame: cage centroid at the origin, farthest cage vertex at 1.
-        let centre = cage.iter().copied().sum::<DVec2>() / n as f64;
+        let centre = cage.iter().copied().sum::<DVec2>() / cage_vertices as f64;
         let scale = cage.iter().map(|c| c.distance(centre)).fold(0.0, f64::max);
         let q: Vec<DVec2> = domain
             .positions()
@@ -221,7 +230,7 @@ impl Problem {
             .collect();
         let mut phi = vec![0.0; triangles.len() * n];
         for (s, t) in triangles.iter().enumerate() {
-            for i in 0..n {
+            for i in 0..cage_vertices {
                 let d = t.iter().map(|&v| distances[i][v as usize]).sum::<f64>() / 3.0;
                 phi[s * n + i] = tau.apply(d);
             }
@@ -239,10 +248,11 @@ impl Problem {
                 interior.push(v as u32);
             }
         }
-        let k: Vec<DVec3> = cage
+        let mut k: Vec<DVec3> = cage
             .iter()
             .map(|c| ((*c - centre) / scale).extend(1.0))
             .collect();
+        k.resize(n, DVec3::ZERO);
         let ktk = k.iter().fold(DMat3::ZERO, |acc, r| {
             acc + DMat3::from_cols(*r * r.x, *r * r.y, *r * r.z)
         });
@@ -278,6 +288,7 @@ impl Problem {
         let root = split.iter().map(|m: &f64| m.sqrt()).collect();
         let k_columns = [0, 1, 2].map(|c| k.iter().map(|k| k[c]).collect());
         let mut problem = Self {
+            cage_vertices,
             split,
             root,
             n,
@@ -886,11 +897,24 @@ impl Problem {
         Ok(clamped)
     }
 
+    /// Rows of `n` columns (the iterations') cut to a column per cage vertex.
+    fn unpadded(&self, rows: &[f64]) -> Vec<f64> {
+        if self.n == self.cage_vertices {
+            return rows.to_vec();
+        }
+        rows.chunks_exact(self.n)
+            .flat_map(|row| &row[..self.cage_vertices])
+            .copied()
+            .collect()
+    }
+
     /// Projects every unknown row onto `{w ≥ 0, Σ w_i c_i = x, Σ w_i = 1}`, first
     /// within the face where ADMM's clamped `W` is zero (so its zeros stay exact
     /// zeros), and over the whole set if that face has no solution.
+    /// `z` and `clamped` have a column per cage vertex (see [`Problem::unpadded`]).
     fn project(&self, z: &mut [f64], clamped: Option<&[f64]>) {
-        let n = self.n;
+        let n = self.cage_vertices;
+        let k = &self.k[..n];
         let rows: Vec<(usize, Vec<f64>)> = self
             .interior
             .par_iter()
@@ -902,11 +926,11 @@ impl Problem {
                 if let Some(w) = clamped {
                     let support: Vec<bool> =
                         w[j * n..(j + 1) * n].iter().map(|&x| x > 0.0).collect();
-                    if let Ok(row) = project_row(z0, &self.k, b, Some(&support)) {
+                    if let Ok(row) = project_row(z0, k, b, Some(&support)) {
                         return (v, row);
                     }
                 }
-                match project_row(z0, &self.k, b, None) {
+                match project_row(z0, k, b, None) {
                     Ok(row) | Err(Some(row)) => (v, row),
                     Err(None) => (v, z0.to_vec()),
                 }
@@ -917,9 +941,9 @@ impl Problem {
         }
     }
 
-    /// Eq. (14) of `z`, in the caller's units.
+    /// Eq. (14) of `z` (a column per cage vertex), in the caller's units.
     fn objective(&self, z: &[f64]) -> f64 {
-        let n = self.n;
+        let (n, padded) = (self.cage_vertices, self.n);
         let total: f64 = (0..self.triangles.len())
             .into_par_iter()
             .map(|s| {
@@ -928,7 +952,7 @@ impl Problem {
                 (0..n)
                     .map(|i| {
                         let grad: DVec2 = (0..3).map(|k| g[k] * z[t[k] as usize * n + i]).sum();
-                        self.phi[s * n + i] * self.elements.area[s] * grad.length()
+                        self.phi[s * padded + i] * self.elements.area[s] * grad.length()
                     })
                     .sum::<f64>()
             })
@@ -1017,6 +1041,14 @@ impl ThreadChoice {
             _ => rayon::current_num_threads(),
         }
     }
+}
+
+/// The columns the iterations' rows have for `n` cage vertices: a multiple of four
+/// from 8 on, so that every loop over a row runs in whole vectors of four (the extra
+/// columns have no cage vertex: zero weights `φ`, zero rows of `K`, and their values
+/// stay zero throughout). An entry costs 9% less with 28 columns than with 27.
+fn padded(n: usize) -> usize {
+    if n >= 8 { n.next_multiple_of(4) } else { n }
 }
 
 /// How the iterations keep their state and the weights `φ√A`, which they stream
