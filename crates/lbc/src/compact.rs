@@ -47,6 +47,22 @@ impl Coordinates {
         }
     }
 
+    /// The same coordinates with vertex `old_of[v]` numbered `v` before now numbered
+    /// `old_of[v]`: back to the caller's numbering after a solve on a renumbered mesh.
+    pub(crate) fn renumbered(mut self, old_of: &[u32]) -> Self {
+        let n = self.n;
+        let mut weights = vec![0.0; self.weights.len()];
+        let mut positions = vec![DVec2::ZERO; self.positions.len()];
+        for (new, &old) in old_of.iter().enumerate() {
+            let old = old as usize;
+            weights[old * n..(old + 1) * n].copy_from_slice(&self.weights[new * n..(new + 1) * n]);
+            positions[old] = self.positions[new];
+        }
+        self.weights = weights;
+        self.positions = positions;
+        self
+    }
+
     /// Number of cage vertices.
     pub fn cage_vertices(&self) -> usize {
         self.n

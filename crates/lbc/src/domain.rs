@@ -30,6 +30,9 @@ pub struct Domain {
     triangles: Vec<[u32; 3]>,
     cage_vertices: Vec<u32>,
     on_cage: Vec<Option<OnCage>>,
+    /// Whether the vertices and triangles are numbered as [`spatial_order`] numbers
+    /// them.
+    ordered: bool,
 }
 
 impl Domain {
@@ -94,20 +97,8 @@ impl Domain {
             });
             triangles.push(tri);
         }
-        // Number the vertices along a Z-order curve and the triangles by their first
-        // vertex, so that neighbours sit near each other in memory (spade refines in
-        // no spatial order; the solve's passes over the triangles read their
-        // corners' rows).
-        let order = geometry::z_order(&positions);
-        let mut renumber = vec![0u32; positions.len()];
-        for (new, &old) in order.iter().enumerate() {
-            renumber[old as usize] = new as u32;
-        }
-        let positions: Vec<DVec2> = order.iter().map(|&old| positions[old as usize]).collect();
-        for t in &mut triangles {
-            *t = t.map(|v| renumber[v as usize]);
-        }
-        triangles.sort_unstable_by_key(|t| (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2])));
+        // Spade refines in no spatial order.
+        let (positions, renumber) = spatial_order(&positions, &mut triangles);
         for i in index.iter_mut().filter(|i| **i != u32::MAX) {
             *i = renumber[*i as usize];
         }
@@ -123,7 +114,9 @@ impl Domain {
                 }
             })
             .collect::<Result<Vec<_>, _>>()?;
-        Self::assemble(cage.clone(), positions, triangles, Some(cage_vertices))
+        let mut domain = Self::assemble(cage.clone(), positions, triangles, Some(cage_vertices))?;
+        domain.ordered = true;
+        Ok(domain)
     }
 
     /// Uses a given triangulation of the cage's interior as it is. Cage vertices are
@@ -260,6 +253,7 @@ impl Domain {
             triangles,
             cage_vertices,
             on_cage,
+            ordered: false,
         })
     }
 
@@ -295,6 +289,60 @@ impl Domain {
         let e = at.edge as usize;
         [(e, 1.0 - at.t), ((e + 1) % n, at.t)]
     }
+}
+
+impl Domain {
+    /// The same domain numbered by [`spatial_order`], and the old number of each new
+    /// vertex; `None` if it is numbered so already (as [`Domain::triangulate`]
+    /// numbers it).
+    pub(crate) fn spatially_ordered(&self) -> Option<(Self, Vec<u32>)> {
+        if self.ordered {
+            return None;
+        }
+        let mut triangles = self.triangles.clone();
+        let (positions, renumber) = spatial_order(&self.positions, &mut triangles);
+        let mut old_of = vec![0u32; renumber.len()];
+        for (old, &new) in renumber.iter().enumerate() {
+            old_of[new as usize] = old as u32;
+        }
+        Some((
+            Self {
+                cage: self.cage.clone(),
+                positions,
+                triangles,
+                cage_vertices: self
+                    .cage_vertices
+                    .iter()
+                    .map(|&v| renumber[v as usize])
+                    .collect(),
+                on_cage: old_of
+                    .iter()
+                    .map(|&old| self.on_cage[old as usize])
+                    .collect(),
+                ordered: true,
+            },
+            old_of,
+        ))
+    }
+}
+
+/// Numbers the vertices along a Z-order curve and the triangles by their first
+/// vertex, so that neighbours sit near each other in memory (the solve's passes over
+/// the triangles read their corners' rows, and its pass over the rows reads each
+/// row's triangles). Renumbers `triangles` in place; returns the positions in the
+/// new order and the new number of each old vertex.
+fn spatial_order(positions: &[DVec2], triangles: &mut [[u32; 3]]) -> (Vec<DVec2>, Vec<u32>) {
+    let order = geometry::z_order(positions);
+    let mut renumber = vec![0u32; positions.len()];
+    for (new, &old) in order.iter().enumerate() {
+        renumber[old as usize] = new as u32;
+    }
+    let positions = order.iter().map(|&old| positions[old as usize]).collect();
+    for t in triangles.iter_mut() {
+        *t = t.map(|v| renumber[v as usize]);
+    }
+    triangles.sort_unstable_by_key(|t| (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2])));
+    (positions, renumber)
 }
 
 fn p_of(p: Point2<f64>) -> DVec2 {

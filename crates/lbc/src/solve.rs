@@ -128,6 +128,27 @@ pub fn solve_with_distances(
             "distances: one row per cage vertex, one value per mesh vertex".into(),
         ));
     }
+    // The passes run over a mesh numbered for locality (a mesh given as a file may
+    // be numbered in any order), and the rows go back to the caller's numbering.
+    if let Some((ordered, old_of)) = domain.spatially_ordered() {
+        let distances: Vec<Vec<f64>> = distances
+            .iter()
+            .map(|d| old_of.iter().map(|&old| d[old as usize]).collect())
+            .collect();
+        let solved = solve_ordered(&ordered, &distances, settings, progress)?;
+        return Ok(solved.renumbered(&old_of));
+    }
+    solve_ordered(domain, distances, settings, progress)
+}
+
+/// [`solve_with_distances`] on a mesh numbered for locality.
+fn solve_ordered(
+    domain: &Domain,
+    distances: &[Vec<f64>],
+    settings: &Settings,
+    progress: &mut dyn FnMut(&Progress) -> bool,
+) -> Result<Coordinates, LbcError> {
+    let n = domain.cage().len();
     let problem = Problem::new(domain, distances, settings.tau);
     let mut z = problem.initial_rows(domain);
     let mut report = Report {
