@@ -71,7 +71,14 @@
 //! Y-update's own right-hand sides rather than another pass. The iterations keep
 //! their state (and the weights `φ√A`) in single precision, computing in double:
 //! half the memory they stream through, the same iterates to the objective's
-//! seventh digit.
+//! seventh digit. Their rows are padded to a multiple of four columns (from 8 cage
+//! vertices on; the extra columns have no cage vertex and stay zero) so that every
+//! loop over a row runs in whole vectors, and the iterations that measure the
+//! residuals store their terms and sum them in four lanes, so that their loops
+//! vectorise too. A mesh given as it is ([`Domain::from_mesh`]) is solved numbered
+//! along a Z-order curve, as [`Domain::triangulate`] numbers its own, and the rows
+//! come back in the caller's numbering: the passes read each triangle's corners' rows
+//! and each row's triangles, which a file's numbering may scatter.
 //!
 //! The passes of an iteration are compiled twice, for the baseline x86-64 and for
 //! AVX2, and the AVX2 copy runs where the CPU has it ([`Settings::wide_vectors`]):
