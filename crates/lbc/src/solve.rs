@@ -509,7 +509,8 @@ impl Problem {
                     }
                     let row = k * n..(k + 1) * n;
                     if measuring {
-                        for ((c, p), a) in change[row.clone()].iter_mut().zip(&kept[row.clone()]).zip(&*acc) {
+                        let was = &kept[row.clone()];
+                        for ((c, p), a) in change[row.clone()].iter_mut().zip(was).zip(&*acc) {
                             *c = a - p;
                         }
                     }
@@ -546,7 +547,10 @@ impl Problem {
                 .map(|((y, yp), change)| {
                     // In four lanes, so that the loop vectorises.
                     let mut lanes = [0.0; 4];
-                    let quads = y.chunks_exact(4).zip(yp.chunks_exact(4)).zip(change.chunks_exact(4));
+                    let quads = y
+                        .chunks_exact(4)
+                        .zip(yp.chunks_exact(4))
+                        .zip(change.chunks_exact(4));
                     for ((y, yp), c) in quads {
                         for l in 0..4 {
                             lanes[l] += (y[l] - yp[l]) * c[l];
@@ -572,10 +576,11 @@ impl Problem {
     /// One ADMM iteration as a map of its state, in place: the Y-update from `t`
     /// (into `z`), then the multipliers `u = t − (Gz, z)`, the X-update by group
     /// soft-thresholding (eq. 30) and the W-update by clamping (eq. 31), both
-    /// over-relaxed, and the next state `x̃ + u` into `t`; with `measure`, the clamped
-    /// `W` goes into `clamped`. The residuals are summed only when `measure` (they cost about a
-    /// third of the pass over the triangles), and the Y-update keeps what the dual
-    /// residual needs only when `keep` (the next iteration measures).
+    /// over-relaxed, and the next state `x̃ + u` into `t`. Only when `measure`, the
+    /// clamped `W` goes into `clamped` and the residuals are summed (their terms
+    /// stored per triangle or row and summed by [`Residuals::of_terms`]); the Y-update
+    /// keeps what the dual residual needs only when `keep` (the next iteration
+    /// measures).
     fn iterate / iterate_plain / iterate_avx2 (
         &self,
         wide: bool,
