@@ -410,6 +410,43 @@ fn a_given_mesh_is_used_as_is() {
     ));
 }
 
+/// A given mesh is solved renumbered for locality and its rows returned in its own
+/// numbering: the crate's own mesh of a star, given back with its vertices shuffled
+/// and each triangle's corners rotated, solves to the same coordinates, vertex for
+/// vertex (to rounding: the sums run in another order).
+#[test]
+fn a_given_mesh_solves_alike_in_any_numbering() {
+    let cage = star(14, false);
+    let (domain, ours) = solved(&cage, 1500);
+    let nv = domain.positions().len();
+    // new = (old · 7919 + 13) mod nv, a permutation when nv is not a multiple of 7919.
+    let perm: Vec<u32> = (0..nv).map(|v| ((v * 7919 + 13) % nv) as u32).collect();
+    let mut positions = vec![DVec2::ZERO; nv];
+    for (old, &new) in perm.iter().enumerate() {
+        positions[new as usize] = domain.positions()[old];
+    }
+    let triangles: Vec<[u32; 3]> = domain
+        .triangles()
+        .iter()
+        .enumerate()
+        .map(|(s, t)| {
+            let t = t.map(|v| perm[v as usize]);
+            [t[s % 3], t[(s + 1) % 3], t[(s + 2) % 3]]
+        })
+        .collect();
+    let given = Domain::from_mesh(&cage, positions, triangles).expect("valid mesh");
+    let theirs = solve(&given, &Settings::default(), &mut |_| true).expect("solves");
+    check_properties(&cage, &given, &theirs);
+    assert_eq!(theirs.report.iterations, ours.report.iterations);
+    let objective = ours.report.objective;
+    assert!((theirs.report.objective - objective).abs() <= 1e-9 * objective);
+    for (old, &new) in perm.iter().enumerate() {
+        for (a, b) in ours.row(old).iter().zip(theirs.row(new as usize)) {
+            assert!((a - b).abs() < 1e-6, "vertex {old}: {a} against {b}");
+        }
+    }
+}
+
 fn check_properties_small(cage: &Cage, domain: &Domain, c: &Coordinates) {
     for v in 0..domain.positions().len() {
         let row = c.row(v);
