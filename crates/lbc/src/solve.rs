@@ -102,12 +102,19 @@ pub fn solve(
     settings: &Settings,
     progress: &mut dyn FnMut(&Progress) -> bool,
 ) -> Result<Coordinates, LbcError> {
+    // (The geodesics too run on the mesh numbered for locality: see
+    // `solve_with_distances`.)
     let start = Instant::now();
-    let distances = geodesic_distances(domain)?;
+    let ordered = domain.spatially_ordered();
+    let on = ordered.as_ref().map_or(domain, |(d, _)| d);
+    let distances = geodesic_distances(on)?;
     let geodesics = start.elapsed();
-    let mut c = solve_with_distances(domain, &distances, settings, progress)?;
+    let mut c = solve_ordered(on, &distances, settings, progress)?;
     c.report.geodesics = geodesics;
-    Ok(c)
+    Ok(match ordered {
+        Some((_, old_of)) => c.renumbered(&old_of),
+        None => c,
+    })
 }
 
 /// Like [`solve`], with the normalised distances `D_i` given (`distances[i][v]`, as
