@@ -8,8 +8,9 @@
 #
 #   LBC_PEER_DIR  (default /tmp/lbc-peer)   THREADS (default 2)   REPEAT (default 3)
 #   MODELS        (default "woody cactus Gil_Gecko LBClogo")
-# Timings: the minimum over REPEAT runs of each side (the machine may be shared;
-# OpenMP barriers suffer badly when another process takes a core).
+# Timings: the minimum over REPEAT runs of each side, the two sides' runs alternating
+# (the machine may be shared; OpenMP barriers suffer badly when another process takes
+# a core).
 set -euo pipefail
 HERE="$(cd "$(dirname "$0")" && pwd)"
 P="${LBC_PEER_DIR:-/tmp/lbc-peer}"
@@ -32,15 +33,18 @@ for m in $MODELS; do
   "$DRV" "$cage" "$d" --target-vertices "${TARGET[$m]}" > "$d/their_1.txt" 2> "$d/their_1.log"
   cp "$d/their_stats.json" "$d/their_stats_1.json"
   cells=$(python3 -c "import json,sys;print(json.load(open(sys.argv[1]))['cells_param'])" "$d/their_stats.json")
+  # ours: `weights` (wall time of the whole command) and `bench` (stage times); the
+  # two solvers' runs alternate, so that a slow spell of the machine falls on both
+  ours() {
+    /usr/bin/time -f "%e" -o "$d/ours_weights_time_$1.txt" \
+      "$C2W" weights --mesh "$d/mesh.obj" --rig "$d/rig.json" -o "$d/ours.json" 2> "$d/ours_weights_$1.log"
+    "$C2W" bench --mesh "$d/mesh.obj" --rig "$d/rig.json" --method lbc > "$d/ours_bench_$1.json" 2> "$d/ours_bench_$1.log"
+  }
+  ours 1
   for r in $(seq 2 "$REPEAT"); do
     "$DRV" "$cage" "$d" --cells "$cells" > "$d/their_$r.txt" 2> "$d/their_$r.log"
     cp "$d/their_stats.json" "$d/their_stats_$r.json"
-  done
-  # ours: `weights` (wall time of the whole command) and `bench` (stage times)
-  for r in $(seq 1 "$REPEAT"); do
-    /usr/bin/time -f "%e" -o "$d/ours_weights_time_$r.txt" \
-      "$C2W" weights --mesh "$d/mesh.obj" --rig "$d/rig.json" -o "$d/ours.json" 2> "$d/ours_weights_$r.log"
-    "$C2W" bench --mesh "$d/mesh.obj" --rig "$d/rig.json" --method lbc > "$d/ours_bench_$r.json" 2> "$d/ours_bench_$r.log"
+    ours "$r"
   done
   python3 "$HERE/lbc_objective.py" "$d/mesh.obj" "$d/their_geodesics.txt" "$d/their_weights.txt" "$d/ours.json" \
     --cage-index "$d/cage_vertex_index.txt" --json > "$d/objectives.json"
