@@ -102,18 +102,13 @@ pub fn solve(
     settings: &Settings,
     progress: &mut dyn FnMut(&Progress) -> bool,
 ) -> Result<Coordinates, LbcError> {
-    // (The geodesics too run on the mesh numbered for locality: see
-    // `solve_with_distances`.)
-    let start = Instant::now();
-    let ordered = domain.spatially_ordered();
-    let on = ordered.as_ref().map_or(domain, |(d, _)| d);
-    let distances = geodesic_distances(on)?;
-    let geodesics = start.elapsed();
-    let mut c = solve_ordered(on, &distances, settings, progress)?;
-    c.report.geodesics = geodesics;
-    Ok(match ordered {
-        Some((_, old_of)) => c.renumbered(&old_of),
-        None => c,
+    in_local_order(domain, |domain, _| {
+        let start = Instant::now();
+        let distances = geodesic_distances(domain)?;
+        let geodesics = start.elapsed();
+        let mut c = solve_ordered(domain, &distances, settings, progress)?;
+        c.report.geodesics = geodesics;
+        Ok(c)
     })
 }
 
@@ -135,17 +130,31 @@ pub fn solve_with_distances(
             "distances: one row per cage vertex, one value per mesh vertex".into(),
         ));
     }
-    // The passes run over a mesh numbered for locality (a mesh given as a file may
-    // be numbered in any order), and the rows go back to the caller's numbering.
-    if let Some((ordered, old_of)) = domain.spatially_ordered() {
-        let distances: Vec<Vec<f64>> = distances
-            .iter()
-            .map(|d| old_of.iter().map(|&old| d[old as usize]).collect())
-            .collect();
-        let solved = solve_ordered(&ordered, &distances, settings, progress)?;
-        return Ok(solved.renumbered(&old_of));
+    in_local_order(domain, |domain, old_of| match old_of {
+        Some(old_of) => {
+            let distances: Vec<Vec<f64>> = distances
+                .iter()
+                .map(|d| old_of.iter().map(|&old| d[old as usize]).collect())
+                .collect();
+            solve_ordered(domain, &distances, settings, progress)
+        }
+        None => solve_ordered(domain, distances, settings, progress),
+    })
+}
+
+/// Runs `solve` on `domain` numbered for locality and returns its rows in the
+/// caller's numbering. The passes read each triangle's corners' rows and each row's
+/// triangles, which a mesh given as a file may number far apart; `solve` gets the mesh
+/// it is to solve and, where that is a renumbered copy, the old number of each of its
+/// vertices.
+fn in_local_order(
+    domain: &Domain,
+    solve: impl FnOnce(&Domain, Option<&[u32]>) -> Result<Coordinates, LbcError>,
+) -> Result<Coordinates, LbcError> {
+    match domain.spatially_ordered() {
+        Some((ordered, old_of)) => Ok(solve(&ordered, Some(&old_of))?.renumbered(&old_of)),
+        None => solve(domain, None),
     }
-    solve_ordered(domain, distances, settings, progress)
 }
 
 /// [`solve_with_distances`] on a mesh numbered for locality.
