@@ -24,6 +24,7 @@ use project::{Canvas, HandleSpec, MetricChoice, Middle, Project};
 use render::Picture;
 
 pub use arap::{ArapOptions, ArapRig, ArapTimes};
+pub use c2::MeshRig;
 pub use layers::{Artwork, Layer, write_ora};
 pub use mesh::Mesh;
 pub use method::{
@@ -687,7 +688,8 @@ pub fn write_virtual_handles(domain: &Domain, placed: &[VirtualHandle], project:
 }
 
 /// Builds `project`'s C² rig on a given mesh (`--mesh`), as [`mesh_with_handles`]
-/// gives it.
+/// gives it, renumbered for the rig's graph searches ([`Domain::in_local_order`]) and
+/// answering in the file's numbering (see [`MeshRig`]).
 ///
 /// # Errors
 /// As [`mesh_with_handles`], and what the rig refuses.
@@ -695,16 +697,23 @@ pub fn rig_on_mesh(
     mesh: &Mesh,
     project: &Project,
     progress: &(dyn Fn(weights_core::Progress) + Sync),
-) -> Result<Rig> {
-    let (domain, virtual_handles) = mesh_with_handles(mesh, project)?;
-    Ok(Rig::with_overlaid(
+) -> Result<MeshRig> {
+    let (domain, mut virtual_handles) = mesh_with_handles(mesh, project)?;
+    let (rest, triangles) = (domain.positions().to_vec(), domain.triangles().to_vec());
+    let (domain, sample) =
+        Domain::in_local_order(rest.clone(), triangles.clone(), domain.metric())?;
+    for v in &mut virtual_handles {
+        v.vertex = sample[v.vertex as usize];
+    }
+    let rig = Rig::with_overlaid(
         domain,
         handles(project),
         &project.overlaid,
         &virtual_handles,
         rig_options(project)?,
         progress,
-    )?)
+    )?;
+    Ok(MeshRig::new(rig, sample, rest, triangles))
 }
 
 /// A given mesh (`--mesh`) with `project`'s handles on it: its vertices are used as
@@ -804,6 +813,14 @@ impl Warper {
     pub fn on_rig(rig: Rig, project: &Project) -> Self {
         let depths: Vec<i32> = project.handles.iter().map(HandleSpec::depth).collect();
         let predefined = order::predefined_order(&rig, &depths);
+        Self::arranged(Box::new(rig), predefined, project)
+    }
+
+    /// A C² rig on a given mesh (see [`rig_on_mesh`]), drawn as [`Warper::on_rig`]
+    /// draws its rig (the two number the triangles alike).
+    pub fn on_mesh_rig(rig: MeshRig, project: &Project) -> Self {
+        let depths: Vec<i32> = project.handles.iter().map(HandleSpec::depth).collect();
+        let predefined = order::predefined_order(rig.rig(), &depths);
         Self::arranged(Box::new(rig), predefined, project)
     }
 

@@ -56,7 +56,7 @@ pub fn setup(source: Source<'_>, project: &Project, listener: &dyn Listener) -> 
         // A given mesh: C² keeps the virtual handles inserted into it.
         (Controls::Handles, Source::Mesh(mesh)) if project.method == Method::C2 => {
             let rig = crate::rig_on_mesh(mesh, project, &|p| listener.weighting(p))?;
-            Ok(Warper::on_rig(rig, project))
+            Ok(Warper::on_mesh_rig(rig, project))
         }
         (Controls::Handles, Source::Mesh(mesh)) => {
             let (domain, _) = crate::mesh_with_handles(mesh, project)?;

@@ -5,6 +5,7 @@ mod arap_pins;
 mod close_handles;
 mod cuts;
 mod depth;
+mod given_mesh;
 mod parts;
 mod support;
 mod visible_content;

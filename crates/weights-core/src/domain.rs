@@ -261,11 +261,19 @@ impl Grid {
 ///
 /// Samples are connected by the triangles' edges; that graph carries the intrinsic
 /// (inside-the-shape) distance when the metric is [`Metric::Intrinsic`].
+///
+/// Wherever two samples tie (equally near, equally far), the one of lower rank wins:
+/// its index, or for a domain made by [`Domain::in_local_order`] the number the caller
+/// gave it, so that a renumbered mesh is weighed as the caller's numbering would have
+/// it.
 #[derive(Clone, Debug)]
 pub struct Domain {
     positions: Vec<DVec2>,
     triangles: Vec<[u32; 3]>,
     metric: Metric,
+    /// The caller's number of each sample ([`Domain::in_local_order`]); `None`: its
+    /// index.
+    rank: Option<Vec<u32>>,
     min: DVec2,
     max: DVec2,
     graph: OnceLock<Graph>,
@@ -285,24 +293,42 @@ impl Domain {
         triangles: Vec<[u32; 3]>,
         metric: Metric,
     ) -> Result<Self, DomainError> {
-        if triangles.is_empty() {
-            return Err(DomainError::Empty);
-        }
-        if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
-            return Err(DomainError::NonFinite { vertex: i });
-        }
-        for (i, t) in triangles.iter().enumerate() {
-            if t.iter().any(|&v| v as usize >= positions.len()) {
-                return Err(DomainError::IndexOutOfRange {
-                    triangle: i,
-                    vertices: positions.len(),
-                });
-            }
-            if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
-                return Err(DomainError::DegenerateTriangle { triangle: i });
-            }
-        }
+        check(&positions, &triangles)?;
         Ok(Self::new_unchecked(positions, triangles, metric))
+    }
+
+    /// The domain [`Domain::new`] makes of `positions` and `triangles`, its samples
+    /// numbered along a Z-order curve (samples at one place in the given order), and
+    /// the new number of each given vertex. The graph searches of a rig walk from
+    /// sample to neighbouring sample: numbered so, neighbours sit near each other in
+    /// memory, where a mesh generator's numbering scatters them. The triangles keep
+    /// their order. Ties between samples are broken by the given numbering
+    /// ([`Domain::rank`]), so a rig on this domain has the weights of a rig on
+    /// `Domain::new(positions, triangles, metric)`, sample for renumbered sample.
+    ///
+    /// # Errors
+    /// As [`Domain::new`], with the given numbering.
+    pub fn in_local_order(
+        positions: Vec<DVec2>,
+        triangles: Vec<[u32; 3]>,
+        metric: Metric,
+    ) -> Result<(Self, Vec<u32>), DomainError> {
+        check(&positions, &triangles)?;
+        let order = geometry::z_order(&positions);
+        let mut renumber = vec![0u32; positions.len()];
+        for (new, &old) in order.iter().enumerate() {
+            renumber[old as usize] = new as u32;
+        }
+        let mut domain = Self::new_unchecked(
+            order.iter().map(|&old| positions[old as usize]).collect(),
+            triangles
+                .iter()
+                .map(|t| t.map(|v| renumber[v as usize]))
+                .collect(),
+            metric,
+        );
+        domain.rank = Some(order);
+        Ok((domain, renumber))
     }
 
     fn new_unchecked(positions: Vec<DVec2>, triangles: Vec<[u32; 3]>, metric: Metric) -> Self {
@@ -314,6 +340,7 @@ impl Domain {
             positions,
             triangles,
             metric,
+            rank: None,
             min,
             max,
             graph: OnceLock::new(),
@@ -322,6 +349,23 @@ impl Domain {
             boundary: OnceLock::new(),
             mean_edge: OnceLock::new(),
         }
+    }
+
+    /// The rank of sample `v` among samples that tie: the caller's number of it (see
+    /// [`Domain::in_local_order`]), else `v` itself.
+    #[inline]
+    pub fn rank(&self, v: u32) -> u32 {
+        match &self.rank {
+            Some(rank) => rank[v as usize],
+            None => v,
+        }
+    }
+
+    /// Whether sample `v` wins a tie against sample `w` (`w` may be `u32::MAX`: none,
+    /// which every sample beats).
+    #[inline]
+    pub(crate) fn ranks_before(&self, v: u32, w: u32) -> bool {
+        w == u32::MAX || self.rank(v) < self.rank(w)
     }
 
     /// Sample positions in pixels.
@@ -439,7 +483,7 @@ impl Domain {
         best.map(|(t, b, _)| (t, b))
     }
 
-    /// The sample nearest to `p` (ties to the lower index).
+    /// The sample nearest to `p` (ties to the lower rank).
     pub fn nearest_vertex(&self, p: DVec2) -> Option<u32> {
         if !p.is_finite() {
             return None;
@@ -465,7 +509,9 @@ impl Domain {
                     }
                     for &v in grid.items(x, y) {
                         let d2 = (self.positions[v as usize] - p).length_squared();
-                        if best.is_none_or(|(b, bv)| d2 < b || (d2 == b && v < bv)) {
+                        if best
+                            .is_none_or(|(b, bv)| d2 < b || (d2 == b && self.ranks_before(v, bv)))
+                        {
                             best = Some((d2, v));
                         }
                     }
@@ -475,7 +521,7 @@ impl Domain {
         best.map(|(_, v)| v)
     }
 
-    /// The samples at exactly sample `v`'s place, `v` among them, in index order: more
+    /// The samples at exactly sample `v`'s place, `v` among them, in rank order: more
     /// than one where the mesh was split along a cut (the vertices on it doubled, one
     /// for each side).
     pub fn coincident(&self, v: u32) -> Vec<u32> {
@@ -487,12 +533,12 @@ impl Domain {
         let mut out: Vec<u32> = (grid.items(x, y).iter().copied())
             .filter(|&u| self.positions[u as usize] == p)
             .collect();
-        out.sort_unstable();
+        out.sort_unstable_by_key(|&u| self.rank(u));
         out
     }
 
     /// The samples within `r` of the segment from `a` to `b` (of the point `a` when
-    /// `a == b`), in index order; none for a non-finite segment or radius.
+    /// `a == b`), in rank order; none for a non-finite segment or radius.
     pub fn vertices_near_segment(&self, a: DVec2, b: DVec2, r: f64) -> Vec<u32> {
         if !(a.is_finite() && b.is_finite() && r.is_finite() && r >= 0.0) {
             return Vec::new();
@@ -511,15 +557,33 @@ impl Domain {
                 }
             }
         }
-        out.sort_unstable();
+        out.sort_unstable_by_key(|&v| self.rank(v));
         out
     }
 
     /// Closed boundary loops (edges used by exactly one triangle), each as a vertex
-    /// sequence without repeating the first vertex.
+    /// sequence without repeating the first vertex, each starting at its sample of
+    /// lowest rank.
     pub fn boundary_loops(&self) -> &[Vec<u32>] {
-        self.boundary
-            .get_or_init(|| boundary_loops(&self.triangles))
+        self.boundary.get_or_init(|| match &self.rank {
+            None => boundary_loops(&self.triangles),
+            // Traced in the caller's numbering, so that loops start, and turn at a
+            // vertex where two meet, as they would there.
+            Some(rank) => {
+                let ranked: Vec<[u32; 3]> = (self.triangles.iter())
+                    .map(|t| t.map(|v| rank[v as usize]))
+                    .collect();
+                let mut sample = vec![0u32; rank.len()];
+                for (v, &r) in rank.iter().enumerate() {
+                    sample[r as usize] = v as u32;
+                }
+                let mut loops = boundary_loops(&ranked);
+                for v in loops.iter_mut().flatten() {
+                    *v = sample[*v as usize];
+                }
+                loops
+            }
+        })
     }
 
     /// Whether the segment from `a` to `b` lies in the domain: both ends inside and no
@@ -638,6 +702,28 @@ fn boundary_loops(triangles: &[[u32; 3]]) -> Vec<Vec<u32>> {
         }
     }
     loops
+}
+
+/// Checks what [`Domain::new`] requires of `positions` and `triangles`.
+fn check(positions: &[DVec2], triangles: &[[u32; 3]]) -> Result<(), DomainError> {
+    if triangles.is_empty() {
+        return Err(DomainError::Empty);
+    }
+    if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+        return Err(DomainError::NonFinite { vertex: i });
+    }
+    for (i, t) in triangles.iter().enumerate() {
+        if t.iter().any(|&v| v as usize >= positions.len()) {
+            return Err(DomainError::IndexOutOfRange {
+                triangle: i,
+                vertices: positions.len(),
+            });
+        }
+        if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+            return Err(DomainError::DegenerateTriangle { triangle: i });
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

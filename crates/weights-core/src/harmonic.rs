@@ -175,16 +175,17 @@ pub(crate) type Coefficients = Box<[(u32, f64)]>;
 pub(crate) fn harmonic_coordinates(
     positions: &[DVec2],
     node_vertex: &[u32],
+    node_rank: &[u32],
     node_group: &[Option<usize>],
     edges: &[(u32, u32)],
     progress: &(dyn Fn(usize, usize) + Sync),
     earlier: &Solved,
 ) -> (Vec<Option<Coefficients>>, Solved) {
     let n = node_vertex.len();
-    // Free nodes in a canonical order (by sample), so results do not depend on how the
-    // nodes happen to be numbered.
+    // Free nodes in a canonical order (by the rank of their samples), so results do not
+    // depend on how the nodes happen to be numbered.
     let mut free: Vec<usize> = (0..n).filter(|&k| node_group[k].is_none()).collect();
-    free.sort_unstable_by_key(|&k| node_vertex[k]);
+    free.sort_unstable_by_key(|&k| node_rank[k]);
     let mut index = vec![u32::MAX; n];
     for (i, &k) in free.iter().enumerate() {
         index[k] = i as u32;
@@ -202,7 +203,7 @@ pub(crate) fn harmonic_coordinates(
         adjacency[b].push((a, 1.0 / len));
     }
     for list in adjacency.iter_mut() {
-        list.sort_unstable_by_key(|&(j, _)| node_vertex[j]);
+        list.sort_unstable_by_key(|&(j, _)| node_rank[j]);
     }
     // Components of the free nodes, each listed in free order, in the order of their
     // first member.
@@ -452,6 +453,7 @@ mod tests {
         let h = harmonic_coordinates(
             &positions,
             &node_vertex,
+            &node_vertex,
             &groups,
             &edges,
             &|_, _| {},
@@ -476,6 +478,7 @@ mod tests {
         let h = harmonic_coordinates(
             &positions,
             &node_vertex,
+            &node_vertex,
             &groups,
             &edges,
             &|_, _| {},
@@ -495,6 +498,7 @@ mod tests {
         let edges = [(0, 1), (1, 2), (2, 3), (4, 5)];
         let h = harmonic_coordinates(
             &positions,
+            &node_vertex,
             &node_vertex,
             &node_group,
             &edges,
@@ -539,6 +543,7 @@ mod tests {
         }
         let h = harmonic_coordinates(
             &p,
+            &node_vertex,
             &node_vertex,
             &node_group,
             &edges,

@@ -218,9 +218,13 @@ fn harmonic_of(
 ) -> (Vec<Option<Coefficients>>, Solved) {
     let edges = dual_edges(domain, partition);
     let node_group: Vec<Option<usize>> = nodes.iter().map(|n| group_of(n, handle_count)).collect();
+    let node_rank: Vec<u32> = (partition.node_vertex.iter())
+        .map(|&v| domain.rank(v))
+        .collect();
     harmonic_coordinates(
         domain.positions(),
         &partition.node_vertex,
+        &node_rank,
         &node_group,
         &edges,
         progress,
@@ -1816,7 +1820,11 @@ fn real_nodes(
         })?;
         let tri = domain.triangles()[t];
         let best = (0..3)
-            .max_by(|&a, &b| bary[a].total_cmp(&bary[b]).then(tri[b].cmp(&tri[a])))
+            .max_by(|&a, &b| {
+                bary[a]
+                    .total_cmp(&bary[b])
+                    .then(domain.rank(tri[b]).cmp(&domain.rank(tri[a])))
+            })
             .unwrap_or(0);
         Ok(tri[best])
     };

@@ -24,7 +24,7 @@ use crate::voronoi::Partition;
 pub enum Placement {
     /// The paper's Algorithm 1 as written: each round, one virtual handle, at the
     /// farthest sample of the cell with the largest (r_d − r_h)/r_d (ties: the node
-    /// on the lower sample; its farthest sample of lowest index).
+    /// on the sample of lower rank; its farthest sample of lowest rank).
     #[default]
     AsWritten,
     /// Each round, every cell within a relative 10⁻⁹ of the worst ratio, each at all
@@ -81,7 +81,7 @@ impl std::hash::Hasher for SquareHasher {
 }
 
 /// A node violating r_d < r_h, ordered worst first: by ratio (r_d − r_h)/r_d, then by
-/// lower sample.
+/// the lower rank of its sample.
 #[derive(Clone, Copy, Debug)]
 struct Violator {
     ratio: f64,
@@ -130,7 +130,7 @@ pub(crate) fn insert_virtual_handles(
     }
     if domain.metric() == Metric::Intrinsic {
         // One node for every component of the sample graph that no node reaches.
-        for v in partition.unreached() {
+        for v in partition.unreached(domain) {
             if partition.owner[v as usize] == crate::voronoi::NONE {
                 partition.add_node(domain, v);
                 inserted(partition, partition.len() - 1);
@@ -150,7 +150,7 @@ pub(crate) fn insert_virtual_handles(
         .filter_map(|k| {
             ratio(partition, k).map(|r| Violator {
                 ratio: r,
-                key: partition.node_vertex[k],
+                key: domain.rank(partition.node_vertex[k]),
                 node: k,
             })
         })
@@ -305,7 +305,7 @@ pub(crate) fn insert_virtual_handles(
         heap.extend(touched.into_iter().filter_map(|k| {
             ratio(partition, k).map(|r| Violator {
                 ratio: r,
-                key: partition.node_vertex[k],
+                key: domain.rank(partition.node_vertex[k]),
                 node: k,
             })
         }));
@@ -448,6 +448,6 @@ mod tests {
         let mut part = Partition::new(&d, vec![5]);
         let added = insert_virtual_handles(&d, &mut part, Placement::AsWritten, |_, _| {});
         assert!(added.contains(&n));
-        assert!(part.unreached().is_empty());
+        assert!(part.unreached(&d).is_empty());
     }
 }

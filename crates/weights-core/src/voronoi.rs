@@ -6,8 +6,9 @@
 //! graph neighbour in another cell, which every boundary edge starts from) and its
 //! farthest member, so that a change re-reads a few hundred samples per touched cell.
 //!
-//! Ties between nodes at equal distance go to the node on the lower sample index, so
-//! the partition depends on the set of nodes, not on the order they were added in.
+//! Ties between nodes at equal distance go to the node on the sample of lower rank
+//! ([`Domain::rank`]: its index, unless the domain was renumbered), so the partition
+//! depends on the set of nodes, not on the order they were added in.
 
 use glam::DVec2;
 
@@ -205,8 +206,9 @@ impl Partition {
                 p.members = CellLists::new(p.node_vertex.len(), n);
                 with_queue(domain, |queue| {
                     for (k, &v) in p.node_vertex.iter().enumerate() {
-                        let entry = Entry::new(0.0, v, v);
-                        if less((0.0, v), (p.dist[v as usize], p.key_of(v))) {
+                        let key = domain.rank(v);
+                        let entry = Entry::new(0.0, key, v);
+                        if less((0.0, key), (p.dist[v as usize], p.key_of(domain, v))) {
                             p.dist[v as usize] = 0.0;
                             p.owner[v as usize] = k as u32;
                             queue.push(entry);
@@ -234,7 +236,7 @@ impl Partition {
             let this = &*self;
             self.far = (0..this.node_vertex.len())
                 .into_par_iter()
-                .map(|k| this.farthest(k))
+                .map(|k| this.farthest(domain, k))
                 .collect();
         }
         let this = &*self;
@@ -256,13 +258,15 @@ impl Partition {
         o != NONE && self.node_vertex[o as usize] == v
     }
 
+    /// The tie-break key of sample `v`'s node: the rank of its sample (`NONE` for
+    /// none).
     #[inline]
-    fn key_of(&self, v: u32) -> u32 {
+    fn key_of(&self, domain: &Domain, v: u32) -> u32 {
         let o = self.owner[v as usize];
         if o == NONE {
             NONE
         } else {
-            self.node_vertex[o as usize]
+            domain.rank(self.node_vertex[o as usize])
         }
     }
 
@@ -288,7 +292,7 @@ impl Partition {
         let graph = domain.graph();
         while let Some(entry) = queue.pop() {
             let (d, key, v) = (entry.d(), entry.key(), entry.v());
-            if d != self.dist[v as usize] || key != self.key_of(v) {
+            if d != self.dist[v as usize] || key != self.key_of(domain, v) {
                 continue;
             }
             let k = self.owner[v as usize];
@@ -297,7 +301,7 @@ impl Partition {
                 let w = e.to as usize;
                 let dw = self.dist[w];
                 // (The tie-break key is looked up only on a tie.)
-                if nd < dw || (nd == dw && key < self.key_of(e.to)) {
+                if nd < dw || (nd == dw && key < self.key_of(domain, e.to)) {
                     self.dist[w] = nd;
                     if let Some(changed) = changed.as_deref_mut() {
                         let old = self.owner[w];
@@ -365,7 +369,7 @@ impl Partition {
                 if o != NONE {
                     seeds.push(Entry::new(
                         self.dist[e.to as usize],
-                        self.node_vertex[o as usize],
+                        domain.rank(self.node_vertex[o as usize]),
                         e.to,
                     ));
                 }
@@ -385,11 +389,12 @@ impl Partition {
                 farthest: NONE,
                 r_h: f64::INFINITY,
             });
-            if less((0.0, v), (self.dist[v as usize], self.key_of(v))) {
+            let key = domain.rank(v);
+            if less((0.0, key), (self.dist[v as usize], self.key_of(domain, v))) {
                 changed.push((v, self.owner[v as usize]));
                 self.dist[v as usize] = 0.0;
                 self.set_owner(v, k);
-                seeds.push(Entry::new(0.0, v, v));
+                seeds.push(Entry::new(0.0, key, v));
             }
         }
         with_queue(domain, |queue| {
@@ -405,7 +410,7 @@ impl Partition {
                 if o != NONE && (o as usize) < first_new {
                     let (r, f) = self.far[o as usize];
                     let d = self.dist[v as usize];
-                    if d > r || (d == r && v < f) {
+                    if d > r || (d == r && domain.ranks_before(v, f)) {
                         self.far[o as usize] = (d, v);
                     }
                 }
@@ -415,11 +420,11 @@ impl Partition {
         for &j in &touched {
             let f = self.far[j].1;
             if j < first_new && f != NONE && self.owner[f as usize] != j as u32 {
-                self.far[j] = self.farthest(j);
+                self.far[j] = self.farthest(domain, j);
             }
         }
         for k in first_new..self.node_vertex.len() {
-            self.far[k] = self.farthest(k);
+            self.far[k] = self.farthest(domain, k);
             touched.push(k);
         }
         self.refresh(domain, touched)
@@ -459,7 +464,7 @@ impl Partition {
                 let mut best = (f64::INFINITY, NONE, NONE);
                 for &k in &candidates[y * grid.nx + x] {
                     let d = (node_pos[k as usize] - p).length();
-                    let key = node_vertex[k as usize];
+                    let key = domain.rank(node_vertex[k as usize]);
                     if less((d, key), (best.0, best.1)) {
                         best = (d, key, k);
                     }
@@ -515,7 +520,7 @@ impl Partition {
         for &j in &touched {
             let s = self.stats[j];
             if j != k && s.farthest != NONE && self.owner[s.farthest as usize] != j as u32 {
-                let (r_d, farthest) = self.farthest(j);
+                let (r_d, farthest) = self.farthest(domain, j);
                 self.stats[j].r_d = r_d;
                 self.stats[j].farthest = farthest;
             }
@@ -578,7 +583,7 @@ impl Partition {
                 let wi = w as usize;
                 let dw = self.dist[wi];
                 // (The tie-break key is looked up only on a tie.)
-                if d < dw || (d == dw && v < self.key_of(w)) {
+                if d < dw || (d == dw && domain.rank(v) < self.key_of(domain, w)) {
                     let old = self.owner[wi];
                     if old != NONE && touched.last() != Some(&(old as usize)) {
                         touched.push(old as usize);
@@ -661,8 +666,9 @@ impl Partition {
             let mut best = (f64::INFINITY, NONE, NONE);
             for (j, &nv) in self.node_vertex.iter().enumerate() {
                 let d = (positions[nv as usize] - p).length();
-                if less((d, nv), (best.0, best.1)) {
-                    best = (d, nv, j as u32);
+                let key = domain.rank(nv);
+                if less((d, key), (best.0, best.1)) {
+                    best = (d, key, j as u32);
                 }
             }
             self.dist[v as usize] = best.0;
@@ -809,13 +815,13 @@ impl Partition {
         cells
     }
 
-    /// r_d and the farthest sample of cell `k` (ties to the lower sample index).
-    fn farthest(&self, k: usize) -> (f64, u32) {
+    /// r_d and the farthest sample of cell `k` (ties to the lower rank).
+    fn farthest(&self, domain: &Domain, k: usize) -> (f64, u32) {
         let mut r_d = 0.0;
         let mut farthest = NONE;
         for &v in &self.members[k] {
             let d = self.dist[v as usize];
-            if d > r_d || (d == r_d && v < farthest) {
+            if d > r_d || (d == r_d && domain.ranks_before(v, farthest)) {
                 r_d = d;
                 farthest = v;
             }
@@ -832,7 +838,7 @@ impl Partition {
     fn cell_stats(&self, domain: &Domain, k: usize) -> CellStats {
         let (mut r_d, mut farthest) = match domain.metric() {
             Metric::Intrinsic => self.far[k],
-            Metric::Euclidean => self.farthest(k),
+            Metric::Euclidean => self.farthest(domain, k),
         };
         let r_h = match domain.metric() {
             Metric::Intrinsic => {
@@ -847,7 +853,9 @@ impl Partition {
                             let dw = self.dist[e.to as usize];
                             let reach = du + f64::from(e.len);
                             best = best.min(reach + dw);
-                            if reach == dw && (dw > r_d || (dw == r_d && e.to < farthest)) {
+                            if reach == dw
+                                && (dw > r_d || (dw == r_d && domain.ranks_before(e.to, farthest)))
+                            {
                                 r_d = dw;
                                 farthest = e.to;
                             }
@@ -871,7 +879,7 @@ impl Partition {
     }
 
     /// Every sample of the closed cell `k` at distance exactly r_d (its farthest samples,
-    /// ties included), lowest index first.
+    /// ties included), lowest rank first.
     pub fn farthest_samples(&self, domain: &Domain, k: usize) -> Vec<u32> {
         let r_d = self.stats[k].r_d;
         let mut out: Vec<u32> = self.members[k]
@@ -891,7 +899,7 @@ impl Partition {
                 }
             }
         }
-        out.sort_unstable();
+        out.sort_unstable_by_key(|&v| domain.rank(v));
         out.dedup();
         out
     }
@@ -914,11 +922,13 @@ impl Partition {
         })
     }
 
-    /// Samples no node reaches (other components of the graph), lowest first.
-    pub fn unreached(&self) -> Vec<u32> {
-        (0..self.owner.len() as u32)
+    /// Samples no node reaches (other components of the graph), lowest rank first.
+    pub fn unreached(&self, domain: &Domain) -> Vec<u32> {
+        let mut out: Vec<u32> = (0..self.owner.len() as u32)
             .filter(|&v| self.owner[v as usize] == NONE)
-            .collect()
+            .collect();
+        out.sort_unstable_by_key(|&v| domain.rank(v));
+        out
     }
 
     /// Checks the partition against a rebuild from scratch; for tests.
@@ -1052,7 +1062,18 @@ mod tests {
                     expected = (dv, v as u32);
                 }
             }
-            assert_eq!(part.farthest(0), expected, "{metric:?}");
+            assert_eq!(part.farthest(&d, 0), expected, "{metric:?}");
+            // Given in reverse (the top-right corner first) and renumbered along the
+            // curve (which starts at the bottom left), the tie still goes to the corner
+            // first in the given numbering.
+            let last = p.len() as u32 - 1;
+            let reversed: Vec<DVec2> = p.iter().rev().copied().collect();
+            let flipped: Vec<[u32; 3]> = t.iter().map(|t| t.map(|v| last - v)).collect();
+            let (r, renumber) = Domain::in_local_order(reversed, flipped, metric).expect("valid");
+            let part = Partition::new(&r, vec![renumber[(last - (100 * 251 + 125)) as usize]]);
+            let (far, v) = part.farthest(&r, 0);
+            assert_eq!(far, expected.0, "{metric:?}");
+            assert_eq!(r.positions()[v as usize], p[last as usize], "{metric:?}");
         }
     }
 

@@ -561,8 +561,8 @@ impl Weights {
             })
             .collect();
         let mut order: Vec<usize> = (0..partition.len()).collect();
-        order.sort_unstable_by_key(|&k| partition.node_vertex[k]);
-        // Every support's entries bucketed by chunk, nodes in sample order.
+        order.sort_unstable_by_key(|&k| domain.rank(partition.node_vertex[k]));
+        // Every support's entries bucketed by chunk, nodes in rank order.
         let mut by_chunk: Vec<Vec<(u32, u32, f32)>> = vec![Vec::new(); n.div_ceil(CHUNK)];
         for &k in &order {
             for &(v, f) in &supports[k] {
@@ -612,7 +612,7 @@ impl Weights {
         // Per cell, the nodes whose support disc meets it (or whose sample is in it), in
         // order of the nodes' samples: nodes visited in that order, bucketed by cell.
         let mut order: Vec<u32> = (0..partition.len() as u32).collect();
-        order.sort_unstable_by_key(|&k| partition.node_vertex[k as usize]);
+        order.sort_unstable_by_key(|&k| domain.rank(partition.node_vertex[k as usize]));
         let reached: Vec<Vec<u32>> = order
             .par_iter()
             .map(|&k| {
