@@ -220,8 +220,18 @@ pub(crate) fn insert_virtual_handles(
         for &(_, k) in &violators {
             let r_h = partition.stats[k].r_h;
             let samples = farthest[k].get_or_insert_with(|| {
+                let stats = &partition.stats[k];
+                if as_written {
+                    // The first of the cell's farthest samples, which its radii keep
+                    // (a violator has r_d > 0, so it has one).
+                    debug_assert_eq!(
+                        partition.farthest_samples(domain, k).first(),
+                        Some(&stats.farthest)
+                    );
+                    return vec![stats.farthest];
+                }
                 let mut all = partition.farthest_samples(domain, k);
-                all.truncate(if as_written { 1 } else { MAX_TIED_PER_CELL });
+                all.truncate(MAX_TIED_PER_CELL);
                 all
             });
             for &far in samples.iter() {
