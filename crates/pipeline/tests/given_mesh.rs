@@ -221,3 +221,41 @@ fn ties_on_a_renumbered_mesh_go_as_the_files_numbering_has_them() {
         }
     }
 }
+
+#[test]
+fn saved_virtual_handles_keep_their_copy_of_a_cut_vertex() {
+    // A slit up the middle of the strip: the vertices on it doubled, the copies (after
+    // the file's vertices) used by the triangles on its right. Two saved virtual
+    // handles sit on the slit, one on each copy.
+    let mut mesh = strip(true);
+    let slit: Vec<u32> = (0..6).map(|j| file(24, j)).collect();
+    let mut copy = std::collections::HashMap::new();
+    for &v in &slit {
+        copy.insert(v, mesh.vertices.len() as u32);
+        mesh.vertices.push(mesh.vertices[v as usize]);
+    }
+    for (t, tri) in mesh.triangles.iter_mut().enumerate() {
+        // Triangles are made two a cell, cells row by row: cell i of the row.
+        let i = (t / 2) as u32 % (NX - 1);
+        if i >= 24 {
+            *tri = tri.map(|v| copy.get(&v).copied().unwrap_or(v));
+        }
+    }
+    let on_slit = |j: u32| {
+        let p = mesh.vertices[file(24, j) as usize];
+        [p.x, p.y]
+    };
+    let project = Project {
+        metric: MetricChoice::Intrinsic,
+        handles: vec![
+            pin(&mesh, 4, 6),
+            pin(&mesh, 44, 5),
+            point([243.0, 81.0], [0.0, 0.0]),
+        ],
+        virtual_handles: vec![on_slit(2), on_slit(4)],
+        virtual_placed_for: vec![Some(0), Some(1)],
+        virtual_copy: vec![1, 0],
+        ..Project::default()
+    };
+    answers_as_numbered(&mesh, project);
+}
