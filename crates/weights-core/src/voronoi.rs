@@ -763,20 +763,24 @@ impl Partition {
             let mut front = false;
             for e in graph.neighbors(v) {
                 let ow = self.owner[e.to as usize];
+                if ow == o {
+                    // (Its cell is noted already.)
+                    if o != NONE
+                        && (o as usize) < fresh
+                        && self.frontier_cell[e.to as usize] != NONE
+                        && !self.on_frontier(graph, e.to)
+                    {
+                        self.set_frontier(e.to, NONE);
+                    }
+                    continue;
+                }
                 note(ow, &mut cells);
                 if ow == NONE || o == NONE {
                     continue;
                 }
-                if ow != o {
-                    front = true;
-                    if self.frontier_cell[e.to as usize] != ow {
-                        self.set_frontier(e.to, ow);
-                    }
-                } else if (ow as usize) < fresh
-                    && self.frontier_cell[e.to as usize] != NONE
-                    && !self.on_frontier(graph, e.to)
-                {
-                    self.set_frontier(e.to, NONE);
+                front = true;
+                if self.frontier_cell[e.to as usize] != ow {
+                    self.set_frontier(e.to, ow);
                 }
             }
             self.set_frontier(v, if front { o } else { NONE });
