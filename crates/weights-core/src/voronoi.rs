@@ -214,7 +214,7 @@ impl Partition {
                             queue.push(entry);
                         }
                     }
-                    p.propagate(domain, queue, None);
+                    p.propagate(domain, queue, None, None);
                 });
                 for v in 0..n {
                     let o = p.owner[v];
@@ -282,12 +282,16 @@ impl Partition {
     /// Multi-source Dijkstra from the entries in `queue`, claiming samples for the
     /// popped entry's owner wherever that is lexicographically closer. With `changed`,
     /// member lists are kept current and each sample whose owner changed is recorded
-    /// with its previous owner.
+    /// with its previous owner. With `bordering`, each sample settled with a neighbour
+    /// in another cell (or in none) at that moment is recorded: with one node
+    /// searching, whose cell only grows meanwhile, a settled sample not recorded has
+    /// its whole neighbourhood in its cell for good.
     fn propagate(
         &mut self,
         domain: &Domain,
         queue: &mut Queue,
         mut changed: Option<&mut Vec<(u32, u32)>>,
+        mut bordering: Option<&mut Vec<u32>>,
     ) {
         let graph = domain.graph();
         while let Some(entry) = queue.pop() {
@@ -296,25 +300,31 @@ impl Partition {
                 continue;
             }
             let k = self.owner[v as usize];
+            let mut foreign = false;
             for e in graph.neighbors(v) {
                 let nd = d + f64::from(e.len);
                 let w = e.to as usize;
                 let dw = self.dist[w];
                 // (The tie-break key is looked up only on a tie.)
-                if nd < dw || (nd == dw && key < self.key_of(domain, e.to)) {
-                    self.dist[w] = nd;
-                    if let Some(changed) = changed.as_deref_mut() {
-                        let old = self.owner[w];
-                        if old != k {
-                            changed.push((e.to, old));
-                            self.set_owner(e.to, k);
-                        }
-                    } else {
-                        self.owner[w] = k;
-                    }
-                    graph.prefetch(e.to);
-                    queue.push(Entry::new(nd, key, e.to));
+                if !(nd < dw || (nd == dw && key < self.key_of(domain, e.to))) {
+                    foreign |= bordering.is_some() && self.owner[w] != k;
+                    continue;
                 }
+                self.dist[w] = nd;
+                if let Some(changed) = changed.as_deref_mut() {
+                    let old = self.owner[w];
+                    if old != k {
+                        changed.push((e.to, old));
+                        self.set_owner(e.to, k);
+                    }
+                } else {
+                    self.owner[w] = k;
+                }
+                graph.prefetch(e.to);
+                queue.push(Entry::new(nd, key, e.to));
+            }
+            if foreign && let Some(bordering) = bordering.as_deref_mut() {
+                bordering.push(v);
             }
         }
     }
@@ -397,9 +407,12 @@ impl Partition {
                 seeds.push(Entry::new(0.0, key, v));
             }
         }
+        // One node added and none removed (each of Algorithm 1's): only the samples
+        // it settled beside another cell need their neighbourhoods read again.
+        let mut bordering = (freed.is_empty() && added.len() == 1).then(Vec::new);
         with_queue(domain, |queue| {
             seeds.into_iter().for_each(|e| queue.push(e));
-            self.propagate(domain, queue, Some(&mut changed));
+            self.propagate(domain, queue, Some(&mut changed), bordering.as_mut());
         });
         // A surviving cell only gained freed samples and lost samples to the new
         // nodes (a sample that stays keeps its distance): its farthest member is the
@@ -416,7 +429,7 @@ impl Partition {
                 }
             }
         }
-        let mut touched = self.settle(domain, &changed, first_new);
+        let mut touched = self.settle(domain, &changed, first_new, bordering.as_deref());
         for &j in &touched {
             let f = self.far[j].1;
             if j < first_new && f != NONE && self.owner[f as usize] != j as u32 {
@@ -732,12 +745,22 @@ impl Partition {
     /// cells whose radii may have changed, each once — the owners before and after of
     /// the changed samples and the owners of their neighbours.
     ///
+    /// With `bordering` (one node added, see [`Partition::propagate`]), the changed
+    /// samples not in it have every neighbour in their own cell: off every frontier,
+    /// and nothing else to see.
+    ///
     /// Only the changed samples and their neighbours can enter or leave a frontier. A
     /// changed sample is checked in full; a neighbour in another cell is on a frontier
     /// now; a neighbour in the same cell may have lost its only foreign neighbour, which
     /// matters only if it is on a frontier list, and not at all in cells from `fresh`
     /// on (new cells, whose samples all changed and are checked in full).
-    fn settle(&mut self, domain: &Domain, changed: &[(u32, u32)], fresh: usize) -> Vec<usize> {
+    fn settle(
+        &mut self,
+        domain: &Domain,
+        changed: &[(u32, u32)],
+        fresh: usize,
+        bordering: Option<&[u32]>,
+    ) -> Vec<usize> {
         let graph = domain.graph();
         // A flag per cell, kept between calls and cleared after: a fresh one each time
         // would cost a pass over every cell for each new node (quadratic where Algorithm
@@ -745,7 +768,7 @@ impl Partition {
         let mut seen = std::mem::take(&mut self.noted);
         seen.resize(self.node_vertex.len(), false);
         let mut cells = Vec::new();
-        let mut note = |o: u32, cells: &mut Vec<usize>| {
+        let mut note = |o: u32| {
             if o != NONE && !seen[o as usize] {
                 seen[o as usize] = true;
                 cells.push(o as usize);
@@ -753,43 +776,73 @@ impl Partition {
         };
         /// How far ahead of a visit the edges are fetched.
         const AHEAD: usize = 8;
-        for (i, &(v, old)) in changed.iter().enumerate() {
-            if let Some(&(ahead, _)) = changed.get(i + AHEAD) {
-                graph.prefetch(ahead);
-            }
-            let o = self.owner[v as usize];
-            note(old, &mut cells);
-            note(o, &mut cells);
-            let mut front = false;
-            for e in graph.neighbors(v) {
-                let ow = self.owner[e.to as usize];
-                if ow == o {
-                    // (Its cell is noted already.)
-                    if o != NONE
-                        && (o as usize) < fresh
-                        && self.frontier_cell[e.to as usize] != NONE
-                        && !self.on_frontier(graph, e.to)
-                    {
-                        self.set_frontier(e.to, NONE);
+        match bordering {
+            None => {
+                for (i, &(v, old)) in changed.iter().enumerate() {
+                    if let Some(&(ahead, _)) = changed.get(i + AHEAD) {
+                        graph.prefetch(ahead);
                     }
-                    continue;
-                }
-                note(ow, &mut cells);
-                if ow == NONE || o == NONE {
-                    continue;
-                }
-                front = true;
-                if self.frontier_cell[e.to as usize] != ow {
-                    self.set_frontier(e.to, ow);
+                    note(old);
+                    self.settle_sample(graph, v, fresh, &mut note);
                 }
             }
-            self.set_frontier(v, if front { o } else { NONE });
+            Some(bordering) => {
+                for &(v, old) in changed {
+                    note(old);
+                    note(self.owner[v as usize]);
+                    self.set_frontier(v, NONE);
+                }
+                for (i, &v) in bordering.iter().enumerate() {
+                    if let Some(&ahead) = bordering.get(i + AHEAD) {
+                        graph.prefetch(ahead);
+                    }
+                    self.settle_sample(graph, v, fresh, &mut note);
+                }
+            }
         }
         for &c in &cells {
             seen[c] = false;
         }
         self.noted = seen;
         cells
+    }
+
+    /// [`Partition::settle`] for one changed sample `v`: notes its cell and its
+    /// neighbours' (`note`), and puts it and its neighbours on the frontiers they now
+    /// belong to.
+    fn settle_sample(
+        &mut self,
+        graph: &crate::domain::Graph,
+        v: u32,
+        fresh: usize,
+        note: &mut impl FnMut(u32),
+    ) {
+        let o = self.owner[v as usize];
+        note(o);
+        let mut front = false;
+        for e in graph.neighbors(v) {
+            let ow = self.owner[e.to as usize];
+            if ow == o {
+                // (Its cell is noted already.)
+                if o != NONE
+                    && (o as usize) < fresh
+                    && self.frontier_cell[e.to as usize] != NONE
+                    && !self.on_frontier(graph, e.to)
+                {
+                    self.set_frontier(e.to, NONE);
+                }
+                continue;
+            }
+            note(ow);
+            if ow == NONE || o == NONE {
+                continue;
+            }
+            front = true;
+            if self.frontier_cell[e.to as usize] != ow {
+                self.set_frontier(e.to, ow);
+            }
+        }
+        self.set_frontier(v, if front { o } else { NONE });
     }
 
     /// Puts sample `v` on the frontier list of cell `cell` (`NONE`: on none).
@@ -1049,6 +1102,24 @@ mod tests {
                 .expect("one");
             p.replace_nodes(&d, &[0, 1], &[a, inside, elsewhere]);
             p.assert_matches_rebuild(&d);
+        }
+    }
+
+    #[test]
+    fn nodes_added_one_by_one_keep_the_frontiers_of_a_rebuild() {
+        // Each single addition settles only the samples it claimed beside another
+        // cell; the frontier lists must still be every cell's.
+        for metric in [Metric::Intrinsic, Metric::Euclidean] {
+            let d = jittered(30, 20, 11, metric);
+            let mut p = Partition::new(&d, vec![0]);
+            for i in 1..40 {
+                let v = (i * 7919 + 13) % d.len() as u32;
+                if !p.is_node(v) {
+                    p.add_node(&d, v);
+                    p.assert_matches_rebuild(&d);
+                }
+            }
+            assert!(p.len() > 30);
         }
     }
 
