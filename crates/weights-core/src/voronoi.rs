@@ -981,6 +981,11 @@ impl Partition {
 
     /// Samples no node reaches (other components of the graph), lowest rank first.
     pub fn unreached(&self, domain: &Domain) -> Vec<u32> {
+        // (Counted first: every sample is reached, nearly always.)
+        let reached: usize = self.members.lists.iter().map(Vec::len).sum();
+        if reached == self.owner.len() {
+            return Vec::new();
+        }
         let mut out: Vec<u32> = (0..self.owner.len() as u32)
             .filter(|&v| self.owner[v as usize] == NONE)
             .collect();
