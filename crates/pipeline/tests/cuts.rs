@@ -2,7 +2,9 @@
 //! other side where it was, under C² and ARAP; the cut is part of the rig file, so a
 //! reopened project builds the same mesh.
 
-use project::{Cut, HandleSpec, Method, Project};
+use project::{Cut, Method, Project};
+
+use crate::support::point;
 
 /// Two blobs that touch along x = 60 for y in 20..40 only (a tail against a leg).
 fn touching() -> image::RgbaImage {
@@ -11,16 +13,6 @@ fn touching() -> image::RgbaImage {
         let right = (60..112).contains(&x) && (20..40).contains(&y);
         image::Rgba([180, 90, 40, if left || right { 255 } else { 0 }])
     })
-}
-
-fn point(rest: [f64; 2], translate: [f64; 2]) -> HandleSpec {
-    HandleSpec::Point {
-        rest,
-        translate,
-        rotate: 0.0,
-        scale: 1.0,
-        depth: 0,
-    }
 }
 
 /// The largest move of a vertex of the left blob (x < 59) when the right blob's pin

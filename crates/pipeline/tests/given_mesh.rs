@@ -7,6 +7,8 @@ use pipeline::{Deformer, Mesh, Source, WeightsListing};
 use project::{HandleSpec, MetricChoice, Project};
 use weights_core::{Domain, Metric};
 
+use crate::support::point;
+
 /// A long strip (a limb) of 48 × 12 vertices 10 px apart, jittered (no two distances
 /// tie) or on a regular grid (ties everywhere), numbered in a scattered order as a mesh
 /// generator numbers its vertices.
@@ -48,16 +50,6 @@ const NY: u32 = 12;
 /// number `g`.
 fn file(i: u32, j: u32) -> u32 {
     ((j * NX + i) * 37) % (NX * NY)
-}
-
-fn point(rest: [f64; 2], translate: [f64; 2]) -> HandleSpec {
-    HandleSpec::Point {
-        rest,
-        translate,
-        rotate: 0.0,
-        scale: 1.0,
-        depth: 0,
-    }
 }
 
 fn weights_of(deformer: &dyn Deformer, file_vertices: usize) -> serde_json::Value {
