@@ -890,8 +890,9 @@ impl Weights {
                             .extend_from_slice(&chunk.phi[a as usize..b as usize]);
                         continue;
                     }
-                    // A dirty row: its entries of unchanged nodes (in sample order
-                    // already), then each changed node's new entry put in its place.
+                    // A dirty row: its entries of unchanged nodes (in the order of
+                    // their samples' ranks already), then each changed node's new
+                    // entry put in its place.
                     let i = v - lo;
                     let (a, b) = (chunk.offsets[i] as usize, chunk.offsets[i + 1] as usize);
                     let base = rebuilt.nodes.len();
@@ -903,13 +904,12 @@ impl Weights {
                         }
                     }
                     for &(k, f) in &by_row[start[i] as usize..start[i + 1] as usize] {
-                        let key = partition.node_vertex[k as usize];
+                        let rank = |k: u32| domain.rank(partition.node_vertex[k as usize]);
+                        let key = rank(k);
                         let mut at = rebuilt.nodes.len();
                         rebuilt.nodes.push(k);
                         rebuilt.phi.push(f);
-                        while at > base
-                            && partition.node_vertex[rebuilt.nodes[at - 1] as usize] > key
-                        {
+                        while at > base && rank(rebuilt.nodes[at - 1]) > key {
                             rebuilt.nodes[at] = rebuilt.nodes[at - 1];
                             rebuilt.phi[at] = rebuilt.phi[at - 1];
                             at -= 1;
