@@ -156,20 +156,10 @@ proptest! {
         convex in any::<bool>(),
         renumbered in any::<bool>(),
     ) {
-        let domain = grid_domain(36, 28, 1.0, 0.3, shape_of(convex), seed);
         // Also on the mesh renumbered along the curve, its ties broken by the grid's
         // numbering.
-        let domain = if renumbered {
-            Domain::in_local_order(
-                domain.positions().to_vec(),
-                domain.triangles().to_vec(),
-                domain.metric(),
-            )
-            .expect("valid")
-            .0
-        } else {
-            domain
-        };
+        let domain = grid_domain(36, 28, 1.0, 0.3, shape_of(convex), seed);
+        let domain = support::renumbered_if(domain, renumbered);
         let mut rng = Rng(seed);
         let handles = random_handles(&domain, &mut rng, 4, 1);
         let mut rig = Rig::new(domain.clone(), handles, RigOptions::default()).expect("valid");

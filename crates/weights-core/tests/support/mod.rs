@@ -108,3 +108,16 @@ pub fn compact(positions: Vec<DVec2>, triangles: Vec<[u32; 3]>, metric: Metric) 
         .collect();
     Domain::new(kept, triangles, metric).expect("valid test domain")
 }
+
+/// `domain` renumbered along a Z-order curve ([`Domain::in_local_order`]) if
+/// `renumbered`, its ties broken by its numbering before; else as it is.
+pub fn renumbered_if(domain: Domain, renumbered: bool) -> Domain {
+    if !renumbered {
+        return domain;
+    }
+    let positions = domain.positions().to_vec();
+    let triangles = domain.triangles().to_vec();
+    Domain::in_local_order(positions, triangles, domain.metric())
+        .expect("a valid domain")
+        .0
+}
