@@ -3,7 +3,14 @@
 //! factorisations with faer.
 
 use faer::Side;
-use faer::sparse::{SparseColMat, Triplet};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::perm::PermRef;
+use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::linalg::cholesky::{
+    CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
+    factorize_symbolic_cholesky,
+};
+use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
 use geometry::orient;
 use glam::DVec2;
 
@@ -35,18 +42,22 @@ impl Elements {
         Self { area, grad }
     }
 
-    /// Lower triangle (row ≥ column) of `scale_k · K + scale_m · M` over the vertices
-    /// `map[v] = Some(row)`, with `K` the stiffness matrix `∫∇φ_a·∇φ_b` and `M` the
-    /// lumped mass matrix.
-    pub fn lower_triplets(
+    /// The lower triangle (row ≥ column) of the stiffness matrix `K = ∫∇φ_a·∇φ_b`
+    /// and of a diagonal `mass`, over the vertices `map[v] = Some(row)`: one
+    /// assembly for every `scale_k · K + scale_m · M` of that pattern
+    /// ([`Lower::values`]).
+    pub fn lower(
         &self,
         triangles: &[[u32; 3]],
         map: &dyn Fn(u32) -> Option<usize>,
-        scale_k: f64,
         mass: &[f64],
-        scale_m: f64,
-    ) -> Vec<Triplet<usize, usize, f64>> {
-        let mut out = Vec::with_capacity(triangles.len() * 6 + mass.len());
+    ) -> Lower {
+        let capacity = triangles.len() * 6 + mass.len();
+        let mut lower = Lower {
+            index: Vec::with_capacity(capacity),
+            stiffness: Vec::with_capacity(capacity),
+            mass: Vec::with_capacity(capacity),
+        };
         for (s, t) in triangles.iter().enumerate() {
             let g = &self.grad[s];
             for a in 0..3 {
@@ -54,21 +65,17 @@ impl Elements {
                 for b in 0..3 {
                     let Some(rb) = map(t[b]) else { continue };
                     if ra >= rb {
-                        out.push(Triplet::new(
-                            ra,
-                            rb,
-                            scale_k * self.area[s] * g[a].dot(g[b]),
-                        ));
+                        lower.push(ra, rb, self.area[s] * g[a].dot(g[b]), 0.0);
                     }
                 }
             }
         }
         for (v, &m) in mass.iter().enumerate() {
             if let Some(r) = map(v as u32) {
-                out.push(Triplet::new(r, r, scale_m * m));
+                lower.push(r, r, 0.0, m);
             }
         }
-        out
+        lower
     }
 
     /// Lumped mass: a third of each incident triangle's area.
@@ -81,6 +88,102 @@ impl Elements {
         }
         m
     }
+}
+
+/// Entries of the lower triangles of a stiffness and a mass matrix on one pattern
+/// (duplicates to be summed), from [`Elements::lower`].
+pub(crate) struct Lower {
+    index: Vec<Pair<usize, usize>>,
+    stiffness: Vec<f64>,
+    mass: Vec<f64>,
+}
+
+impl Lower {
+    fn push(&mut self, row: usize, col: usize, stiffness: f64, mass: f64) {
+        self.index.push(Pair::new(row, col));
+        self.stiffness.push(stiffness);
+        self.mass.push(mass);
+    }
+
+    /// The entries of `scale_k · K + scale_m · M`, in the order of the pattern's.
+    pub fn values(&self, scale_k: f64, scale_m: f64) -> Vec<f64> {
+        self.stiffness
+            .iter()
+            .zip(&self.mass)
+            .map(|(k, m)| scale_k * k + scale_m * m)
+            .collect()
+    }
+}
+
+/// The structure of a symmetric positive definite `n × n` matrix given by the
+/// entries of its lower triangle, and of its Cholesky factor (simplicial, in a
+/// fill-reducing order): worked out once for every matrix of that pattern. The
+/// geodesics' two matrices share one, and the ADMM's, on the inner vertices only,
+/// takes the order of theirs ([`Pattern::order`]) rather than ordering afresh:
+/// the minimum-degree ordering is most of the cost of a factorisation.
+pub(crate) struct Pattern {
+    matrix: SymbolicSparseColMat<usize>,
+    argsort: Argsort<usize>,
+    cholesky: SymbolicCholesky<usize>,
+}
+
+impl Pattern {
+    /// The pattern of the entries of `lower` (row ≥ column) of an `n × n` matrix,
+    /// eliminated in approximate minimum degree order, or in `order` where given
+    /// (`order[i]` the unknown eliminated `i`-th).
+    pub fn new(n: usize, lower: &Lower, order: Option<&[u32]>) -> Result<Self, LbcError> {
+        let (matrix, argsort) = SymbolicSparseColMat::try_new_from_indices(n, n, &lower.index)
+            .map_err(|e| failed(&e))?;
+        let params = CholeskySymbolicParams {
+            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SIMPLICIAL,
+            ..Default::default()
+        };
+        let cholesky = match order {
+            None => factorize_symbolic_cholesky(
+                matrix.as_ref(),
+                Side::Lower,
+                SymmetricOrdering::Amd,
+                params,
+            ),
+            Some(order) => {
+                if order.len() != n {
+                    return Err(LbcError::Factorization(
+                        "an order of the wrong length".into(),
+                    ));
+                }
+                let forward: Vec<usize> = order.iter().map(|&i| i as usize).collect();
+                let mut inverse = vec![0; n];
+                for (i, &p) in forward.iter().enumerate() {
+                    inverse[p] = i;
+                }
+                let perm = PermRef::new_checked(&forward, &inverse, n);
+                factorize_symbolic_cholesky(
+                    matrix.as_ref(),
+                    Side::Lower,
+                    SymmetricOrdering::Custom(perm),
+                    params,
+                )
+            }
+        }
+        .map_err(|e| failed(&e))?;
+        Ok(Self {
+            matrix,
+            argsort,
+            cholesky,
+        })
+    }
+
+    /// The elimination order: `order()[i]` is the unknown eliminated `i`-th.
+    pub fn order(&self) -> Vec<u32> {
+        match self.cholesky.perm() {
+            Some(p) => p.arrays().0.iter().map(|&i| i as u32).collect(),
+            None => (0..self.matrix.nrows() as u32).collect(),
+        }
+    }
+}
+
+fn failed(e: &dyn std::fmt::Debug) -> LbcError {
+    LbcError::Factorization(format!("{e:?}"))
 }
 
 /// A sparse Cholesky factor `P A Pᵀ = L Lᵀ` (faer's fill-reducing ordering `P`,
@@ -100,27 +203,12 @@ pub(crate) struct RowFactor {
 }
 
 impl RowFactor {
-    /// Factorises the `n × n` matrix given by its lower triangle (duplicates summed).
-    pub fn new(n: usize, lower: &[Triplet<usize, usize, f64>]) -> Result<Self, LbcError> {
-        use faer::dyn_stack::{MemBuffer, MemStack};
-        use faer::sparse::linalg::SupernodalThreshold;
-        use faer::sparse::linalg::cholesky::{
-            CholeskySymbolicParams, SymbolicCholeskyRaw, SymmetricOrdering,
-            factorize_symbolic_cholesky,
-        };
-        let failed = |e: &dyn std::fmt::Debug| LbcError::Factorization(format!("{e:?}"));
-        let a = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, lower)
+    /// Factorises the matrix of `pattern` whose entries are `values` (in the order of
+    /// the pattern's, duplicates summed).
+    pub fn new(pattern: &Pattern, values: &[f64]) -> Result<Self, LbcError> {
+        let a = SparseColMat::new_from_argsort(pattern.matrix.clone(), &pattern.argsort, values)
             .map_err(|e| failed(&e))?;
-        let symbolic = factorize_symbolic_cholesky(
-            a.symbolic(),
-            Side::Lower,
-            SymmetricOrdering::Amd,
-            CholeskySymbolicParams {
-                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SIMPLICIAL,
-                ..Default::default()
-            },
-        )
-        .map_err(|e| failed(&e))?;
+        let symbolic = &pattern.cholesky;
         let mut values = vec![0.0; symbolic.len_val()];
         let par = faer::Par::Seq;
         let mut mem = MemBuffer::try_new(
@@ -143,6 +231,7 @@ impl RowFactor {
                 "expected a simplicial factor".into(),
             ));
         };
+        let n = pattern.matrix.nrows();
         let col_ptr: Vec<usize> = s.col_ptr().to_vec();
         let row_idx: Vec<u32> = s.row_idx().iter().map(|&r| r as u32).collect();
         if (0..n).any(|j| col_ptr[j] == col_ptr[j + 1] || row_idx[col_ptr[j]] as usize != j) {
@@ -150,10 +239,7 @@ impl RowFactor {
                 "a column of the factor does not start at its diagonal".into(),
             ));
         }
-        let perm: Vec<u32> = match symbolic.perm() {
-            Some(p) => p.arrays().0.iter().map(|&i| i as u32).collect(),
-            None => (0..n as u32).collect(),
-        };
+        let perm = pattern.order();
         let mut position = vec![0; perm.len()];
         for (i, &p) in perm.iter().enumerate() {
             position[p as usize] = i as u32;
@@ -285,6 +371,7 @@ impl RowFactor {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use faer::sparse::Triplet;
 
     /// `A = L + I` for the 5-point Laplacian `L` of a `k × k` grid, lower triangle.
     fn grid(k: usize) -> (usize, Vec<Triplet<usize, usize, f64>>) {
@@ -319,7 +406,17 @@ mod tests {
     #[test]
     fn row_factor_solves_every_column_of_any_width() {
         let (n, lower) = grid(23);
-        let factor = RowFactor::new(n, &lower).expect("positive definite");
+        let mut entries = Lower {
+            index: Vec::new(),
+            stiffness: Vec::new(),
+            mass: Vec::new(),
+        };
+        for t in &lower {
+            entries.push(t.row, t.col, t.val, 0.0);
+        }
+        let pattern = Pattern::new(n, &entries, None).expect("a pattern");
+        let factor =
+            RowFactor::new(&pattern, &entries.values(1.0, 0.0)).expect("positive definite");
         let mut scratch = Vec::new();
         // Blocks for two threads and for one; the plain and (where the CPU has it) the
         // AVX2 copy, which give the same numbers.

@@ -6,7 +6,7 @@ use rayon::prelude::*;
 
 use crate::domain::Domain;
 use crate::error::LbcError;
-use crate::fem::{Elements, RowFactor};
+use crate::fem::{Elements, Pattern, RowFactor};
 
 /// For each cage vertex `i`, the geodesic distance inside the cage from it to every
 /// mesh vertex, divided by its own maximum (the paper's eq. 12): `D[i][v] ∈ [0, 1]`,
@@ -28,6 +28,12 @@ use crate::fem::{Elements, RowFactor};
 /// # Errors
 /// [`LbcError::Factorization`] only on a bug.
 pub fn geodesic_distances(domain: &Domain) -> Result<Vec<Vec<f64>>, LbcError> {
+    Ok(geodesics(domain)?.0)
+}
+
+/// [`geodesic_distances`], and the elimination order of the mesh's vertices its
+/// factorisations used (see [`Pattern::order`]).
+pub(crate) fn geodesics(domain: &Domain) -> Result<(Vec<Vec<f64>>, Vec<u32>), LbcError> {
     let positions = domain.positions();
     let triangles = domain.triangles();
     let nv = positions.len();
@@ -45,10 +51,10 @@ pub fn geodesic_distances(domain: &Domain) -> Result<Vec<Vec<f64>>, LbcError> {
     // The solves run on rows of `n` (a column per cage vertex), as the ADMM's do.
     let wide = crate::wide::available();
     let mut scratch = Vec::new();
-    let heat = RowFactor::new(
-        nv,
-        &elements.lower_triplets(triangles, &all, h * h, &mass, 1.0),
-    )?;
+    // The heat and the Poisson matrix: one pattern, one ordering.
+    let lower = elements.lower(triangles, &all, &mass);
+    let pattern = Pattern::new(nv, &lower, None)?;
+    let heat = RowFactor::new(&pattern, &lower.values(h * h, 1.0))?;
     let mut u = vec![0.0; nv * n];
     for (i, &v) in domain.cage_vertices().iter().enumerate() {
         u[v as usize * n + i] = 1.0;
@@ -82,15 +88,12 @@ pub fn geodesic_distances(domain: &Domain) -> Result<Vec<Vec<f64>>, LbcError> {
     drop(columns);
     // The mass term is relative to the domain's area, so that the frame does not matter.
     let total: f64 = mass.iter().sum();
-    let poisson = RowFactor::new(
-        nv,
-        &elements.lower_triplets(triangles, &all, 1.0, &mass, 1e-8 / total),
-    )?;
+    let poisson = RowFactor::new(&pattern, &lower.values(1.0, 1e-8 / total))?;
     poisson.solve_rows(wide, &mut phi, n, &mut scratch);
     let phi = columns_of(&phi, n);
 
     let piece = pieces(nv, triangles);
-    Ok((0..n)
+    let distances = (0..n)
         .into_par_iter()
         .map(|i| {
             let source = domain.cage_vertices()[i] as usize;
@@ -111,7 +114,8 @@ pub fn geodesic_distances(domain: &Domain) -> Result<Vec<Vec<f64>>, LbcError> {
             }
             d
         })
-        .collect())
+        .collect();
+    Ok((distances, pattern.order()))
 }
 
 /// The columns of `rows` (row-major, `n` values a row), each as one vector.

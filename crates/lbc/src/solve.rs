@@ -9,8 +9,8 @@ use rayon::prelude::*;
 use crate::compact::Coordinates;
 use crate::domain::Domain;
 use crate::error::LbcError;
-use crate::fem::{Elements, RowFactor};
-use crate::geodesic::geodesic_distances;
+use crate::fem::{Elements, Pattern, RowFactor};
+use crate::geodesic::geodesics;
 use crate::projection::project_row;
 use crate::report::{Progress, Report};
 
@@ -104,16 +104,16 @@ pub fn solve(
 ) -> Result<Coordinates, LbcError> {
     in_local_order(domain, |domain, _| {
         let start = Instant::now();
-        let distances = geodesic_distances(domain)?;
-        let geodesics = start.elapsed();
-        let mut c = solve_ordered(domain, &distances, settings, progress)?;
-        c.report.geodesics = geodesics;
+        let (distances, order) = geodesics(domain)?;
+        let time = start.elapsed();
+        let mut c = solve_ordered(domain, &distances, Some(&order), settings, progress)?;
+        c.report.geodesics = time;
         Ok(c)
     })
 }
 
 /// Like [`solve`], with the normalised distances `D_i` given (`distances[i][v]`, as
-/// [`geodesic_distances`] returns them).
+/// [`geodesic_distances`](crate::geodesic_distances) returns them).
 ///
 /// # Errors
 /// As [`solve`]; [`LbcError::InvalidMesh`] if `distances` has the wrong shape.
@@ -136,9 +136,9 @@ pub fn solve_with_distances(
                 .iter()
                 .map(|d| old_of.iter().map(|&old| d[old as usize]).collect())
                 .collect();
-            solve_ordered(domain, &distances, settings, progress)
+            solve_ordered(domain, &distances, None, settings, progress)
         }
-        None => solve_ordered(domain, distances, settings, progress),
+        None => solve_ordered(domain, distances, None, settings, progress),
     })
 }
 
@@ -157,10 +157,12 @@ fn in_local_order(
     }
 }
 
-/// [`solve_with_distances`] on a mesh numbered for locality.
+/// [`solve_with_distances`] on a mesh numbered for locality; `order` an elimination
+/// order of its vertices for the factorisation (see [`Problem::factorise`]).
 fn solve_ordered(
     domain: &Domain,
     distances: &[Vec<f64>],
+    order: Option<&[u32]>,
     settings: &Settings,
     progress: &mut dyn FnMut(&Progress) -> bool,
 ) -> Result<Coordinates, LbcError> {
@@ -182,7 +184,7 @@ fn solve_ordered(
     let mut clamped = None;
     if !problem.interior.is_empty() && n > 3 {
         let t = Instant::now();
-        let factor = problem.factorise(domain)?;
+        let factor = problem.factorise(order)?;
         report.factorisation = t.elapsed();
         let t = Instant::now();
         clamped = Some(problem.admm(&factor, &mut z, settings, progress, &mut report)?);
@@ -413,18 +415,21 @@ impl Problem {
         });
     }
 
-    fn factorise(&self, domain: &Domain) -> Result<RowFactor, LbcError> {
-        let mut ones = vec![0.0; self.q.len()];
+    /// Factorises `GᵀG + βM` on the unknown rows. `order`, an elimination order of
+    /// the mesh's vertices (the geodesics'), is followed on the unknown ones where
+    /// given; a minimum-degree ordering is computed otherwise.
+    fn factorise(&self, order: Option<&[u32]>) -> Result<RowFactor, LbcError> {
+        let mut split = vec![0.0; self.q.len()];
         for (j, &v) in self.interior.iter().enumerate() {
-            ones[v as usize] = self.split[j];
+            split[v as usize] = self.split[j];
         }
         let row_of = &self.row_of;
         let map = |v: u32| row_of[v as usize].map(|r| r as usize);
-        let elements = Elements::new(&self.q, domain.triangles());
-        RowFactor::new(
-            self.interior.len(),
-            &elements.lower_triplets(&self.triangles, &map, 1.0, &ones, 1.0),
-        )
+        let lower = self.elements.lower(&self.triangles, &map, &split);
+        let order: Option<Vec<u32>> =
+            order.map(|order| order.iter().filter_map(|&v| row_of[v as usize]).collect());
+        let pattern = Pattern::new(self.interior.len(), &lower, order.as_deref())?;
+        RowFactor::new(&pattern, &lower.values(1.0, 1.0))
     }
 
     /// Unknown row `j`'s `(triangle, corner)` incidences.
