@@ -883,9 +883,11 @@ impl Problem {
                     keep,
                 )
             };
+            // On a thread of the pool either way: called from outside one, each of
+            // an iteration's passes would be handed to the pool and waited for.
             let r = match threads.single_for(it) {
                 Some(pool) => pool.install(iterate),
-                None => iterate(),
+                None => rayon::scope(|_| iterate()),
             };
             threads.took(it, clock.elapsed());
             report.iterations = it;
