@@ -38,7 +38,8 @@
 
 use glam::DVec2;
 
-use crate::segment::{Frame, Moments, Weight, moments};
+pub(crate) use crate::segment::Moments;
+use crate::segment::{Frame, Weight, moments};
 use crate::{Control, Variant};
 
 /// Relative size of the on-control tolerance: a vertex within
@@ -149,12 +150,38 @@ pub(crate) struct Scratch {
     moment: Vec<DVec2>,
 }
 
+/// `1 / d²`, or 1 where that is not finite (`d` zero: a vertex on the control).
+fn inverse_scale(d2: f64) -> f64 {
+    if d2 > 0.0 && (1.0 / d2).is_finite() {
+        1.0 / d2
+    } else {
+        1.0
+    }
+}
+
+/// A bar's integrals at a vertex ([`Moments`]), `frame` its frame there, with the
+/// weights scaled so that the bar's point nearest to the vertex is at distance 1: a
+/// function of the vertex and the bar alone, which a table built again for other
+/// controls can keep ([`crate::Mls::renewed`]). [`fit_vertex`] scales them to the
+/// vertex's common scale.
+pub(crate) fn bar_moments(frame: &Frame, alpha: f64) -> Moments {
+    moments(
+        frame,
+        &Weight {
+            alpha,
+            inv_scale2: inverse_scale(frame.dist2),
+        },
+    )
+}
+
 /// Fills `coef` (one per rest position) for vertex `v` and says how they combine.
+/// `bars` holds [`bar_moments`] at `v` of each bar among the controls, in order.
 pub(crate) fn fit_vertex(
     v: DVec2,
     rest: &Rest,
     alpha: f64,
     variant: Variant,
+    bars: &[Moments],
     scratch: &mut Scratch,
     coef: &mut [Coef],
 ) -> Header {
@@ -223,16 +250,19 @@ pub(crate) fn fit_vertex(
         };
         near2 = near2.min(d2);
     }
-    let inv_scale2 = if near2 > 0.0 && (1.0 / near2).is_finite() {
-        1.0 / near2
-    } else {
-        1.0
+    let weight = Weight {
+        alpha,
+        inv_scale2: inverse_scale(near2),
     };
-    let weight = Weight { alpha, inv_scale2 };
 
     // Every control as an element.
     scratch.elements.clear();
+    let mut bars = bars.iter();
     for ((control, frame), first) in rest.controls.iter().zip(&scratch.frames).zip(&rest.first) {
+        let bar = match control {
+            Control::Bar(_) => bars.next().copied().unwrap_or_default(),
+            Control::Point(_) => Moments::default(),
+        };
         let element = match (*control, frame) {
             (Control::Point(p), _) => Element {
                 first: *first,
@@ -249,7 +279,9 @@ pub(crate) fn fit_vertex(
                 bar: true,
                 anchor: frame.nearest(a, b),
                 dir: frame.dir,
-                m: moments(frame, &weight),
+                // From the bar's own scale to the common one: the weights differ by
+                // a constant factor.
+                m: bar.scaled(weight.of_squared(1.0 / inverse_scale(frame.dist2))),
             },
             (Control::Bar([a, _]), None) => Element {
                 first: *first,
@@ -337,7 +369,12 @@ pub(crate) fn fit_vertex(
     }
     match variant {
         Variant::Rigid => {
-            let spread = coef.iter().map(|c| c.re.hypot(c.im)).sum();
+            // (`hypot`'s guard against overflow is not needed at these sizes, and it
+            // took a fifth of a precomputation.)
+            let spread = coef
+                .iter()
+                .map(|c| (c.re * c.re + c.im * c.im).sqrt())
+                .sum();
             Header::Rigid { d, spread }
         }
         Variant::Similarity | Variant::Affine => {

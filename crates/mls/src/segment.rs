@@ -286,6 +286,20 @@ pub(crate) struct Moments {
     pub c: f64,
 }
 
+impl Moments {
+    /// Every integral times `factor` (the same integrals under weights `factor` times
+    /// as large).
+    pub fn scaled(self, factor: f64) -> Moments {
+        Moments {
+            a0: self.a0 * factor,
+            a1: self.a1 * factor,
+            b0: self.b0 * factor,
+            b1: self.b1 * factor,
+            c: self.c * factor,
+        }
+    }
+}
+
 /// The [`Moments`] of the bar with frame `frame` under `weight`.
 pub(crate) fn moments(frame: &Frame, weight: &Weight) -> Moments {
     let Frame { s_a, s_b, s_c, .. } = *frame;

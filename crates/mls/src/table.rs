@@ -1,14 +1,23 @@
 //! The precomputed deformation of a set of rest vertices ([`Mls`]): validation, the
 //! per-vertex coefficient tables, and applying a pose.
 
+use std::sync::Arc;
+
 use glam::DVec2;
 use rayon::prelude::*;
 
-use crate::precompute::{Coef, Header, Rest, Scratch, apply, fit_vertex, rigid, tolerance};
+use crate::precompute::{
+    Coef, Header, Moments, Rest, Scratch, apply, bar_moments, fit_vertex, rigid, tolerance,
+};
+use crate::segment::Frame;
 use crate::{Control, MlsError, MlsOptions, Variant};
 
 /// Vertices per parallel work item.
 const CHUNK: usize = 1024;
+
+/// A table keeps its bars' integrals at every vertex (for [`Mls::renewed`]) while
+/// they number at most this many (40 bytes each: 40 MiB).
+const KEPT_INTEGRALS: usize = 1 << 20;
 
 /// Moving least squares deformation, precomputed for one set of rest vertices and
 /// rest controls (positions in pixels, image space).
@@ -54,6 +63,19 @@ pub struct Mls {
     vertices: usize,
     options: MlsOptions,
     table: Table,
+    /// The bars' integrals at every vertex, where kept.
+    kept: Option<Kept>,
+}
+
+/// What a table keeps of its precomputation for the next one: each bar's integrals
+/// at every vertex ([`bar_moments`]), which depend on the vertex, the bar and α alone.
+/// Adding a point handle then costs the fits, not the bars' quadrature again.
+#[derive(Clone, Debug)]
+struct Kept {
+    vertices: Arc<[DVec2]>,
+    alpha: f64,
+    /// Each bar's ends, and its integrals per vertex.
+    bars: Vec<([DVec2; 2], Arc<[Moments]>)>,
 }
 
 /// Per-vertex coefficients, `K` per vertex, vertex-major.
@@ -87,6 +109,38 @@ impl Mls {
         controls: &[Control],
         options: &MlsOptions,
     ) -> Result<Mls, MlsError> {
+        Self::build(vertices, controls, options, None, KEPT_INTEGRALS)
+    }
+
+    /// [`Mls::new`] for other controls or options, taking the bars' integrals this
+    /// table kept where `vertices`, α and a bar are the same: the answer is the very
+    /// same, in less time (a bar's quadrature is most of a precomputation).
+    ///
+    /// Errors: as [`Mls::new`].
+    pub fn renewed(
+        &self,
+        vertices: &[DVec2],
+        controls: &[Control],
+        options: &MlsOptions,
+    ) -> Result<Mls, MlsError> {
+        Self::build(
+            vertices,
+            controls,
+            options,
+            self.kept.as_ref(),
+            KEPT_INTEGRALS,
+        )
+    }
+
+    /// [`Mls::new`], reusing `previous` where it applies, keeping the bars' integrals
+    /// while there are at most `keep` of them.
+    fn build(
+        vertices: &[DVec2],
+        controls: &[Control],
+        options: &MlsOptions,
+        previous: Option<&Kept>,
+        keep: usize,
+    ) -> Result<Mls, MlsError> {
         validate_options(options)?;
         if let Some(vertex) = vertices.iter().position(|v| !v.is_finite()) {
             return Err(MlsError::NonFiniteVertex { vertex });
@@ -106,19 +160,74 @@ impl Mls {
                 vertices: n,
                 options: *options,
                 table: Table::Identity(vertices.to_vec()),
+                kept: None,
             });
         }
+        let alpha = options.alpha;
+        let ends: Vec<[DVec2; 2]> = controls
+            .iter()
+            .filter_map(|c| match *c {
+                Control::Bar(ends) => Some(ends),
+                Control::Point(_) => None,
+            })
+            .collect();
+        // The bars' integrals at every vertex, taken from `previous` or worked out
+        // (where they are to be kept; otherwise each vertex works out its own).
+        let kept = (n * ends.len() <= keep && !ends.is_empty()).then(|| {
+            let previous =
+                previous.filter(|p| p.alpha == alpha && same_bits(&p.vertices, vertices));
+            let vertices: Arc<[DVec2]> = match previous {
+                Some(p) => p.vertices.clone(),
+                None => vertices.into(),
+            };
+            let bars = ends
+                .iter()
+                .map(|&[a, b]| {
+                    let known = previous
+                        .and_then(|p| p.bars.iter().find(|(e, _)| same_bits(e, &[a, b])))
+                        .map(|(_, m)| m.clone());
+                    let column = known.unwrap_or_else(|| {
+                        vertices
+                            .par_iter()
+                            .map(|&v| bar_moments(&Frame::new(v, a, b), alpha))
+                            .collect()
+                    });
+                    ([a, b], column)
+                })
+                .collect();
+            Kept {
+                vertices,
+                alpha,
+                bars,
+            }
+        });
 
         let mut coef = vec![Coef::default(); n * k];
         let mut headers = vec![Header::Snap; n];
         coef.par_chunks_mut(CHUNK * k)
             .zip(headers.par_chunks_mut(CHUNK))
             .zip(vertices.par_chunks(CHUNK))
-            .for_each_init(Scratch::default, |scratch, ((coef, headers), vertices)| {
-                for ((v, header), coef) in vertices.iter().zip(headers).zip(coef.chunks_mut(k)) {
-                    *header = fit_vertex(*v, &rest, options.alpha, options.variant, scratch, coef);
-                }
-            });
+            .enumerate()
+            .for_each_init(
+                || (Scratch::default(), Vec::new()),
+                |(scratch, moments), (chunk, ((coef, headers), vertices))| {
+                    let rows = vertices.iter().zip(headers).zip(coef.chunks_mut(k));
+                    for (i, ((v, header), coef)) in rows.enumerate() {
+                        moments.clear();
+                        match &kept {
+                            Some(kept) => {
+                                moments.extend(kept.bars.iter().map(|(_, m)| m[chunk * CHUNK + i]))
+                            }
+                            None => moments.extend(
+                                ends.iter()
+                                    .map(|&[a, b]| bar_moments(&Frame::new(*v, a, b), alpha)),
+                            ),
+                        }
+                        *header =
+                            fit_vertex(*v, &rest, alpha, options.variant, moments, scratch, coef);
+                    }
+                },
+            );
 
         let table = match options.variant {
             Variant::Rigid => {
@@ -158,6 +267,7 @@ impl Mls {
             vertices: n,
             options: *options,
             table,
+            kept,
         })
     }
 
@@ -273,16 +383,33 @@ pub fn deform_point(
     }
     let rest = Rest::new(controls);
     let mut coef = vec![Coef::default(); q.len()];
+    let moments: Vec<Moments> = controls
+        .iter()
+        .filter_map(|c| match *c {
+            Control::Bar([a, b]) => Some(bar_moments(&Frame::new(v, a, b), options.alpha)),
+            Control::Point(_) => None,
+        })
+        .collect();
     let header = fit_vertex(
         v,
         &rest,
         options.alpha,
         options.variant,
+        &moments,
         &mut Scratch::default(),
         &mut coef,
     );
     let (o, centred, reach) = centre(&q);
     Ok(apply(header, &coef, &centred, o, reach))
+}
+
+/// Whether two lists of points are the same to the bit (so that what was worked out
+/// from one is what the other would give, signed zeros included).
+fn same_bits(a: &[DVec2], b: &[DVec2]) -> bool {
+    a.len() == b.len()
+        && a.iter()
+            .zip(b)
+            .all(|(p, q)| p.x.to_bits() == q.x.to_bits() && p.y.to_bits() == q.y.to_bits())
 }
 
 fn validate_options(options: &MlsOptions) -> Result<(), MlsError> {
@@ -359,4 +486,85 @@ fn centre(q: &[DVec2]) -> (DVec2, Vec<DVec2>, f64) {
     let centred: Vec<DVec2> = q.iter().map(|p| *p - o).collect();
     let reach = centred.iter().map(|p| p.length()).fold(0.0, f64::max);
     (o, centred, reach)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scene() -> (Vec<DVec2>, Vec<Control>, Vec<Control>) {
+        let vertices: Vec<DVec2> = (0..400)
+            .map(|i| DVec2::new(f64::from(i % 20) * 7.3, f64::from(i / 20) * 5.1))
+            .collect();
+        let rest = vec![
+            Control::Point(DVec2::new(10.0, 10.0)),
+            Control::Bar([DVec2::new(30.0, 40.0), DVec2::new(120.0, 60.0)]),
+            Control::Bar([DVec2::new(20.0, 90.0), DVec2::new(20.0, 30.0)]),
+        ];
+        let posed = vec![
+            Control::Point(DVec2::new(15.0, 5.0)),
+            Control::Bar([DVec2::new(30.0, 45.0), DVec2::new(110.0, 90.0)]),
+            Control::Bar([DVec2::new(25.0, 90.0), DVec2::new(10.0, 35.0)]),
+        ];
+        (vertices, rest, posed)
+    }
+
+    fn deformed(mls: &Mls, posed: &[Control]) -> Vec<DVec2> {
+        let mut out = vec![DVec2::ZERO; mls.vertex_count()];
+        mls.deform(posed, &mut out).expect("a valid pose");
+        out
+    }
+
+    /// A renewed table takes the bars' integrals the table before kept, rather than
+    /// working them out again; a bar that moved gets its own.
+    #[test]
+    fn a_renewed_table_shares_the_integrals_kept() {
+        let (vertices, rest, _) = scene();
+        let options = MlsOptions::default();
+        let before = Mls::new(&vertices, &rest, &options).expect("valid");
+        let mut more = rest.clone();
+        more.push(Control::Point(DVec2::new(70.0, 20.0)));
+        more[2] = Control::Bar([DVec2::new(21.0, 90.0), DVec2::new(20.0, 30.0)]);
+        let after = before.renewed(&vertices, &more, &options).expect("valid");
+        let (was, now) = (
+            before.kept.as_ref().expect("kept"),
+            after.kept.as_ref().expect("kept"),
+        );
+        assert!(Arc::ptr_eq(&was.vertices, &now.vertices));
+        assert!(Arc::ptr_eq(&was.bars[0].1, &now.bars[0].1));
+        assert!(!Arc::ptr_eq(&was.bars[1].1, &now.bars[1].1));
+        // Under another α nothing applies.
+        let other = MlsOptions {
+            alpha: 2.0,
+            ..options
+        };
+        let again = before.renewed(&vertices, &more, &other).expect("valid");
+        assert!(!Arc::ptr_eq(
+            &was.bars[0].1,
+            &again.kept.expect("kept").bars[0].1
+        ));
+    }
+
+    /// Past the memory the kept integrals may take, each vertex works out its own,
+    /// to the same bits.
+    #[test]
+    fn integrals_kept_or_not_give_the_same_table() {
+        let (vertices, rest, posed) = scene();
+        for variant in [Variant::Affine, Variant::Similarity, Variant::Rigid] {
+            let options = MlsOptions {
+                variant,
+                ..MlsOptions::default()
+            };
+            let kept = Mls::build(&vertices, &rest, &options, None, usize::MAX).expect("valid");
+            let not = Mls::build(&vertices, &rest, &options, None, 0).expect("valid");
+            assert!(kept.kept.is_some() && not.kept.is_none());
+            let (a, b) = (deformed(&kept, &posed), deformed(&not, &posed));
+            assert!(
+                a.iter()
+                    .zip(&b)
+                    .all(|(p, q)| p.to_array().map(f64::to_bits) == q.to_array().map(f64::to_bits)),
+                "{variant:?}"
+            );
+        }
+    }
 }

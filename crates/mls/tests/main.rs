@@ -3,4 +3,5 @@
 mod edges;
 mod interpolation;
 mod reference;
+mod renewed;
 mod support;

@@ -117,7 +117,12 @@ impl MlsRig {
         }
         if !same_rest {
             let clock = Instant::now();
-            self.table = Arc::new(precompute(&self.rest, handles, &options)?);
+            let rest: Vec<mls::Control> = handles.iter().map(rest_control).collect();
+            // What the table before worked out for the bars that stay is kept.
+            let table = (self.table)
+                .renewed(&self.rest, &rest, &options)
+                .context("moving least squares cannot use these handles")?;
+            self.table = Arc::new(table);
             self.options = options;
             self.setup_ms = ms(clock);
         }
@@ -195,6 +200,17 @@ impl Deformer for MlsRig {
             pose.push(self.pose_ms);
         }
         self.set(&handles, self.options)?;
+        // A point handle inserted at a random vertex, and removed again.
+        let mut insert = Vec::new();
+        let n = self.rest.len() as u64;
+        for _ in 0..poses.max(1) {
+            let at = self.rest[(sequence.next_u64() % n) as usize];
+            let mut more = handles.clone();
+            more.push(Handle::point(at));
+            self.set(&more, self.options)?;
+            insert.push(self.setup_ms);
+            self.set(&handles, self.options)?;
+        }
         json(&MlsReport {
             method: "mls",
             variant: match self.options.variant {
@@ -210,6 +226,7 @@ impl Deformer for MlsRig {
             pose_ms_p90: quantile(pose.clone(), 0.9),
             pose_ms_median: median(pose.clone()),
             poses: pose.len(),
+            insert_precompute_ms_median: median(insert),
         })
     }
 
@@ -265,4 +282,7 @@ struct MlsReport {
     pose_ms_p90: f64,
     /// Poses timed.
     poses: usize,
+    /// Median precomputation again for a point handle inserted at a random vertex
+    /// (the bars' integrals kept), ms.
+    insert_precompute_ms_median: f64,
 }
