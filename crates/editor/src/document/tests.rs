@@ -1854,3 +1854,72 @@ fn under_mls_a_pin_placed_in_a_pose_moves_nothing() {
     assert!(moved > 5.0, "{moved}");
     doc.check_reopens().expect("reopens dragged");
 }
+
+/// `locate` finds the first triangle whose barycentric coordinates of the point are
+/// all at least −10⁻⁹, as the test written plainly does, for points inside, outside,
+/// on edges and on corners of a jittered grid with a sliver in it.
+#[test]
+fn locate_finds_the_first_triangle_holding_the_point() {
+    fn plain(points: &[DVec2], triangles: &[[u32; 3]], p: DVec2) -> Option<([u32; 3], [f64; 3])> {
+        triangles.iter().find_map(|&[a, b, c]| {
+            let (pa, pb, pc) = (points[a as usize], points[b as usize], points[c as usize]);
+            let area = (pb - pa).perp_dot(pc - pa);
+            if area.abs() < 1e-12 {
+                return None;
+            }
+            let u = (pb - p).perp_dot(pc - p) / area;
+            let v = (pc - p).perp_dot(pa - p) / area;
+            let w = 1.0 - u - v;
+            (u >= -1e-9 && v >= -1e-9 && w >= -1e-9).then_some(([a, b, c], [u, v, w]))
+        })
+    }
+    let n = 12;
+    let mut state = 7u64;
+    let mut next = move || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut points = Vec::new();
+    for y in 0..=n {
+        for x in 0..=n {
+            let jitter = DVec2::new(next() - 0.5, next() - 0.5) * 0.6;
+            points.push(DVec2::new(f64::from(x), f64::from(y)) * 10.0 + jitter);
+        }
+    }
+    let at = |x: u32, y: u32| y * (n + 1) + x;
+    let mut triangles = Vec::new();
+    for y in 0..n {
+        for x in 0..n {
+            triangles.push([at(x, y), at(x + 1, y), at(x + 1, y + 1)]);
+            triangles.push([at(x, y), at(x + 1, y + 1), at(x, y + 1)]);
+        }
+    }
+    // A sliver (and a flat one) over the grid's corner, turned either way.
+    let base = points.len() as u32;
+    points.extend([
+        DVec2::new(0.0, 0.0),
+        DVec2::new(200.0, 0.0),
+        DVec2::new(200.0, 1e-3),
+        DVec2::new(300.0, 0.0),
+    ]);
+    triangles.push([base, base + 2, base + 1]);
+    triangles.push([base, base + 1, base + 3]);
+    let mut probes: Vec<DVec2> = points.clone();
+    for &[a, b, _] in &triangles {
+        probes.push(points[a as usize].lerp(points[b as usize], 0.37));
+    }
+    for _ in 0..3000 {
+        probes.push(DVec2::new(next() * 320.0 - 10.0, next() * 140.0 - 10.0));
+    }
+    probes.push(DVec2::new(200.0 + 1e-8, 5e-4));
+    probes.push(DVec2::new(-1e-12, 0.0));
+    let mut found = 0;
+    for p in probes {
+        let want = plain(&points, &triangles, p);
+        found += usize::from(want.is_some());
+        assert_eq!(locate(&points, &triangles, p), want, "at {p}");
+    }
+    assert!(found > 1000, "{found} points found");
+}
