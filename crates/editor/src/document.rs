@@ -191,6 +191,10 @@ pub struct Document {
     /// already (a pin placed on a part that followed another): taken when the
     /// deformer is brought in line with the edit.
     primed: Option<Box<dyn Deformer>>,
+    /// The mesh working out an edit meshed the picture anew with (a shape carried
+    /// over a re-mesh), with the project it is for, `carried` aside: taken when the
+    /// edit is made rather than meshed again.
+    primed_mesh: Option<(Project, Domain)>,
 }
 
 /// The picture's mesh, and C²'s weights of it where they are used.
@@ -352,6 +356,7 @@ impl Document {
             live: false,
             depth_deferred: false,
             primed: None,
+            primed_mesh: None,
         }
         .with_method()
     }
@@ -695,7 +700,16 @@ impl Document {
     /// What the rig rejects: a handle off the shape, coincident handles, a zero-length
     /// bar, non-finite values, a missing handle; or a re-mesh that fails.
     pub fn apply(&mut self, edit: Edit) -> Result<()> {
+        let applied = self.apply_edit(edit);
+        // What working out the edit set up is for it alone (taken as the edit is
+        // made, dropped if it fails).
         self.primed = None;
+        self.primed_mesh = None;
+        applied
+    }
+
+    /// [`Document::apply`]'s work.
+    fn apply_edit(&mut self, edit: Edit) -> Result<()> {
         let mut project = self.project.clone();
         match edit {
             Edit::Add(handle) => self.push_handle(&mut project, handle, None)?,
@@ -1039,33 +1053,32 @@ impl Document {
             return Ok(());
         };
         let shown = method.deformed();
-        let mut without = project.clone();
-        without.carried.retain(|c| c.part.is_some());
+        let without = without_carried(project);
         let remesh = self.change_to(project).remesh;
-        let (trial, before) = if remesh {
+        let (trial, before, mesh) = if remesh {
             // Meshed anew (as restoring the edit will mesh it): set up there.
             let mesh = pipeline::mesh_picture_for(&self.image, &without)?;
             let before = pipeline::carried::resample(self.mesh(), &shown, mesh.positions());
             let Some(trial) = pipeline::on_mesh(&without, &mesh, Some(&self.image))? else {
                 return Ok(());
             };
-            (trial, before)
+            (trial, before, Some(mesh))
         } else {
             let mut trial = method.clone_box();
             if trial.follow(&without)? == Follow::NeedsSetup {
                 return Ok(());
             }
-            (trial, shown)
+            (trial, shown, None)
         };
         let old = pipeline::carried::picture_shape(&self.project);
         let shape = pipeline::carried::keep(trial.as_ref(), &before, old, keep)?;
-        project.carried = without.carried;
+        project.carried.clone_from(&without.carried);
         project.carried.extend(shape);
         project.carried.sort_by_key(|c| c.part);
-        if !remesh {
-            // The method as the edit leaves it, on the same mesh.
-            self.primed = Some(trial);
-        }
+        // The method as the edit leaves it, on the mesh the edit makes (kept with the
+        // project it is for, where that is a new one).
+        self.primed_mesh = mesh.map(|mesh| (without, mesh));
+        self.primed = Some(trial);
         Ok(())
     }
 
@@ -1434,7 +1447,18 @@ impl Document {
         } else {
             None
         };
-        let new_mesh = if remesh {
+        // Meshed anew while the edit was worked out, or now.
+        let primed_mesh = (self.primed_mesh.take())
+            .filter(|(key, _)| remesh && *key == without_carried(&project))
+            .map(|(_, mesh)| mesh);
+        let reused = primed_mesh.is_some();
+        if remesh && !reused {
+            // Set up on another mesh than this edit's.
+            self.primed = None;
+        }
+        let new_mesh = if let Some(mesh) = primed_mesh {
+            Some(mesh)
+        } else if remesh {
             Some(pipeline::mesh_picture_for(&self.image, &project)?)
         } else if matches!(self.base, Base::Rig(_)) || new.metric != old.metric {
             Some(pipeline::with_metric(self.mesh().clone(), &project)?)
@@ -1444,8 +1468,12 @@ impl Document {
         let mesh = new_mesh.as_ref().unwrap_or(self.mesh());
         weights_core::check_handles_on(mesh, &pipeline::handles(&project))?;
         let parts = self.layers.is_some() && project.parts.is_some();
+        // (The method set up on a mesh made while the edit was worked out is taken
+        // when the deformer is brought in line, `primed`.)
+        let primed = reused && self.primed.is_some();
         let fresh = if project.method.sets_up_on_the_mesh()
             && !parts
+            && !primed
             && (new_mesh.is_some() || self.method.is_none())
         {
             pipeline::on_mesh(&project, mesh, Some(&self.image))?
@@ -1705,6 +1733,14 @@ fn influence_of(rig: &Rig, handle: usize) -> Vec<f32> {
                 .clamp(0.0, 1.0) as f32
         })
         .collect()
+}
+
+/// `project` with the shapes carried by the picture as a whole left out (the parts'
+/// kept): what a shape carried over an edit is worked out from.
+fn without_carried(project: &Project) -> Project {
+    let mut without = project.clone();
+    without.carried.retain(|c| c.part.is_some());
+    without
 }
 
 /// The first of `triangles` (corners indexing `points`) that contains `p`, and `p`'s
