@@ -403,17 +403,23 @@ mod tests {
         (n, lower)
     }
 
-    #[test]
-    fn row_factor_solves_every_column_of_any_width() {
-        let (n, lower) = grid(23);
+    /// `lower` as the entries of a stiffness matrix (no mass).
+    fn entries_of(lower: &[Triplet<usize, usize, f64>]) -> Lower {
         let mut entries = Lower {
             index: Vec::new(),
             stiffness: Vec::new(),
             mass: Vec::new(),
         };
-        for t in &lower {
+        for t in lower {
             entries.push(t.row, t.col, t.val, 0.0);
         }
+        entries
+    }
+
+    #[test]
+    fn row_factor_solves_every_column_of_any_width() {
+        let (n, lower) = grid(23);
+        let entries = entries_of(&lower);
         let pattern = Pattern::new(n, &entries, None).expect("a pattern");
         let factor =
             RowFactor::new(&pattern, &entries.values(1.0, 0.0)).expect("positive definite");
@@ -469,14 +475,7 @@ mod tests {
     #[test]
     fn row_factor_follows_a_given_order() {
         let (n, lower) = grid(17);
-        let mut entries = Lower {
-            index: Vec::new(),
-            stiffness: Vec::new(),
-            mass: Vec::new(),
-        };
-        for t in &lower {
-            entries.push(t.row, t.col, t.val, 0.0);
-        }
+        let entries = entries_of(&lower);
         let amd = Pattern::new(n, &entries, None).expect("a pattern");
         // Every other unknown first, then the rest backwards: far from the
         // minimum-degree order.
