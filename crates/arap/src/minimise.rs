@@ -156,6 +156,10 @@ struct Anderson {
     /// Where the next difference goes.
     slot: usize,
     residual: Vec<DVec2>,
+    /// The residual differences' dot products, `gram[i][j]` of the ring's `i` and `j`:
+    /// only a new difference's are worked out (the same numbers as afresh, each dot
+    /// product summed in the same order).
+    gram: Vec<Vec<f64>>,
 }
 
 impl Anderson {
@@ -167,6 +171,7 @@ impl Anderson {
             last: None,
             slot: 0,
             residual: Vec::new(),
+            gram: vec![vec![0.0; depth]; depth],
         }
     }
 
@@ -198,6 +203,11 @@ impl Anderson {
                     .zip(last_r.iter())
                     .map(|(a, b)| *a - *b),
             );
+            for (j, other) in self.residuals.iter().enumerate() {
+                let d = dot(&self.residuals[self.slot], other);
+                self.gram[self.slot][j] = d;
+                self.gram[j][self.slot] = d;
+            }
             self.slot = (self.slot + 1) % self.depth;
             last_g.clone_from_slice(g);
             last_r.clone_from_slice(&self.residual);
@@ -205,7 +215,7 @@ impl Anderson {
             self.last = Some((g.to_vec(), self.residual.clone()));
         }
         x.clone_from_slice(g);
-        if let Some(theta) = least_squares(&self.residuals, &self.residual) {
+        if let Some(theta) = least_squares(&self.gram, &self.residuals, &self.residual) {
             for (t, dg) in theta.iter().zip(&self.outputs) {
                 for (n, d) in x.iter_mut().zip(dg) {
                     *n -= *t * *d;
@@ -215,21 +225,22 @@ impl Anderson {
     }
 }
 
+/// `Σ aᵢ·bᵢ`, in order.
+fn dot(a: &[DVec2], b: &[DVec2]) -> f64 {
+    a.iter().zip(b).map(|(a, b)| a.dot(*b)).sum::<f64>()
+}
+
 /// The coefficients θ minimising ‖r − Σ θⱼ·columnsⱼ‖ (normal equations, a touch of
-/// regularisation), or `None` with no columns or a singular system.
-fn least_squares(columns: &[Vec<DVec2>], r: &[DVec2]) -> Option<Vec<f64>> {
+/// regularisation), or `None` with no columns or a singular system. `gram` holds the
+/// columns' dot products with each other.
+fn least_squares(gram: &[Vec<f64>], columns: &[Vec<DVec2>], r: &[DVec2]) -> Option<Vec<f64>> {
     let m = columns.len();
     if m == 0 {
         return None;
     }
-    let dot = |a: &[DVec2], b: &[DVec2]| a.iter().zip(b).map(|(a, b)| a.dot(*b)).sum::<f64>();
     let mut matrix = vec![vec![0.0; m + 1]; m];
     for i in 0..m {
-        for j in 0..=i {
-            let d = dot(&columns[i], &columns[j]);
-            matrix[i][j] = d;
-            matrix[j][i] = d;
-        }
+        matrix[i][..m].copy_from_slice(&gram[i][..m]);
         matrix[i][m] = dot(&columns[i], r);
     }
     let trace: f64 = (0..m).map(|i| matrix[i][i]).sum();
