@@ -159,14 +159,15 @@ fn inverse_scale(d2: f64) -> f64 {
     }
 }
 
-/// A bar's integrals at a vertex ([`Moments`]), `frame` its frame there, with the
+/// The integrals ([`Moments`]) at vertex `v` of the bar from `a` to `b`, with the
 /// weights scaled so that the bar's point nearest to the vertex is at distance 1: a
 /// function of the vertex and the bar alone, which a table built again for other
 /// controls can keep ([`crate::Mls::renewed`]). [`fit_vertex`] scales them to the
 /// vertex's common scale.
-pub(crate) fn bar_moments(frame: &Frame, alpha: f64) -> Moments {
+pub(crate) fn bar_moments(v: DVec2, [a, b]: [DVec2; 2], alpha: f64) -> Moments {
+    let frame = Frame::new(v, a, b);
     moments(
-        frame,
+        &frame,
         &Weight {
             alpha,
             inv_scale2: inverse_scale(frame.dist2),

@@ -9,7 +9,6 @@ use rayon::prelude::*;
 use crate::precompute::{
     Coef, Header, Moments, Rest, Scratch, apply, bar_moments, fit_vertex, rigid, tolerance,
 };
-use crate::segment::Frame;
 use crate::{Control, MlsError, MlsOptions, Variant};
 
 /// Vertices per parallel work item.
@@ -189,7 +188,7 @@ impl Mls {
                     let column = known.unwrap_or_else(|| {
                         vertices
                             .par_iter()
-                            .map(|&v| bar_moments(&Frame::new(v, a, b), alpha))
+                            .map(|&v| bar_moments(v, [a, b], alpha))
                             .collect()
                     });
                     ([a, b], column)
@@ -218,10 +217,8 @@ impl Mls {
                             Some(kept) => {
                                 moments.extend(kept.bars.iter().map(|(_, m)| m[chunk * CHUNK + i]))
                             }
-                            None => moments.extend(
-                                ends.iter()
-                                    .map(|&[a, b]| bar_moments(&Frame::new(*v, a, b), alpha)),
-                            ),
+                            None => moments
+                                .extend(ends.iter().map(|&ends| bar_moments(*v, ends, alpha))),
                         }
                         *header =
                             fit_vertex(*v, &rest, alpha, options.variant, moments, scratch, coef);
@@ -386,7 +383,7 @@ pub fn deform_point(
     let moments: Vec<Moments> = controls
         .iter()
         .filter_map(|c| match *c {
-            Control::Bar([a, b]) => Some(bar_moments(&Frame::new(v, a, b), options.alpha)),
+            Control::Bar(ends) => Some(bar_moments(v, ends, options.alpha)),
             Control::Point(_) => None,
         })
         .collect();
