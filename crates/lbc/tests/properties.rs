@@ -161,6 +161,26 @@ fn locality_on_a_concave_cage() {
         "exactly zero on {:.0}% of the area",
         100.0 * zero_area / total
     );
+    // `P(0)` is the mean share of the area where a coordinate is exactly zero (on a
+    // triangle with a corner above zero, the zeros have no area), and `P(1)` is 1.
+    let n = cage.len();
+    let mut zero = 0.0;
+    for t in domain.triangles() {
+        let p = t.map(|v| domain.positions()[v as usize]);
+        let area = 0.5 * (p[1] - p[0]).perp_dot(p[2] - p[0]);
+        zero += area
+            * (0..n)
+                .filter(|&i| t.iter().all(|&v| c.row(v as usize)[i] == 0.0))
+                .count() as f64;
+    }
+    let stats = lbc::locality(&domain, &c, &[0.0, 1.0]);
+    let expected = zero / (total * n as f64);
+    assert!(
+        (stats.p[0] - expected).abs() < 1e-12,
+        "P(0) = {}, not {expected}",
+        stats.p[0]
+    );
+    assert!((stats.p[1] - 1.0).abs() < 1e-12, "P(1) = {}", stats.p[1]);
 }
 
 /// Mean value coordinates (Hormann and Floater 2006) at an interior point.
