@@ -1254,6 +1254,38 @@ fn under_arap_a_drag_on_parts_is_live_and_its_end_is_what_a_file_renders() {
         .expect("the end of the drag is what the file renders");
 }
 
+/// A frame of a live drag (or of playback) under ARAP is the iteration's answer from
+/// the frame before, stopped early: the document's checks (saved and reopened
+/// included) hold for it as they do once the drag has settled.
+#[test]
+fn under_arap_the_checks_hold_mid_drag_and_after_it() {
+    let mut doc = document();
+    doc.apply(Edit::Method(Method::Arap)).expect("ARAP");
+    doc.apply(Edit::Add(point(30.0, 24.0)))
+        .expect("a third pin");
+    let mut project = doc.project().clone();
+    for frame in 0..4 {
+        if let HandleSpec::Point {
+            translate, rotate, ..
+        } = &mut project.handles[1]
+        {
+            translate[0] += 9.0;
+            translate[1] -= 7.0;
+            *rotate += 0.4;
+        }
+        doc.preview(project.clone()).expect("a drag frame");
+        doc.sanity_check()
+            .unwrap_or_else(|e| panic!("frame {frame}: {e:#}"));
+        doc.check_reopens()
+            .unwrap_or_else(|e| panic!("frame {frame}: {e:#}"));
+    }
+    let live = doc.deformer().deformed();
+    doc.settle().expect("settled");
+    assert_ne!(live, doc.deformer().deformed(), "the drag's end solves on");
+    doc.sanity_check().expect("settled");
+    doc.check_reopens().expect("what the file renders");
+}
+
 #[test]
 fn a_locked_part_takes_no_new_pin_or_paint_and_moves_as_before() {
     let dir = tempfile::tempdir().expect("temp dir");
