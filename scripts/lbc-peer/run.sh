@@ -60,7 +60,8 @@ for m in models:
     best = min(th, key=lambda s: s["total_s"])
     ow = [float(open(f"{d}/ours_weights_time_{r}.txt").read().split()[-1]) for r in range(1, R + 1)]
     ob = [json.load(open(f"{d}/ours_bench_{r}.json")) for r in range(1, R + 1)]
-    solve = lambda b: (b["geodesics_ms"] + b["factorisation_ms"] + b["admm_ms"] + b["projection_ms"]) / 1000
+    # (our factorisation runs beside the geodesics: its time is within theirs)
+    solve = lambda b: (b["geodesics_ms"] + b["admm_ms"] + b["projection_ms"]) / 1000
     bb = min(ob, key=solve)
     obj = json.load(open(f"{d}/objectives.json"))
     t, o = obj["results"]

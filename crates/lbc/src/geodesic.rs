@@ -28,12 +28,17 @@ use crate::fem::{Elements, Pattern, RowFactor};
 /// # Errors
 /// [`LbcError::Factorization`] only on a bug.
 pub fn geodesic_distances(domain: &Domain) -> Result<Vec<Vec<f64>>, LbcError> {
-    Ok(geodesics(domain)?.0)
+    Ok(geodesics(domain, |_| ())?.0)
 }
 
-/// [`geodesic_distances`], and the elimination order of the mesh's vertices its
-/// factorisations used (see [`Pattern::order`]).
-pub(crate) fn geodesics(domain: &Domain) -> Result<(Vec<Vec<f64>>, Vec<u32>), LbcError> {
+/// [`geodesic_distances`], with `beside` run on the elimination order of the mesh's
+/// vertices that its factorisations follow (see [`Pattern::order`]) while they run
+/// (on two threads, the heat and the Poisson matrix are factorised on one and
+/// `beside` runs on the other); returns what `beside` returned too.
+pub(crate) fn geodesics<R: Send>(
+    domain: &Domain,
+    beside: impl FnOnce(&[u32]) -> R + Send,
+) -> Result<(Vec<Vec<f64>>, R), LbcError> {
     let positions = domain.positions();
     let triangles = domain.triangles();
     let nv = positions.len();
@@ -54,7 +59,19 @@ pub(crate) fn geodesics(domain: &Domain) -> Result<(Vec<Vec<f64>>, Vec<u32>), Lb
     // The heat and the Poisson matrix: one pattern, one ordering.
     let lower = elements.lower(triangles, &all, &mass);
     let pattern = Pattern::new(nv, &lower, None)?;
-    let heat = RowFactor::new(&pattern, &lower.values(h * h, 1.0))?;
+    // The mass term is relative to the domain's area, so that the frame does not matter.
+    let total: f64 = mass.iter().sum();
+    let order = pattern.order();
+    let ((heat, poisson), side) = rayon::join(
+        || {
+            rayon::join(
+                || RowFactor::new(&pattern, &lower.values(h * h, 1.0)),
+                || RowFactor::new(&pattern, &lower.values(1.0, 1e-8 / total)),
+            )
+        },
+        || beside(&order),
+    );
+    let (heat, poisson) = (heat?, poisson?);
     let mut u = vec![0.0; nv * n];
     for (i, &v) in domain.cage_vertices().iter().enumerate() {
         u[v as usize * n + i] = 1.0;
@@ -86,9 +103,6 @@ pub(crate) fn geodesics(domain: &Domain) -> Result<(Vec<Vec<f64>>, Vec<u32>), Lb
         }
     }
     drop(columns);
-    // The mass term is relative to the domain's area, so that the frame does not matter.
-    let total: f64 = mass.iter().sum();
-    let poisson = RowFactor::new(&pattern, &lower.values(1.0, 1e-8 / total))?;
     poisson.solve_rows(wide, &mut phi, n, &mut scratch);
     let phi = columns_of(&phi, n);
 
@@ -115,7 +129,7 @@ pub(crate) fn geodesics(domain: &Domain) -> Result<(Vec<Vec<f64>>, Vec<u32>), Lb
             d
         })
         .collect();
-    Ok((distances, pattern.order()))
+    Ok((distances, side))
 }
 
 /// The columns of `rows` (row-major, `n` values a row), each as one vector.

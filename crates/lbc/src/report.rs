@@ -33,9 +33,13 @@ pub struct Report {
     pub objective: f64,
     /// Mesh vertices inside the cage (the unknown rows).
     pub interior_vertices: usize,
-    /// Time for the geodesic distances (zero if they were given).
+    /// Time for the geodesic distances (zero if they were given). [`solve`] factorises
+    /// the Y-update's matrix beside them, on another thread: this is the time of both.
+    ///
+    /// [`solve`]: crate::solve
     pub geodesics: Duration,
-    /// Time to assemble and factorise `GᵀG + I`.
+    /// Time to assemble and factorise the Y-update's matrix `GᵀG + βM` (within
+    /// `geodesics` where it ran beside them).
     pub factorisation: Duration,
     /// Time in ADMM iterations.
     pub admm: Duration,

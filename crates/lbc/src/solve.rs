@@ -104,9 +104,18 @@ pub fn solve(
 ) -> Result<Coordinates, LbcError> {
     in_local_order(domain, |domain, _| {
         let start = Instant::now();
-        let (distances, order) = geodesics(domain)?;
+        let mut problem = Problem::new(domain);
+        // The ADMM's factorisation needs the geodesics' elimination order alone: it
+        // runs beside their own two factorisations.
+        let (distances, factor) = geodesics(domain, |order| {
+            problem.needs_admm().then(|| {
+                let t = Instant::now();
+                problem.factorise(Some(order)).map(|f| (f, t.elapsed()))
+            })
+        })?;
         let time = start.elapsed();
-        let mut c = solve_ordered(domain, &distances, Some(&order), settings, progress)?;
+        problem.weigh(&distances, settings.tau);
+        let mut c = solve_problem(domain, &problem, factor.transpose()?, settings, progress)?;
         c.report.geodesics = time;
         Ok(c)
     })
@@ -136,9 +145,9 @@ pub fn solve_with_distances(
                 .iter()
                 .map(|d| old_of.iter().map(|&old| d[old as usize]).collect())
                 .collect();
-            solve_ordered(domain, &distances, None, settings, progress)
+            solve_ordered(domain, &distances, settings, progress)
         }
-        None => solve_ordered(domain, distances, None, settings, progress),
+        None => solve_ordered(domain, distances, settings, progress),
     })
 }
 
@@ -157,17 +166,29 @@ fn in_local_order(
     }
 }
 
-/// [`solve_with_distances`] on a mesh numbered for locality; `order` an elimination
-/// order of its vertices for the factorisation (see [`Problem::factorise`]).
+/// [`solve_with_distances`] on a mesh numbered for locality.
 fn solve_ordered(
     domain: &Domain,
     distances: &[Vec<f64>],
-    order: Option<&[u32]>,
+    settings: &Settings,
+    progress: &mut dyn FnMut(&Progress) -> bool,
+) -> Result<Coordinates, LbcError> {
+    let mut problem = Problem::new(domain);
+    problem.weigh(distances, settings.tau);
+    solve_problem(domain, &problem, None, settings, progress)
+}
+
+/// The ADMM on `problem` (weighted) and the projection of its rows; `factor` its
+/// Y-update's factorisation and the time it took, where done already (see
+/// [`Problem::factorise`]).
+fn solve_problem(
+    domain: &Domain,
+    problem: &Problem,
+    factor: Option<(RowFactor, Duration)>,
     settings: &Settings,
     progress: &mut dyn FnMut(&Progress) -> bool,
 ) -> Result<Coordinates, LbcError> {
     let n = domain.cage().len();
-    let problem = Problem::new(domain, distances, settings.tau);
     let mut z = problem.initial_rows(domain);
     let mut report = Report {
         iterations: 0,
@@ -182,10 +203,15 @@ fn solve_ordered(
         threads: 1,
     };
     let mut clamped = None;
-    if !problem.interior.is_empty() && n > 3 {
-        let t = Instant::now();
-        let factor = problem.factorise(order)?;
-        report.factorisation = t.elapsed();
+    if problem.needs_admm() {
+        let (factor, time) = match factor {
+            Some(done) => done,
+            None => {
+                let t = Instant::now();
+                (problem.factorise(None)?, t.elapsed())
+            }
+        };
+        report.factorisation = time;
         let t = Instant::now();
         clamped = Some(problem.admm(&factor, &mut z, settings, progress, &mut report)?);
         report.admm = t.elapsed();
@@ -196,9 +222,8 @@ fn solve_ordered(
     problem.project(&mut z, clamped.as_deref());
     report.projection = t.elapsed();
     report.objective = problem.objective(&z);
-    let mut k = problem.k;
-    k.truncate(n);
-    Ok(Coordinates::new(n, z, report, k, problem.q))
+    let k = problem.k[..n].to_vec();
+    Ok(Coordinates::new(n, z, report, k, problem.q.clone()))
 }
 
 /// Everything fixed during the iterations, in the solver's frame.
@@ -247,7 +272,8 @@ struct Problem {
 }
 
 impl Problem {
-    fn new(domain: &Domain, distances: &[Vec<f64>], tau: Tau) -> Self {
+    /// The problem on `domain`, its weights `φ` yet to be given ([`Problem::weigh`]).
+    fn new(domain: &Domain) -> Self {
         let cage = domain.cage().vertices();
         let cage_vertices = cage.len();
         let n = padded(cage_vertices);
@@ -266,18 +292,6 @@ impl Problem {
             .iter()
             .zip(&elements.area)
             .map(|(gr, &a)| gr.map(|x| a.sqrt() * x))
-            .collect();
-        let mut phi = vec![0.0; triangles.len() * n];
-        for (s, t) in triangles.iter().enumerate() {
-            for i in 0..cage_vertices {
-                let d = t.iter().map(|&v| distances[i][v as usize]).sum::<f64>() / 3.0;
-                phi[s * n + i] = tau.apply(d);
-            }
-        }
-        let coef = phi
-            .iter()
-            .enumerate()
-            .map(|(si, &p)| (p * elements.area[si / n].sqrt()) as Stored)
             .collect();
         let mut interior = Vec::new();
         let mut row_of = vec![None; q.len()];
@@ -335,9 +349,9 @@ impl Problem {
             interior,
             row_of,
             g,
-            coef,
+            coef: Vec::new(),
             elements,
-            phi,
+            phi: Vec::new(),
             k,
             ktk_inv,
             q,
@@ -373,6 +387,31 @@ impl Problem {
             }
         }
         problem
+    }
+
+    /// Sets the weights `φ_i^s = τ(D_i)` of eq. (11), `D_i` the normalised distance
+    /// from cage vertex `i` averaged over each triangle's corners.
+    fn weigh(&mut self, distances: &[Vec<f64>], tau: Tau) {
+        let n = self.n;
+        let mut phi = vec![0.0; self.triangles.len() * n];
+        for (s, t) in self.triangles.iter().enumerate() {
+            for i in 0..self.cage_vertices {
+                let d = t.iter().map(|&v| distances[i][v as usize]).sum::<f64>() / 3.0;
+                phi[s * n + i] = tau.apply(d);
+            }
+        }
+        self.coef = phi
+            .iter()
+            .enumerate()
+            .map(|(si, &p)| (p * self.elements.area[si / n].sqrt()) as Stored)
+            .collect();
+        self.phi = phi;
+    }
+
+    /// Whether the coordinates are left to the ADMM: rows inside, and more cage
+    /// vertices than a triangle's (whose barycentric coordinates are the answer).
+    fn needs_admm(&self) -> bool {
+        !self.interior.is_empty() && self.cage_vertices > 3
     }
 
     /// Rows of all mesh vertices: boundary values on the cage, the least-norm

@@ -486,7 +486,9 @@ struct LbcBench {
     samples: usize,
     triangles: usize,
     cage_vertices: usize,
+    /// The geodesics, and the Y-update's factorisation run beside them.
     geodesics_ms: f64,
+    /// The factorisation alone (within `geodesics_ms`).
     factorisation_ms: f64,
     admm_iterations: usize,
     admm_ms: f64,
