@@ -481,18 +481,11 @@ impl Problem {
         2 * self.triangles.len() * self.n
     }
 
-    /// `Gᵀ t₁` for the triangle part `t1` of a state vector, per unknown row: a
-    /// gather over each row's incident triangles (which sit near each other, the
+    /// Unknown row `j` of `Gᵀ t₁`, for the triangle part `t1` of a state vector: a
+    /// gather over the row's incident triangles (which sit near each other, the
     /// triangles being numbered by their first vertex along a Z-order curve). Adding
     /// each triangle's terms into per-thread copies of all rows instead cost 10%
     /// more an iteration at 20k vertices, in filling and summing the copies.
-    fn gather(&self, t1: &[Stored], gt: &mut [f64]) {
-        gt.par_chunks_mut(self.n)
-            .enumerate()
-            .for_each(|(j, acc)| self.gather_row(t1, j, acc));
-    }
-
-    /// Unknown row `j` of [`Problem::gather`].
     #[inline(always)]
     fn gather_row(&self, t1: &[Stored], j: usize, acc: &mut [f64]) {
         let n = self.n;
@@ -509,7 +502,8 @@ impl Problem {
     crate::wide::twice! {
     /// The Y-update towards the targets in the state vector `t`: the unknown rows
     /// of `z` become `YM + H` with
-    /// `Y = (GᵀG + βM)⁻¹ [Gᵀ(t₁ − E) + βM t₂] Mᵀ`, with `Gᵀt₁` from `b.gt`.
+    /// `Y = (GᵀG + βM)⁻¹ [Gᵀ(t₁ − E) + βM t₂] Mᵀ`, `Gᵀt₁` gathered row by row
+    /// ([`Problem::gather_row`]).
     ///
     /// `(GᵀG + βM)⁻¹` acts on rows (mesh vertices) and `MᵀM` on columns (cage
     /// vertices), so they commute: `Y M = (GᵀG + βM)⁻¹ (R MᵀM)`, and `MᵀM` is the
@@ -533,8 +527,7 @@ impl Problem {
         keep: bool,
     ) -> f64 {
         let n = self.n;
-        let t2 = &t[self.triangle_part()..];
-        let gt = &b.gt;
+        let (t1, t2) = t.split_at(self.triangle_part());
         // `R − R_prev` goes into `b.r` where this call measures, `R` into
         // `b.r_previous` where it keeps.
         let measuring = measure && b.has_previous;
@@ -548,17 +541,19 @@ impl Problem {
                     let j = task * PER_TASK + k;
                     let root = self.root[j];
                     let row = j * n..(j + 1) * n;
-                    let rows = acc.iter_mut().zip(&t2[row.clone()]).zip(&gt[row]);
+                    // `Gᵀt₁` first, then the rest around it.
+                    self.gather_row(t1, j, acc);
+                    let rows = acc.iter_mut().zip(&t2[row]);
                     match self.gte_at[j] {
                         u32::MAX => {
-                            for ((a, &t), g) in rows {
-                                *a = root * f64::from(t) + g;
+                            for (a, &t) in rows {
+                                *a += root * f64::from(t);
                             }
                         }
                         at => {
                             let e = &self.gte[at as usize * n..(at as usize + 1) * n];
-                            for (((a, &t), g), e) in rows.zip(e) {
-                                *a = root * f64::from(t) - e + g;
+                            for ((a, &t), e) in rows.zip(e) {
+                                *a += root * f64::from(t) - e;
                             }
                         }
                     }
@@ -620,6 +615,8 @@ impl Problem {
                     let rest: f64 = (whole..y.len()).map(|k| (y[k] - yp[k]) * change[k]).sum();
                     (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + rest
                 })
+                .collect::<Vec<f64>>()
+                .iter()
                 .sum()
         } else {
             0.0
@@ -659,6 +656,9 @@ impl Problem {
         let z = &*z;
         let (t1, t2) = t.split_at_mut(self.triangle_part());
         let inverse_penalty = 1.0 / penalty;
+        // Each task's sums, then the tasks' in order (here and below): rayon's own
+        // reduction groups them as the threads happen to split the work, which moves
+        // the last bits, and so the stop, from run to run.
         let gradients = t1
             .par_chunks_mut(2 * n * PER_TASK)
             .enumerate()
@@ -676,25 +676,20 @@ impl Problem {
                 }
                 r
             })
-            .reduce(Residuals::default, Residuals::add);
-        // The W-update row by row, with the next Y-update's `Gᵀt₁` gathered on the
-        // way.
-        let t1 = &*t1;
+            .collect::<Vec<_>>()
+            .into_iter()
+            .fold(Residuals::default(), Residuals::add);
+        // The W-update row by row.
         let values = t2
             .par_chunks_mut(n * PER_TASK)
             .zip(clamped.par_chunks_mut(n * PER_TASK))
-            .zip(b.gt.par_chunks_mut(n * PER_TASK))
             .enumerate()
-            .map(|(task, ((t2, clamped), gt))| {
+            .map(|(task, (t2, clamped))| {
                 let mut sum = Residuals::default();
                 let mut terms = if measure { vec![0.0; 4 * n] } else { Vec::new() };
-                let rows = t2
-                    .chunks_exact_mut(n)
-                    .zip(clamped.chunks_exact_mut(n))
-                    .zip(gt.chunks_exact_mut(n));
-                for (k, ((tj, wj), gt)) in rows.enumerate() {
+                let rows = t2.chunks_exact_mut(n).zip(clamped.chunks_exact_mut(n));
+                for (k, (tj, wj)) in rows.enumerate() {
                     let j = task * PER_TASK + k;
-                    self.gather_row(t1, j, gt);
                     let v = self.interior[j] as usize;
                     let zj = &z[v * n..(v + 1) * n];
                     let (root, m) = (self.root[j], self.split[j]);
@@ -724,7 +719,9 @@ impl Problem {
                 }
                 sum
             })
-            .reduce(Residuals::default, Residuals::add);
+            .collect::<Vec<_>>()
+            .into_iter()
+            .fold(Residuals::default(), Residuals::add);
         let mut r = gradients.add(values);
         r.dual = dual;
         r
@@ -840,7 +837,6 @@ impl Problem {
         let mi = self.interior.len();
         let len = self.triangle_part() + mi * n;
         let mut buffers = YBuffers {
-            gt: vec![0.0; mi * n],
             rhs: vec![0.0; mi * n],
             r: vec![0.0; mi * n],
             r_previous: vec![0.0; mi * n],
@@ -873,7 +869,6 @@ impl Problem {
                     t2[j * n + i] = (self.root[j] * z[v * n + i]) as Stored;
                 }
             }
-            self.gather(t1, &mut buffers.gt);
         }
         // The penalty to start with: the multipliers of the gradient split are
         // bounded by the weights `φ√A` at the optimum and the split gradients are
@@ -977,7 +972,6 @@ impl Problem {
                 let factor = ratio.sqrt().clamp(0.1, 10.0);
                 mu *= factor;
                 self.rescale(&previous, z, &mut t, factor);
-                self.gather(&t[..self.triangle_part()], &mut buffers.gt);
                 last_change = it;
                 interval *= 2;
             }
@@ -1044,6 +1038,8 @@ impl Problem {
                     })
                     .sum::<f64>()
             })
+            .collect::<Vec<f64>>()
+            .iter()
             .sum();
         total * self.scale
     }
@@ -1052,8 +1048,6 @@ impl Problem {
 /// The Y-update's right-hand side and solution, and the last ones, for the dual
 /// residual.
 struct YBuffers {
-    /// `Gᵀt₁` of the state the next Y-update starts from.
-    gt: Vec<f64>,
     /// `R`, solved in place into `Y`.
     rhs: Vec<f64>,
     /// `R − R_prev`, where the dual residual is measured…
