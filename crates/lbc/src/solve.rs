@@ -115,7 +115,7 @@ pub fn solve(
         })?;
         let time = start.elapsed();
         problem.weigh(&distances, settings.tau);
-        let mut c = solve_problem(domain, &problem, factor.transpose()?, settings, progress)?;
+        let mut c = solve_problem(domain, problem, factor.transpose()?, settings, progress)?;
         c.report.geodesics = time;
         Ok(c)
     })
@@ -175,7 +175,7 @@ fn solve_ordered(
 ) -> Result<Coordinates, LbcError> {
     let mut problem = Problem::new(domain);
     problem.weigh(distances, settings.tau);
-    solve_problem(domain, &problem, None, settings, progress)
+    solve_problem(domain, problem, None, settings, progress)
 }
 
 /// The ADMM on `problem` (weighted) and the projection of its rows; `factor` its
@@ -183,7 +183,7 @@ fn solve_ordered(
 /// [`Problem::factorise`]).
 fn solve_problem(
     domain: &Domain,
-    problem: &Problem,
+    problem: Problem,
     factor: Option<(RowFactor, Duration)>,
     settings: &Settings,
     progress: &mut dyn FnMut(&Progress) -> bool,
@@ -222,8 +222,9 @@ fn solve_problem(
     problem.project(&mut z, clamped.as_deref());
     report.projection = t.elapsed();
     report.objective = problem.objective(&z);
-    let k = problem.k[..n].to_vec();
-    Ok(Coordinates::new(n, z, report, k, problem.q.clone()))
+    let mut k = problem.k;
+    k.truncate(n);
+    Ok(Coordinates::new(n, z, report, k, problem.q))
 }
 
 /// Everything fixed during the iterations, in the solver's frame.
